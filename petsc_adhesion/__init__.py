@@ -1,0 +1,9 @@
+"""petsc-adhesion: adhesive contact of a rough elastic microparticle with a flat.
+
+The self-consistent model of Cheng, Dunn and Brach (J. Adhesion 78, 2002):
+Lennard-Jones surface stress (Derjaguin approximation) coupled to half-space
+elasticity, Gaussian roughness averaged over the gap, solved with PETSc.
+"""
+
+__version__ = "0.1.0"
+__all__ = ["__version__"]

@@ -1,0 +1,55 @@
+"""Newton (SNES) for G(H; lambda) = 0 at a fixed approach lambda.
+
+The SNES gets the residual of eq. (12), the shell Jacobian and a
+preconditioning matrix from :class:`~petsc_adhesion.residual.Problem`, and the
+domain guard as its line-search pre-check.  Defaults are set here, before
+``setFromOptions()``, so every one of them can be overridden at run time.
+"""
+from __future__ import annotations
+
+from petsc4py import PETSc
+
+__all__ = ["create_snes", "default_pc", "solve"]
+
+
+def default_pc(pc: PETSc.PC, pmat: str) -> None:
+    """Preconditioner for the kind of matrix it gets (overridable: -pc_type ...).
+
+    dense: LU on one rank, block Jacobi with dense LU per rank otherwise;
+    band: LU of the near-field AIJ on one rank, block Jacobi + ILU in parallel;
+    shell: none.
+    """
+    if pmat == "shell":
+        pc.setType("none")
+    elif pc.getComm().getSize() == 1:
+        pc.setType("lu")
+    else:
+        pc.setType("bjacobi")
+        # the sub-PC type is set through the database: sub-KSPs exist only after setup
+        opts = PETSc.Options(pc.getOptionsPrefix() or "")
+        if not opts.hasName("sub_pc_type"):
+            opts.setValue("sub_pc_type", "lu" if pmat == "dense" else "ilu")
+
+
+def create_snes(problem, comm=None) -> PETSc.SNES:
+    """A Newton-Krylov SNES (GMRES) on ``problem`` at ``problem.lam``."""
+    comm = comm or problem.comm
+    snes = PETSc.SNES().create(comm)
+    snes.setType("newtonls")
+    snes.setFunction(problem.form_function, problem.create_vec())
+    snes.setJacobian(problem.form_jacobian, problem.J, problem.P)
+    snes.setTolerances(rtol=1e-10, atol=1e-10, stol=1e-14, max_it=50)
+    ksp = snes.getKSP()
+    ksp.setType("gmres")
+    ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=1000)
+    default_pc(ksp.getPC(), problem.pmat_kind)
+    snes.setLineSearchPreCheck(problem.precheck)
+    snes.setFromOptions()
+    return snes
+
+
+def solve(snes: PETSc.SNES, problem, lam: float, H: PETSc.Vec) -> bool:
+    """Solve G(H; lam) = 0 in place from the guess in H; True when converged."""
+    problem.lam = lam
+    snes.solve(None, H)
+    return snes.getConvergedReason() > 0

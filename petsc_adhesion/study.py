@@ -1,0 +1,253 @@
+"""The study driver: options -> model -> grid -> solver -> results -> files.
+
+A study is either one solve at a fixed approach (``-adh_lambda``) or the whole
+load-approach curve by continuation (the default).
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+import petsc4py
+from petsc4py import PETSc
+
+from . import __version__, grid
+from .continuation import Continuation, Settings
+from .events import EventFinder, grid_warning
+from .influence import create_influence
+from .model import Model
+from .options import TABLE, AppOptions, InputError, check_unused, print_help
+from .output import check_writable, write_h5, write_json
+from .residual import Problem
+from .solver import create_snes, solve
+
+__all__ = ["read_model", "read_grid", "gather", "main"]
+
+_APP = ("adh_", "grid_", "cont_")
+
+
+def _is_app(name: str) -> bool:
+    return name.startswith(_APP) or name in TABLE
+
+
+def read_model(opts: AppOptions) -> Model:
+    model = Model(mu=opts.real("adh_mu"), sigma=opts.real("adh_sigma"), rmax=opts.real("adh_rmax"),
+                  roughness=opts.choice("adh_roughness"), hermite_points=opts.int("adh_hermite_points"))
+    if model.roughness == "none" and model.sigma > 0:
+        raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
+    return model
+
+
+def read_grid(opts: AppOptions, model: Model) -> np.ndarray:
+    kind = opts.choice("grid_type")
+    n, nu = opts.int("grid_n"), opts.int("grid_paper_uniform")
+    extra, start = opts.int("grid_paper_extra"), opts.real("grid_paper_refine_from")
+    if kind == "uniform":
+        return grid.uniform(n, model.rmax)
+    if extra > nu - 1:
+        raise InputError(f"-grid_paper_extra: expected an integer in [0, {nu - 1}], got {extra}")
+    if start >= model.rmax:
+        raise InputError(f"-grid_paper_refine_from: expected a real in [0, {model.rmax:g}), got {start:g}")
+    return grid.paper(model.rmax, nu, extra, start)
+
+
+def gather(v: PETSc.Vec) -> np.ndarray:
+    """The whole of a distributed vector, on every rank."""
+    scatter, full = PETSc.Scatter.toAll(v)
+    scatter.scatter(v, full, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+    out = full.getArray(readonly=True).copy()
+    scatter.destroy()
+    full.destroy()
+    return out
+
+
+def _guess(problem: Problem, lam: float, path: str | None) -> PETSc.Vec:
+    H = problem.rigid(lam, problem.create_vec())
+    if path is None:
+        return H
+    try:
+        import h5py
+        with h5py.File(path, "r") as f:
+            r0, h0 = f["grid/r"][()], f["solution/H"][()]
+    except (OSError, KeyError) as e:
+        raise InputError(f"-adh_guess: cannot read grid/r and solution/H from '{path}' ({e})") from None
+    h = np.interp(problem.r[problem.lo:problem.hi], r0, h0)
+    if not np.all(np.isfinite(h)) or np.any(h <= problem.law.wall):
+        raise InputError(f"-adh_guess: H in '{path}' is not finite and above the wall {problem.law.wall:g}")
+    H.setArray(h)
+    return H
+
+
+def _versions(comm) -> dict:
+    return {"program": "petsc-adhesion", "version": __version__,
+            "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(),
+            "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize()}
+
+
+def fixed_solve(problem: Problem, snes: PETSc.SNES, lam: float, H: PETSc.Vec) -> dict:
+    """One solve at approach ``lam``: the state, its load and the solver's effort."""
+    t0 = time.perf_counter()
+    ok = solve(snes, problem, lam, H)
+    wall = time.perf_counter() - t0
+    if not ok:
+        raise RuntimeError(f"Newton did not converge at lambda = {lam:g} "
+                           f"(reason {snes.getConvergedReason()}); try -adh_guess or -snes_monitor")
+    p, _ = problem.pressure(H)
+    pv = problem.create_vec()
+    pv.setArray(p)
+    Hall, Pall = gather(H), gather(pv)
+    return {"lambda": lam, "F": problem.load(H), "H0": float(Hall[0]), "H": Hall, "P": Pall,
+            "snes_iterations": snes.getIterationNumber(),
+            "ksp_iterations": snes.getLinearSolveIterations(), "wall_time_s": wall}
+
+
+def start_lambda(model: Model, wall: float) -> float:
+    """Default first approach: the sphere well out of reach of the surface forces.
+
+    The rigid gap at r = 0 is then 3 + 2 mu above the wall of the roughness rule.
+    """
+    return -(wall + 1.0) - 3.0 - 2.0 * model.mu
+
+
+def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
+    """The whole load-approach curve with its events (the program's main job)."""
+    model = problem.model
+    settings = Settings(kind=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
+                        ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
+                        lambda_max=opts.real("cont_lambda_max") or np.inf, F_max=opts.real("cont_F_max"),
+                        max_steps=opts.int("cont_max_steps"), monitor=opts.flag("cont_monitor"))
+    lam0 = opts.real("cont_lambda_start")
+    lam0 = start_lambda(model, problem.law.wall) if lam0 is None else lam0
+    t0 = time.perf_counter()
+    cont = Continuation(problem, snes, settings)
+    finder = EventFinder(cont, opts.reals("cont_at_lambda"), opts.real("cont_event_tol"), opts.flag("profiles"))
+    pts = cont.run(lam0, on_step=finder)
+    finder.landings()
+    wall = time.perf_counter() - t0
+    comm = problem.comm.tompi4py()
+
+    def whole(h):
+        parts = comm.gather(h, root=0)
+        return np.concatenate(parts) if parts is not None else None
+
+    for ev in finder.events:
+        for e in (ev, ev.get("landing", {})):
+            if "h" in e:
+                H = whole(e.pop("h"))
+                if H is not None:
+                    e["H"], e["P"] = H, problem.law(H)[0]
+    # the contact edge: where the attraction peaks (P most negative), on rank 0's view of the curve
+    edges = np.array([problem.r[np.argmin(problem.law(H)[0])] for H in map(whole, (p.h for p in pts))
+                      if H is not None and np.min(problem.law(H)[0]) < 0])
+    return {"points": pts, "events": finder.events, "pull_off": finder.pull_off(),
+            "steps": len(pts) - 1, "rejected_steps": cont.rejected, "stop_reason": cont.stop_reason,
+            "grid_warning": grid_warning(model, problem.r, edges), "wall_time_s": wall,
+            "lambda_start": lam0}
+
+
+def curve_summary(res: dict) -> dict:
+    """The JSON summary of a traced curve (schema in docs/output.md)."""
+    def brief(e):
+        return {k: v for k, v in e.items() if k in ("kind", "lambda", "F", "H0", "stable")} | (
+            {"landing": {k: v for k, v in e["landing"].items() if k in ("lambda", "F", "H0")}}
+            if "landing" in e else {})
+    ev = res["events"]
+    po = res["pull_off"]
+    return {"pull_off": {"lambda": po["lambda"], "F": po["F"]} if po else None,
+            "folds": [brief(e) for e in ev if e["kind"] in ("snap_on", "snap_off")],
+            "equilibria": [{"lambda": e["lambda"]} for e in ev if e["kind"] == "equilibrium"],
+            "load_extrema": [brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
+            "at_lambda": [brief(e) for e in ev if e["kind"] == "lambda"],
+            "steps": res["steps"], "rejected_steps": res["rejected_steps"], "stop_reason": res["stop_reason"],
+            "grid_warning": res["grid_warning"], "wall_time_s": res["wall_time_s"]}
+
+
+def curve_tree(res: dict) -> dict:
+    pts = res["points"]
+    curve = {"lambda": np.array([p.lam for p in pts]), "F": np.array([p.F for p in pts]),
+             "stable": np.array([p.tl > 0 for p in pts]), "ds": np.array([p.ds for p in pts]),
+             "newton_its": np.array([p.its for p in pts]), "ksp_its": np.array([p.ksp_its for p in pts]),
+             "H0": np.array([p.h[0] for p in pts]), "lambdadot": np.array([p.tl for p in pts]),
+             "corrector": np.array([p.kind for p in pts], dtype="S9")}
+    events = [{k: v for k, v in e.items() if k != "segment"} for e in res["events"]]
+    return {"curve": curve, "events": events}
+
+
+def main() -> int:
+    comm = PETSc.COMM_WORLD
+    opts = AppOptions()
+    helping = opts.db.hasName("help")
+    if helping and comm.getRank() == 0:
+        print_help(sys.stdout)
+    model = read_model(opts)
+    r = read_grid(opts, model)
+    lam = opts.real("adh_lambda")
+    guess = opts.string("adh_guess")
+    out, summary = opts.string("out"), opts.string("summary")
+    pmat, band = opts.choice("adh_pmat"), opts.int("adh_pmat_band")
+    if pmat == "dense" and comm.getSize() == 1 and r.size > 20000:
+        raise InputError(f"-adh_pmat: dense needs {8 * r.size**2 / 2**30:.1f} GiB at N = {r.size}; use band or shell")
+    for name in TABLE:                      # read every app option now, so a typo is caught before any work
+        getattr(opts, TABLE[name].kind)(name)
+    check_unused(_is_app)
+    check_writable("out", out)
+    check_writable("summary", summary)
+
+    A = create_influence(r, comm)
+    problem = Problem(model, r, A, pmat, band)
+    snes = create_snes(problem)
+    if helping:
+        return 0
+    if lam is None:
+        res = trace(problem, snes, opts)
+        check_unused()
+        if comm.getRank() == 0:
+            info = _versions(comm)
+            model_attrs = _model_attrs(model)
+            summ = {**info, **model_attrs, "n_nodes": int(r.size), **curve_summary(res)}
+            if out:
+                write_h5(out, {**info, "kind": "curve", "options": opts.db.getAll(), "model": model_attrs,
+                               "grid": {"r": r}, **curve_tree(res), "summary": {
+                                   k: v for k, v in summ.items() if not isinstance(v, (list, dict)) and v is not None}})
+            if summary:
+                write_json(summary, summ)
+            _report(summ)
+        return 0
+    res = fixed_solve(problem, snes, lam, _guess(problem, lam, guess))
+    check_unused()
+    if comm.getRank() == 0:
+        info = _versions(comm)
+        model_attrs = _model_attrs(model)
+        brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
+        if out:
+            write_h5(out, {**info, "kind": "solve", "options": opts.db.getAll(), "model": model_attrs,
+                           "grid": {"r": r}, "solution": {"H": res["H"], "P": res["P"], **brief}})
+        if summary:
+            write_json(summary, {**info, **model_attrs, "n_nodes": int(r.size), **brief})
+        print(f"lambda = {lam:.10g}  F = {res['F']:.10g}  H0 = {res['H0']:.10g}  "
+              f"Newton {res['snes_iterations']}  KSP {res['ksp_iterations']}  {res['wall_time_s']:.3g} s")
+    return 0
+
+
+def _model_attrs(model: Model) -> dict:
+    return {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax,
+            "roughness": model.roughness, "hermite_points": model.hermite_points}
+
+
+def _report(s: dict) -> None:
+    po = s["pull_off"]
+    print(f"mu = {s['mu']:g}  sigma = {s['sigma']:g}  N = {s['n_nodes']}  steps {s['steps']} "
+          f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s; stopped: {s['stop_reason']}")
+    if po:
+        print(f"  pull-off (load control)  lambda = {po['lambda']:.8f}  F = {po['F']:.8f}")
+    for f in s["folds"]:
+        land = f.get("landing")
+        to = f"  -> lands at F = {land['F']:.8f}" if land else ""
+        print(f"  {f['kind']:<23}  lambda = {f['lambda']:.8f}  F = {f['F']:.8f}{to}")
+    for e in s["equilibria"]:
+        print(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}")
+    for e in s["at_lambda"]:
+        print(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}")
+    if s["grid_warning"]:
+        print(f"  WARNING: {s['grid_warning']}")
