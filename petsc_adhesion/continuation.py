@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from petsc4py import PETSc
 
-from .residual import shorten_to_wall
+from .residual import PCReuse, shorten_to_wall
 from .solver import default_pc
 
 __all__ = ["Point", "Bordered", "Continuation"]
@@ -89,10 +89,11 @@ class Bordered:
         self.snes.setTolerances(rtol=1e-10, atol=1e-10, stol=1e-14, max_it=50)
         ksp = self.snes.getKSP()
         ksp.setType("gmres")
-        ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=1000)
+        ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=200)
         default_pc(ksp.getPC(), pb.pmat_kind)
         self.snes.setLineSearchPreCheck(self.precheck)
         self.snes.setFromOptions()
+        self.reuse = PCReuse(pb.reuse.its)
         # the hyperplane Q of eq. (24): through (h0, lam0), normal (th, tl), at distance ds
         self.h0, self.lam0, self.th, self.tl, self.ds = None, 0.0, None, 1.0, 0.0
 
@@ -130,13 +131,15 @@ class Bordered:
     def form_jacobian(self, snes, X, K, P):
         h, _ = self.split(X)
         self.H.setArray(h)
-        self.linearize()
+        self.linearize(self.reuse(snes.getKSP()))
 
-    def linearize(self) -> None:
-        """G_H at self.H (shell), and the assembled bordered matrix for the PC."""
+    def linearize(self, assemble: bool) -> None:
+        """G_H at self.H (shell) and, with ``assemble``, the bordered matrix for the PC."""
         pb = self.pb
         pb.linearize(self.H, assemble=False)
-        if pb.pmat_kind == "dense":
+        if not assemble:
+            pass
+        elif pb.pmat_kind == "dense":
             a = self.P.getDenseArray()
             a[:, :-1][:self.nloc] = pb.jacobian_rows()
             a[:self.nloc, -1] = 1.0
@@ -194,9 +197,7 @@ class Bordered:
             return None
         self.h0, self.lam0, self.th, self.tl, self.ds = a.h, a.lam, th, tl, ds
         self.set_border(th, tl)
-        self.join(h, a.lam + ds * tl)
-        self.snes.solve(None, self.X)
-        if self.snes.getConvergedReason() <= 0:
+        if not fresh_retry(self.snes, self.join(h, a.lam + ds * tl), self.reuse):
             return None
         h, lam = self.split(self.X)
         return h.copy(), lam, self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
@@ -205,19 +206,46 @@ class Bordered:
         """Unit tangent at (h, lam) oriented along (th, tl): solve [[G_H, 1], [w th, tl]] z = (0, 1)."""
         self.H.setArray(h)
         self.set_border(th, tl)
-        self.linearize()
-        ksp = self.snes.getKSP()
-        ksp.setOperators(self.K, self.P)
         rhs = self.X.duplicate()
         rhs.set(0.0)
         if self.last:
             rhs.setValue(rhs.getSize() - 1, 1.0)
         rhs.assemble()
         z = self.X.duplicate()
-        ksp.solve(rhs, z)
+        ksp = self.snes.getKSP()
+        if not krylov_retry(ksp, self.K, self.P, rhs, z, self.reuse, self.linearize):
+            return None
         zh, zl = self.split(z)
         norm = math.sqrt(self.pb.inner(zh, zh) + zl * zl)
         return zh / norm, zl / norm, ksp.getIterationNumber()
+
+
+def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse) -> bool:
+    """Solve from X in place; after a failure, once more with a fresh preconditioner.
+
+    A factorization kept from a distant point of the curve can make the first
+    linear solve fail where Newton itself is fine.
+    """
+    x0 = X.copy()
+    for _ in range(2):
+        snes.solve(None, X)
+        if snes.getConvergedReason() > 0:
+            return True
+        reuse.expire()
+        x0.copy(X)
+    return False
+
+
+def krylov_retry(ksp: PETSc.KSP, A, P, b: PETSc.Vec, x: PETSc.Vec, reuse: PCReuse, linearize) -> bool:
+    """Solve A x = b at the point set by ``linearize(assemble)``; retry once with a fresh PC."""
+    for _ in range(2):
+        linearize(reuse(ksp))
+        ksp.setOperators(A, P)
+        ksp.solve(b, x)
+        if ksp.getConvergedReason() > 0:
+            return True
+        reuse.expire()
+    return False
 
 
 @dataclass
@@ -249,13 +277,11 @@ class Continuation:
         pb = self.pb
         H = pb.create_vec()
         H.setArray(h)
-        pb.linearize(H)
-        ksp = self.snes.getKSP()
-        ksp.setOperators(pb.J, pb.P)
         rhs, phi = pb.create_vec(), pb.create_vec()
         rhs.set(-1.0)
-        ksp.solve(rhs, phi)
-        if ksp.getConvergedReason() <= 0:
+        ksp = self.snes.getKSP()
+        if not krylov_retry(ksp, pb.J, pb.P, rhs, phi, pb.reuse,
+                            lambda assemble: pb.linearize(H, assemble)):
             return None
         p = phi.getArray(readonly=True).copy()
         a = 1.0 / math.sqrt(1.0 + pb.inner(p, p))
@@ -300,8 +326,7 @@ class Continuation:
             H = pb.create_vec()
             H.setArray(h)
             pb.lam = lam
-            self.snes.solve(None, H)                  # eq. (21)-(22)
-            if self.snes.getConvergedReason() <= 0:
+            if not fresh_retry(self.snes, H, pb.reuse):    # eq. (21)-(22)
                 return None
             h = H.getArray(readonly=True).copy()
             its, kits = self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
@@ -315,7 +340,10 @@ class Continuation:
             if sol is None:
                 return None
             h, lam, its, kits = sol
-            th, tl, tk = self.bordered.tangent(h, lam, a.th, a.tl)
+            tan = self.bordered.tangent(h, lam, a.th, a.tl)
+            if tan is None:
+                return None
+            th, tl, tk = tan
             kind = "arclength"
         # angle guard: a tangent that turned too far means a jump between branches
         if pb.inner(a.th, th) + a.tl * tl < 0.8:
@@ -342,6 +370,8 @@ class Continuation:
         while True:
             b = self.step(a, ds)
             if b is None:
+                self.pb.reuse.expire()
+                self.bordered.reuse.expire()
                 self.rejected += 1
                 ds *= 0.5
                 if ds < s.ds_min:
@@ -358,7 +388,7 @@ class Continuation:
             if self.stop_reason:
                 break
             # grow on fast Newton, shrink on slow (pacopy's rule)
-            if b.its <= s.newton_target // 2:
+            if b.its < s.newton_target:
                 ds = min(1.5 * ds, s.ds_max)
             elif b.its > s.newton_target:
                 ds = max(0.7 * ds, s.ds_min)

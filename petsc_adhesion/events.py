@@ -76,8 +76,10 @@ class EventFinder:
                 if sol is None:
                     raise RuntimeError(f"event location failed near lambda = {a.lam:.6g}")
                 h, lam, _, _ = sol
-                th, tl, _ = cont.bordered.tangent(h, lam, a.th, a.tl)
-                cache[s] = cont.make_point(h, lam, th, tl, kind="event")
+                tan = cont.bordered.tangent(h, lam, a.th, a.tl)
+                if tan is None:
+                    raise RuntimeError(f"event location failed near lambda = {a.lam:.6g}")
+                cache[s] = cont.make_point(h, lam, tan[0], tan[1], kind="event")
             return f(cache[s]) - level
 
         # lambda moves by at most |s| along a unit tangent, so xtol in s bounds the error in lambda

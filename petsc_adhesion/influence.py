@@ -64,12 +64,14 @@ def _regular(rr: np.ndarray, c: np.ndarray, ell: np.ndarray,
         sel = np.flatnonzero((q >= lower) & (q < upper))
         lower = upper
         x, w = _GAUSS[n]
-        r = rr[sel, None]
-        t = c[sel, None] + ell[sel, None] * x
-        s = (t - r) / (t + r)
+        r = rr[sel]
+        # points along axis 0: numpy's inner loops then run over the pieces
+        t = c[sel] + ell[sel] * x[:, None]
+        tr = t + r
+        s = (t - r) / tr
         # 1 - m as s^2 keeps K's digits where t is close to r
-        f = t / (t + r) * ellipkm1(s * s)
-        f0, f1 = f @ w, f @ (w * x)
+        f = t / tr * ellipkm1(s * s)
+        f0, f1 = w @ f, (w * x) @ f
         right[sel] = ell[sel] * (u0[sel] * f0 + du[sel] * f1)
         left[sel] = ell[sel] * f0 - right[sel]
     return left, right
@@ -126,42 +128,39 @@ def _add_rows(r: np.ndarray, lo: int, out: np.ndarray) -> None:
     n = r.size
     a, h = r[:-1], np.diff(r)
     rows = np.arange(lo, lo + out.shape[0])
-
-    # pairs (local row, element); an element touches r_i if e = i - 1 or i
-    far_row, far_el = np.nonzero((np.arange(n - 1) < rows[:, None] - 1)
-                                 | (np.arange(n - 1) > rows[:, None]))
-    below = np.arange(rows.size)                    # e = i - 1, r_i = b
-    above = np.flatnonzero(rows < n - 1)            # e = i, r_i = a
+    below = np.arange(rows.size)                    # element i - 1 ends at r_i
+    above = np.flatnonzero(rows < n - 1)            # element i starts at r_i
     el_below, el_above = rows[below] - 1, rows[above]
-    # the log rule takes the part next to r_i, short enough to stay its own
-    # length away from t = 0; the rest of the element is a regular piece
+    # the log rule takes the part of these two elements next to r_i, short
+    # enough to stay its own length away from t = 0
     len_below = h[el_below] / 2
     len_above = np.minimum(h[el_above] / 2, r[el_above])
 
-    pr = np.concatenate([far_row, below, above])
-    pe = np.concatenate([far_el, el_below, el_above])
-    c = np.concatenate([a[far_el], a[el_below], a[el_above] + len_above])
-    ell = np.concatenate([h[far_el], h[el_below] - len_below,
-                          h[el_above] - len_above])
-    rr = r[rows[pr]]
-    dist = np.maximum(c - rr, rr - c - ell)
-    q = dist / ell
-    piece = (rr, c, ell, (c - a[pe]) / h[pe], ell / h[pe])
-    left, right = np.empty_like(c), np.empty_like(c)
-    cut = q < _Q_SPLIT
-    left[~cut], right[~cut] = _regular(*(v[~cut] for v in piece), q[~cut])
+    # one regular piece per (row, element): the element less that part
+    c = np.repeat(a[None], rows.size, axis=0)
+    ell = np.repeat(h[None], rows.size, axis=0)
+    ell[below, el_below] -= len_below
+    c[above, el_above] += len_above
+    ell[above, el_above] -= len_above
+    ri = r[rows, None]
+    dist = np.maximum(c - ri, ri - c - ell).ravel()
+    piece = (np.repeat(r[rows], n - 1), c.ravel(), ell.ravel(),
+             ((c - a) / h).ravel(), (ell / h).ravel())
+    q = dist / piece[2]
+    left, right = _regular(*piece, q)
+    cut = np.flatnonzero(q < _Q_SPLIT)
     left[cut], right[cut] = _split(*(v[cut] for v in piece), dist[cut])
+    out[:, :-1] += left.reshape(c.shape)
+    out[:, 1:] += right.reshape(c.shape)
 
     tr = np.concatenate([below, above])
     te = np.concatenate([el_below, el_above])
     tleft, tright = _touching(r[rows[tr]],
                               np.concatenate([-len_below, len_above]),
                               a[te], h[te])
-
-    # each (row, element) pair occurs once per group: += cannot collide
-    for i, e, vl, vr in ((pr, pe, left, right), (tr, te, tleft, tright)):
-        out[i, e] += vl
-        out[i, e + 1] += vr
+    # each (row, element) pair occurs once here: += cannot collide
+    out[tr, te] += tleft
+    out[tr, te + 1] += tright
 
 
 def influence_rows(r: np.ndarray, start: int, stop: int) -> np.ndarray:

@@ -65,6 +65,8 @@ TABLE = {o.name: o for o in [
     Option("adh_pmat", "choice", "dense", "matrix handed to the preconditioner: the assembled Jacobian, "
            "its near-field band (AIJ), or the shell itself", choices=("dense", "band", "shell")),
     Option("adh_pmat_band", "int", 8, "half bandwidth of -adh_pmat band", 0, 10**6),
+    Option("adh_pc_reuse_its", "int", 10, "keep the preconditioner while Krylov needs at most this many "
+           "iterations (0: rebuild at every Newton iteration)", 0, 10**6),
     # grid
     Option("grid_type", "choice", "paper", "node set", choices=("paper", "uniform")),
     Option("grid_n", "int", 531, "number of nodes of -grid_type uniform", 3, 200000),

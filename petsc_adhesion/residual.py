@@ -37,9 +37,13 @@ class Problem:
         near-field band as AIJ, or nothing (the shell itself).
     band : int
         Half bandwidth of ``pmat="band"``.
+    reuse_its : int
+        Keep the preconditioner while the last Krylov solve took at most this
+        many iterations (0: rebuild at every Newton iteration).
     """
 
-    def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat: str = "dense", band: int = 8):
+    def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat: str = "dense", band: int = 8,
+                 reuse_its: int = 10):
         self.model, self.r, self.A = model, r, A
         self.comm = A.getComm()
         self.law = PressureLaw(model.sigma, model.roughness, model.hermite_points)
@@ -58,6 +62,7 @@ class Problem:
         self.P = {"dense": self._dense_pmat, "band": lambda: self._band_pmat(band),
                   "shell": lambda: self.J}[pmat]()
         self._gather = None
+        self.reuse = PCReuse(reuse_its)
 
     # -- vectors ---------------------------------------------------------
     def create_vec(self) -> PETSc.Vec:
@@ -163,7 +168,7 @@ class Problem:
         self.residual(H, self.lam, G)
 
     def form_jacobian(self, snes, H, J, P):
-        self.linearize(H)
+        self.linearize(H, assemble=self.reuse(snes.getKSP()))
 
     def precheck(self, H: PETSc.Vec, Y: PETSc.Vec, *args) -> bool:
         """Shorten the Newton step H - Y so that no gap closes (domain guard).
@@ -172,6 +177,27 @@ class Problem:
         rule, node by node; all ranks scale by the same factor.
         """
         return shorten_to_wall(self, H.getArray(readonly=True), Y)
+
+
+class PCReuse:
+    """When to refill a preconditioning matrix: only when its factorization got stale.
+
+    PETSc's PCSetUp refactors only a matrix whose state changed, so a matrix
+    left alone keeps its factorization across Newton iterations and
+    continuation steps.  Refill when the last Krylov solve of ``ksp`` failed or
+    took more than ``its`` iterations, or after :meth:`expire`.
+    """
+
+    def __init__(self, its: int):
+        self.its, self.stale = its, True
+
+    def expire(self) -> None:
+        self.stale = True
+
+    def __call__(self, ksp: PETSc.KSP) -> bool:
+        refill = self.stale or ksp.getConvergedReason() < 0 or ksp.getIterationNumber() > self.its
+        self.stale = False
+        return refill
 
 
 def shorten_to_wall(problem: Problem, h: np.ndarray, Y: PETSc.Vec, y: np.ndarray | None = None) -> bool:

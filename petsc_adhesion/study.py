@@ -195,7 +195,7 @@ def main() -> int:
     check_writable("summary", summary)
 
     A = create_influence(r, comm)
-    problem = Problem(model, r, A, pmat, band)
+    problem = Problem(model, r, A, pmat, band, opts.int("adh_pc_reuse_its"))
     snes = create_snes(problem)
     if helping:
         return 0
