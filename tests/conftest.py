@@ -1,0 +1,50 @@
+"""Shared fixtures: petsc4py initialised once, and runners for the command line."""
+import os
+import shutil
+import subprocess
+import sys
+
+import petsc4py
+import pytest
+
+petsc4py.init([sys.argv[0]])
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _env():
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    env.setdefault("PETSC_DIR", "/usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real")
+    if os.geteuid() == 0:
+        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    env.setdefault("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
+    return env
+
+
+def run_cli(*args, np=1, cwd=None, timeout=600):
+    """Run petsc-adhesion (on ``np`` ranks through mpiexec) and return the CompletedProcess."""
+    cmd = [sys.executable, "-m", "petsc_adhesion", *map(str, args)]
+    if np > 1:
+        mpiexec = shutil.which("mpiexec")
+        if mpiexec is None:
+            pytest.skip("mpiexec not found")
+        cmd = [mpiexec, "-n", str(np), *cmd]
+    return subprocess.run(cmd, cwd=cwd or ROOT, env=_env(), capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture
+def cli():
+    return run_cli
+
+
+def make_problem(mu=1.0, sigma=0.0, r=None, pmat="dense", **model):
+    """A Problem and its SNES on grid r (default: uniform, 201 nodes)."""
+    from petsc_adhesion import grid
+    from petsc_adhesion.influence import create_influence
+    from petsc_adhesion.model import Model
+    from petsc_adhesion.residual import Problem
+    from petsc_adhesion.solver import create_snes
+
+    r = grid.uniform(201, 10.0) if r is None else r
+    pb = Problem(Model(mu=mu, sigma=sigma, **model), r, create_influence(r), pmat)
+    return pb, create_snes(pb)
