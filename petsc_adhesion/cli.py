@@ -33,12 +33,15 @@ def main(argv: list[str] | None = None) -> int:
     petsc4py.init(argv)
     from petsc4py import PETSc
 
-    from .options import InputError
+    from .options import InputError, petsc_error
     from .study import main as study
 
     try:
         return study()
     except InputError as e:
         return _error(str(e), 2)
-    except (RuntimeError, FloatingPointError, PETSc.Error) as e:
+    except PETSc.Error as e:
+        bad = petsc_error(e)
+        return _error(str(bad), 2) if bad else _error(f"PETSc error {e.ierr}", 1)
+    except (RuntimeError, FloatingPointError) as e:
         return _error(str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__, 1)

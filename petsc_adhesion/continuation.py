@@ -42,6 +42,7 @@ class Point:
     tl: float
     dF: float                 # dF/ds along the tangent
     ds: float = 0.0           # the step that reached it
+    dev: float = 0.0          # |corrector - predictor| / ds: the curvature the step met
     its: int = 0              # Newton iterations of the corrector
     ksp_its: int = 0
     kind: str = "start"       # "natural" | "arclength" | "start" | "event"
@@ -254,10 +255,12 @@ class Settings:
     ds: float = 0.05
     ds_min: float = 1e-7
     ds_max: float = 0.5
-    newton_target: int = 4
+    newton_target: int = 5
+    max_deviation: float = 0.1
     lambda_max: float = math.inf
     F_max: float = 2.0
     max_steps: int = 2000
+    max_folds: int = 12
     monitor: bool = False
 
 
@@ -269,6 +272,7 @@ class Continuation:
         self.bordered = Bordered(problem)
         self.points: list[Point] = []
         self.rejected = 0
+        self.folds = 0
         self.stop_reason = ""
 
     # -- tangents -----------------------------------------------------------
@@ -345,10 +349,13 @@ class Continuation:
                 return None
             th, tl, tk = tan
             kind = "arclength"
-        # angle guard: a tangent that turned too far means a jump between branches
-        if pb.inner(a.th, th) + a.tl * tl < 0.8:
+        # the corrector's distance from the predictor grows as ds^2 times the curvature;
+        # a step that had to travel far may have cut across a fold pair unseen
+        dh = h - (a.h + ds * a.th)
+        dev = math.sqrt(pb.inner(dh, dh) + (lam - a.lam - ds * a.tl) ** 2) / ds
+        if dev > self.set.max_deviation or pb.inner(a.th, th) + a.tl * tl < 0.8:
             return None
-        return self.make_point(h, lam, th, tl, ds=ds, its=its, ksp_its=kits + tk, kind=kind)
+        return self.make_point(h, lam, th, tl, ds=ds, its=its, ksp_its=kits + tk, kind=kind, dev=dev)
 
     def done(self, b: Point) -> str:
         s = self.set
@@ -358,6 +365,8 @@ class Continuation:
             return f"approach lambda = {b.lam:.4g} >= -cont_lambda_max {s.lambda_max:g}"
         if len(self.points) > s.max_steps:
             return f"-cont_max_steps {s.max_steps} reached"
+        if self.folds > s.max_folds:
+            return f"more than -cont_max_folds {s.max_folds} turning points"
         return ""
 
     def run(self, lam0: float, on_step=None):
@@ -381,14 +390,15 @@ class Continuation:
                     break
                 continue
             self.points.append(b)
+            self.folds += a.tl * b.tl < 0
             self.monitor(b)
             if on_step:
                 on_step(a, b)
             self.stop_reason = self.done(b)
             if self.stop_reason:
                 break
-            # grow on fast Newton, shrink on slow (pacopy's rule)
-            if b.its < s.newton_target:
+            # grow on fast Newton and a nearly straight curve, shrink on slow Newton
+            if b.its < s.newton_target and b.dev < 0.5 * s.max_deviation:
                 ds = min(1.5 * ds, s.ds_max)
             elif b.its > s.newton_target:
                 ds = max(0.7 * ds, s.ds_min)

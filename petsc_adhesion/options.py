@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "print_help"]
+__all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "petsc_error", "print_help"]
 
 
 class InputError(Exception):
@@ -80,10 +80,14 @@ TABLE = {o.name: o for o in [
     Option("cont_lambda_max", "real", None, "stop at this approach (default: past equilibrium)", -1e3, 1e3),
     Option("cont_F_max", "real", 2.0, "stop at this compressive load", -_INF, 1e6),
     Option("cont_max_steps", "int", 2000, "stop after this many accepted steps", 1, 10**7),
+    Option("cont_max_folds", "int", 12, "stop after this many turning points (a grid that traps the "
+           "contact edge makes dozens)", 0, 10**6),
     Option("cont_ds", "real", 0.05, "first arclength step", 0.0, 1e3, lo_open=True),
     Option("cont_ds_min", "real", 1e-7, "smallest step before giving up", 0.0, 1e3, lo_open=True),
     Option("cont_ds_max", "real", 0.5, "largest step", 0.0, 1e3, lo_open=True),
-    Option("cont_newton_target", "int", 4, "corrector iterations aimed at by the step control", 1, 100),
+    Option("cont_newton_target", "int", 5, "corrector iterations aimed at by the step control", 1, 100),
+    Option("cont_max_deviation", "real", 0.1, "largest corrector distance from the predictor, per unit step "
+           "(bounds the step by the curvature)", 0.0, 10.0, lo_open=True),
     Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
     Option("cont_event_tol", "real", 1e-10, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
     Option("cont_monitor", "flag", False, "one line a continuation step"),
@@ -191,6 +195,30 @@ def unused_options() -> list[str]:
     left = [names[i].decode() for i in range(n.value)]
     restore(None, ctypes.byref(n), ctypes.byref(names), ctypes.byref(values))
     return left
+
+
+#: PETSc error codes that mean a bad option value: unknown type, wrong argument, out of range.
+_INPUT_CODES = (86, 62, 63)
+
+
+def petsc_error(err: PETSc.Error) -> InputError | None:
+    """The InputError behind a PETSc error raised by a bad option value, if it is one.
+
+    PETSc keeps the specific message of its last error (PetscErrorMessage); the
+    option is found as the one whose value the message quotes.
+    """
+    if err.ierr not in _INPUT_CODES:
+        return None
+    lib = ctypes.CDLL(PETSc.__file__)
+    get = lib.PetscErrorMessage
+    get.argtypes = [ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(ctypes.c_char_p)]
+    text, specific = ctypes.c_char_p(), ctypes.c_char_p()
+    get(err.ierr, ctypes.byref(text), ctypes.byref(specific))
+    detail = (specific.value or text.value or b"").decode(errors="replace").strip()
+    words = set(detail.replace("'", " ").replace('"', " ").split())
+    named = [k for k, v in PETSc.Options().getAll().items() if v and v in words]
+    where = f"-{named[0]} {PETSc.Options().getString(named[0])}: " if named else ""
+    return InputError(f"{where}{detail}")
 
 
 def check_unused(judged=lambda name: True) -> None:

@@ -115,6 +115,7 @@ def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
     model = problem.model
     settings = Settings(kind=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                         ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
+                        max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
                         lambda_max=opts.real("cont_lambda_max") or np.inf, F_max=opts.real("cont_F_max"),
                         max_steps=opts.int("cont_max_steps"), monitor=opts.flag("cont_monitor"))
     lam0 = opts.real("cont_lambda_start")
@@ -142,7 +143,7 @@ def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
                       if H is not None and np.min(problem.law(H)[0]) < 0])
     return {"points": pts, "events": finder.events, "pull_off": finder.pull_off(),
             "steps": len(pts) - 1, "rejected_steps": cont.rejected, "stop_reason": cont.stop_reason,
-            "grid_warning": grid_warning(model, problem.r, edges), "wall_time_s": wall,
+            "grid_warning": grid_warning(model, problem.r, edges, cont.folds), "wall_time_s": wall,
             "lambda_start": lam0}
 
 
@@ -188,6 +189,8 @@ def main() -> int:
     pmat, band = opts.choice("adh_pmat"), opts.int("adh_pmat_band")
     if pmat == "dense" and comm.getSize() == 1 and r.size > 20000:
         raise InputError(f"-adh_pmat: dense needs {8 * r.size**2 / 2**30:.1f} GiB at N = {r.size}; use band or shell")
+    if guess is not None and lam is None:
+        raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
     for name in TABLE:                      # read every app option now, so a typo is caught before any work
         getattr(opts, TABLE[name].kind)(name)
     check_unused(_is_app)
