@@ -90,7 +90,7 @@ class Bordered:
         self.snes.setTolerances(rtol=1e-10, atol=1e-10, stol=1e-14, max_it=50)
         ksp = self.snes.getKSP()
         ksp.setType("gmres")
-        ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=200)
+        ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=400)
         default_pc(ksp.getPC(), pb.pmat_kind)
         self.snes.setLineSearchPreCheck(self.precheck)
         self.snes.setFromOptions()

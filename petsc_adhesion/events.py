@@ -89,8 +89,10 @@ class EventFinder:
         return cache[s]
 
     def record(self, kind: str, p, segment: int) -> dict:
-        ev = {"kind": kind, "lambda": p.lam, "F": p.F, "stable": bool(p.tl > 0), "segment": segment,
+        ev = {"kind": kind, "lambda": p.lam, "F": p.F, "segment": segment,
               "H0": self.cont.pb.comm.tompi4py().bcast(float(p.h[0]) if self.cont.pb.lo == 0 else None, root=0)}
+        if kind not in ("snap_on", "snap_off"):           # at a fold lambdadot = 0: marginal
+            ev["stable"] = bool(p.tl > 0)
         if self.profiles:
             ev["h"] = p.h
         return ev

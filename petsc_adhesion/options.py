@@ -64,7 +64,7 @@ TABLE = {o.name: o for o in [
     Option("adh_guess", "string", None, "HDF5 result whose H(r) is the initial guess of -adh_lambda"),
     Option("adh_pmat", "choice", "dense", "matrix handed to the preconditioner: the assembled Jacobian, "
            "its near-field band (AIJ), or the shell itself", choices=("dense", "band", "shell")),
-    Option("adh_pmat_band", "int", 8, "half bandwidth of -adh_pmat band", 0, 10**6),
+    Option("adh_pmat_band", "int", 64, "half bandwidth of -adh_pmat band", 0, 10**6),
     Option("adh_pc_reuse_its", "int", 10, "keep the preconditioner while Krylov needs at most this many "
            "iterations (0: rebuild at every Newton iteration)", 0, 10**6),
     # grid
@@ -91,10 +91,13 @@ TABLE = {o.name: o for o in [
     Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
     Option("cont_event_tol", "real", 1e-10, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
     Option("cont_monitor", "flag", False, "one line a continuation step"),
+    Option("cont_error_estimate", "flag", False, "trace again on every other node and give each event "
+           "its discretization error (Richardson) and the load truncated beyond r_m"),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
     Option("profiles", "flag", False, "store H(r) and P(r) at every event"),
+    Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
 ]}
 
 

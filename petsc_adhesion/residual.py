@@ -42,7 +42,7 @@ class Problem:
         many iterations (0: rebuild at every Newton iteration).
     """
 
-    def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat: str = "dense", band: int = 8,
+    def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat: str = "dense", band: int = 64,
                  reuse_its: int = 10):
         self.model, self.r, self.A = model, r, A
         self.comm = A.getComm()

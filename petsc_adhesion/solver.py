@@ -41,7 +41,7 @@ def create_snes(problem, comm=None) -> PETSc.SNES:
     snes.setTolerances(rtol=1e-10, atol=1e-10, stol=1e-14, max_it=50)
     ksp = snes.getKSP()
     ksp.setType("gmres")
-    ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=200)
+    ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=400)
     default_pc(ksp.getPC(), problem.pmat_kind)
     snes.setLineSearchPreCheck(problem.precheck)
     snes.setFromOptions()

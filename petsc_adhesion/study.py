@@ -5,6 +5,7 @@ load-approach curve by continuation (the default).
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 
@@ -102,6 +103,41 @@ def fixed_solve(problem: Problem, snes: PETSc.SNES, lam: float, H: PETSc.Vec) ->
             "ksp_iterations": snes.getLinearSolveIterations(), "wall_time_s": wall}
 
 
+def discretize(model: Model, r: np.ndarray, opts: AppOptions):
+    """Influence matrix, problem and fixed-lambda SNES on grid r."""
+    A = create_influence(r, PETSc.COMM_WORLD)
+    problem = Problem(model, r, A, opts.choice("adh_pmat"), opts.int("adh_pmat_band"), opts.int("adh_pc_reuse_its"))
+    return problem, create_snes(problem)
+
+
+def estimate_errors(fine: dict, coarse: dict, rmax: float) -> None:
+    """Attach error estimates to the events of ``fine`` (in place).
+
+    Discretization: Richardson for a second-order method, |X_h - X_2h| / 3,
+    from the same curve traced on every other node (events matched by kind and
+    order).  Domain truncation of F: the attraction of the rigid sphere beyond
+    r_m, (4/3) (r_m^2/2 + 1 - lambda)^-2.
+    """
+    def by_kind(events):
+        out = {}
+        for e in events:
+            out.setdefault(e["kind"], []).append(e)
+        return out
+
+    cs = by_kind(coarse["events"])
+    for kind, evs in by_kind(fine["events"]).items():
+        matched = len(cs.get(kind, [])) == len(evs)
+        for i, e in enumerate(evs):
+            e["F_truncation"] = (4.0 / 3.0) / (rmax**2 / 2 + 1 - e["lambda"]) ** 2
+            if matched:
+                c = cs[kind][i]
+                e["lambda_err"] = abs(e["lambda"] - c["lambda"]) / 3
+                e["F_err"] = abs(e["F"] - c["F"]) / 3
+    fine["error_estimate"] = {"coarse_wall_time_s": coarse["wall_time_s"],
+                              "coarse_events_matched": all(len(cs.get(k, [])) == len(v)
+                                                           for k, v in by_kind(fine["events"]).items())}
+
+
 def start_lambda(model: Model, wall: float) -> float:
     """Default first approach: the sphere well out of reach of the surface forces.
 
@@ -150,18 +186,21 @@ def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
 def curve_summary(res: dict) -> dict:
     """The JSON summary of a traced curve (schema in docs/output.md)."""
     def brief(e):
-        return {k: v for k, v in e.items() if k in ("kind", "lambda", "F", "H0", "stable")} | (
+        keep = ("kind", "lambda", "F", "H0", "stable", "lambda_err", "F_err", "F_truncation")
+        return {k: v for k, v in e.items() if k in keep} | (
             {"landing": {k: v for k, v in e["landing"].items() if k in ("lambda", "F", "H0")}}
             if "landing" in e else {})
     ev = res["events"]
     po = res["pull_off"]
-    return {"pull_off": {"lambda": po["lambda"], "F": po["F"]} if po else None,
+    return {"pull_off": brief(po) if po else None,
             "folds": [brief(e) for e in ev if e["kind"] in ("snap_on", "snap_off")],
-            "equilibria": [{"lambda": e["lambda"]} for e in ev if e["kind"] == "equilibrium"],
+            "equilibria": [{k: v for k, v in brief(e).items() if k != "F"}
+                           for e in ev if e["kind"] == "equilibrium"],
             "load_extrema": [brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
             "at_lambda": [brief(e) for e in ev if e["kind"] == "lambda"],
             "steps": res["steps"], "rejected_steps": res["rejected_steps"], "stop_reason": res["stop_reason"],
-            "grid_warning": res["grid_warning"], "wall_time_s": res["wall_time_s"]}
+            "grid_warning": res["grid_warning"], "wall_time_s": res["wall_time_s"]} | (
+                {"error_estimate": res["error_estimate"]} if "error_estimate" in res else {})
 
 
 def curve_tree(res: dict) -> dict:
@@ -185,7 +224,7 @@ def main() -> int:
     r = read_grid(opts, model)
     lam = opts.real("adh_lambda")
     guess = opts.string("adh_guess")
-    out, summary = opts.string("out"), opts.string("summary")
+    out, summary, plot = opts.string("out"), opts.string("summary"), opts.string("plot")
     pmat, band = opts.choice("adh_pmat"), opts.int("adh_pmat_band")
     if pmat == "dense" and comm.getSize() == 1 and r.size > 20000:
         raise InputError(f"-adh_pmat: dense needs {8 * r.size**2 / 2**30:.1f} GiB at N = {r.size}; use band or shell")
@@ -196,23 +235,30 @@ def main() -> int:
     check_unused(_is_app)
     check_writable("out", out)
     check_writable("summary", summary)
+    check_writable("plot", plot)
+    if plot and lam is not None:
+        raise InputError("-plot: draws a curve; not with -adh_lambda")
 
-    A = create_influence(r, comm)
-    problem = Problem(model, r, A, pmat, band, opts.int("adh_pc_reuse_its"))
-    snes = create_snes(problem)
+    problem, snes = discretize(model, r, opts)
     if helping:
         return 0
     if lam is None:
         res = trace(problem, snes, opts)
+        if opts.flag("cont_error_estimate"):
+            coarse = r[::2] if r.size % 2 else np.append(r[::2], r[-1])
+            estimate_errors(res, trace(*discretize(model, coarse, opts), opts), model.rmax)
         check_unused()
         if comm.getRank() == 0:
             info = _versions(comm)
             model_attrs = _model_attrs(model)
             summ = {**info, **model_attrs, "n_nodes": int(r.size), **curve_summary(res)}
+            tree = {**info, "kind": "curve", "options": opts.db.getAll(), "model": model_attrs, "grid": {"r": r},
+                    **curve_tree(res),
+                    "summary": {k: v for k, v in summ.items() if not isinstance(v, (list, dict)) and v is not None}}
             if out:
-                write_h5(out, {**info, "kind": "curve", "options": opts.db.getAll(), "model": model_attrs,
-                               "grid": {"r": r}, **curve_tree(res), "summary": {
-                                   k: v for k, v in summ.items() if not isinstance(v, (list, dict)) and v is not None}})
+                write_h5(out, tree)
+            if plot:
+                draw(plot, tree, out)
             if summary:
                 write_json(summary, summ)
             _report(summ)
@@ -233,6 +279,29 @@ def main() -> int:
     return 0
 
 
+def draw(png: str, tree: dict, h5: str | None) -> None:
+    """The curve figure; plotting is imported only here."""
+    import tempfile
+
+    from .output import atomic
+    from .plot import curve_figure
+
+    with tempfile.TemporaryDirectory() as tmp:
+        if h5 is None:
+            h5 = f"{tmp}/curve.h5"
+            write_h5(h5, tree)
+        with atomic(png) as target:
+            curve_figure(h5, target + ".png")
+            os.replace(target + ".png", target)
+
+
+def _err(e: dict) -> str:
+    if "lambda_err" not in e:
+        return ""
+    f = f", F +- {e['F_err']:.1e} (+ truncation {e['F_truncation']:.1e})" if "F" in e else ""
+    return f"   [error: lambda +- {e['lambda_err']:.1e}{f}]"
+
+
 def _model_attrs(model: Model) -> dict:
     return {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax,
             "roughness": model.roughness, "hermite_points": model.hermite_points}
@@ -243,13 +312,13 @@ def _report(s: dict) -> None:
     print(f"mu = {s['mu']:g}  sigma = {s['sigma']:g}  N = {s['n_nodes']}  steps {s['steps']} "
           f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s; stopped: {s['stop_reason']}")
     if po:
-        print(f"  pull-off (load control)  lambda = {po['lambda']:.8f}  F = {po['F']:.8f}")
+        print(f"  pull-off (load control)  lambda = {po['lambda']:.8f}  F = {po['F']:.8f}{_err(po)}")
     for f in s["folds"]:
         land = f.get("landing")
         to = f"  -> lands at F = {land['F']:.8f}" if land else ""
-        print(f"  {f['kind']:<23}  lambda = {f['lambda']:.8f}  F = {f['F']:.8f}{to}")
+        print(f"  {f['kind']:<23}  lambda = {f['lambda']:.8f}  F = {f['F']:.8f}{to}{_err(f)}")
     for e in s["equilibria"]:
-        print(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}")
+        print(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}{_err(e)}")
     for e in s["at_lambda"]:
         print(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}")
     if s["grid_warning"]:

@@ -1,0 +1,225 @@
+"""Benchmarks on one rank: the influence matrix, one Newton solve, the mu = 1 curve.
+
+    OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.bench [-bench_repeats K] \\
+        [-bench_only influence|solve|curve] [-bench_json bench.json] [-bench_profile] [-log_view]
+
+Each quantity is the median wall time of repeated runs (7, 3 at N = 4000 and 5
+for the curve, or K each), shown with its min, max and number of repeats,
+against its target where it has one.  The cores may be shared with other work:
+the load average before the runs is printed with the table, and a benchmark is
+a measurement, not a test.
+
+* influence: ``create_influence(r)`` on the paper grid (N = 531) and on a
+  uniform grid of N = 4000.
+* solve: Newton at mu = 1, lambda = -2 on the paper grid, from the rigid guess
+  (eq. 27), a fresh guess each repeat; the influence matrix and the SNES are
+  built once, untimed.  The SNES keeps its preconditioner between solves by
+  design (:class:`~petsc_adhesion.residual.PCReuse`); each repeat expires it,
+  so every repeat assembles and factors it again.
+* curve: :func:`~petsc_adhesion.study.trace` with the program's defaults
+  (mu = 1, paper grid): the time of the call, its steps, and a check that it
+  found both turning points, the pull-off and the equilibrium.
+
+``-bench_profile`` profiles one more curve (cProfile, which slows the Python
+side) and prints the ten functions of largest own time; ``-log_view`` gives PETSc's account of all runs.
+The model and grids are fixed; other options reach the solvers (``-snes_*``,
+``-ksp_*``) and the continuation (``-cont_*``).
+"""
+from __future__ import annotations
+
+import cProfile
+import os
+import pstats
+import statistics
+import sys
+import time
+
+import petsc4py
+
+petsc4py.init(sys.argv)
+from petsc4py import PETSc
+
+from . import __version__, grid
+from .influence import create_influence
+from .model import Model
+from .options import AppOptions, InputError, check_unused
+from .output import check_writable, write_json
+from .residual import Problem
+from .solver import create_snes, solve
+from .study import trace
+
+__all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main"]
+
+#: -bench_only choices, in the order they run
+PARTS = ("influence", "solve", "curve")
+
+
+def row(quantity: str, times: list[float], target: float | None = None, **extra) -> dict:
+    """Median, min and max of ``times`` (s) and whether the median meets ``target``."""
+    med = statistics.median(times)
+    return {"quantity": quantity, "median_s": med, "min_s": min(times), "max_s": max(times),
+            "repeats": len(times), "target_s": target, "met": None if target is None else med <= target,
+            **extra}
+
+
+def bench_influence(repeats: int | None = None) -> dict:
+    """Build time of the influence matrix of eq. (12) at N = 531 (target 0.3 s) and 4000."""
+    out = {}
+    for key, r, default, target in (("influence_531", grid.paper(10.0), 7, 0.3),
+                                    ("influence_4000", grid.uniform(4000, 10.0), 3, None)):
+        times = []
+        for _ in range(repeats or default):
+            t0 = time.perf_counter()
+            A = create_influence(r)
+            times.append(time.perf_counter() - t0)
+            A.destroy()
+        out[key] = row(f"influence build, N = {r.size}", times, target, n_nodes=r.size)
+    return out
+
+
+def mu1_problem() -> tuple[Problem, PETSc.SNES]:
+    """The default study's Problem (mu = 1, paper grid, dense PC) and its SNES."""
+    r = grid.paper(10.0)
+    problem = Problem(Model(mu=1.0), r, create_influence(r))
+    return problem, create_snes(problem)
+
+
+def bench_solve(problem: Problem, snes: PETSc.SNES, repeats: int | None = None, lam: float = -2.0) -> dict:
+    """One fixed-lambda Newton solve from the rigid guess (target 20 ms), refactoring each repeat."""
+    times = []
+    for _ in range(repeats or 7):
+        H = problem.rigid(lam, problem.create_vec())
+        problem.reuse.expire()
+        t0 = time.perf_counter()
+        ok = solve(snes, problem, lam, H)
+        times.append(time.perf_counter() - t0)
+        if not ok:
+            raise RuntimeError(f"Newton did not converge at lambda = {lam:g} (reason {snes.getConvergedReason()})")
+    return {"solve": row(f"solve, mu = {problem.model.mu:g}, lambda = {lam:g}, N = {problem.r.size}", times, 0.020,
+                         snes_iterations=snes.getIterationNumber(),
+                         ksp_iterations=snes.getLinearSolveIterations())}
+
+
+def check_curve(res: dict) -> dict:
+    """The curve's landmarks; RuntimeError unless both folds, the pull-off and F = 0 are found."""
+    first = {}
+    for e in res["events"]:
+        first.setdefault(e["kind"], e)
+    missing = [k for k in ("snap_on", "snap_off", "equilibrium") if k not in first]
+    if missing or res["pull_off"] is None:
+        raise RuntimeError(f"mu = 1 curve without {', '.join(missing) or 'pull-off'} "
+                           f"({res['steps']} steps; stopped: {res['stop_reason']})")
+    return {"steps": res["steps"], "rejected_steps": res["rejected_steps"],
+            "pull_off_lambda": res["pull_off"]["lambda"], "pull_off_F": res["pull_off"]["F"],
+            "snap_on_lambda": first["snap_on"]["lambda"], "snap_off_lambda": first["snap_off"]["lambda"],
+            "equilibrium_lambda": first["equilibrium"]["lambda"]}
+
+
+def bench_curve(problem: Problem, snes: PETSc.SNES, repeats: int | None = None) -> dict:
+    """The whole default curve (target 1 s), each repeat from an expired preconditioner."""
+    times = []
+    for _ in range(repeats or 5):
+        problem.reuse.expire()
+        t0 = time.perf_counter()
+        res = trace(problem, snes, AppOptions())
+        times.append(time.perf_counter() - t0)
+        marks = check_curve(res)
+    return {"curve": row(f"curve, mu = {problem.model.mu:g}, N = {problem.r.size}", times, 1.0, **marks)}
+
+
+def _where(key: tuple) -> str:
+    path, line, name = key
+    if path == "~":
+        return name
+    return f"{os.path.join(*path.split(os.sep)[-2:])}:{line}({name})"
+
+
+def profile_curve(problem: Problem, snes: PETSc.SNES, top: int = 10) -> dict:
+    """Profiled time of one traced curve and its ``top`` functions by own time (cProfile's tottime)."""
+    problem.reuse.expire()
+    prof = cProfile.Profile()
+    check_curve(prof.runcall(trace, problem, snes, AppOptions()))
+    st = pstats.Stats(prof)
+    best = sorted(st.stats.items(), key=lambda kv: kv[1][2], reverse=True)[:top]
+    return {"total_s": st.total_tt,
+            "top": [{"function": _where(k), "calls": nc, "tottime_s": tt, "cumtime_s": ct, "share": tt / st.total_tt}
+                    for k, (_, nc, tt, ct, _) in best]}
+
+
+def _t(s: float | None) -> str:
+    if s is None:
+        return "-"
+    return f"{s * 1e3:.3g} ms" if s < 1 else f"{s:.3g} s"
+
+
+def report(info: dict, results: dict, profile: dict | None) -> None:
+    print(f"petsc-adhesion {info['version']} bench: PETSc {info['petsc_version']}, 1 rank, "
+          f"OPENBLAS_NUM_THREADS={info['openblas_num_threads']}, "
+          f"load average {info['load_average']:.2f} on {info['cpu_count']} cores before the runs")
+    print(f"{'quantity':<38}{'median':>10}{'min':>10}{'max':>10}{'repeats':>9}{'target':>10}  met")
+    for q in results.values():
+        met = "-" if q["met"] is None else "yes" if q["met"] else "NO"
+        print(f"{q['quantity']:<38}{_t(q['median_s']):>10}{_t(q['min_s']):>10}{_t(q['max_s']):>10}"
+              f"{q['repeats']:>9}{_t(q['target_s']):>10}  {met}")
+    if "solve" in results:
+        s = results["solve"]
+        print(f"solve: Newton {s['snes_iterations']}, KSP {s['ksp_iterations']}; "
+              "preconditioner expired before each repeat (assembled and factored every time)")
+    if "curve" in results:
+        c = results["curve"]
+        print(f"curve: {c['steps']} steps ({c['rejected_steps']} rejected); "
+              f"snap-on lambda = {c['snap_on_lambda']:.6f}, snap-off lambda = {c['snap_off_lambda']:.6f}, "
+              f"pull-off F = {c['pull_off_F']:.6f} at lambda = {c['pull_off_lambda']:.6f}, "
+              f"equilibrium lambda = {c['equilibrium_lambda']:.6f}")
+    if profile:
+        print(f"curve profile (cProfile, one run, {_t(profile['total_s'])} in all; "
+              f"top {len(profile['top'])} by own time):")
+        print(f"{'own':>10}{'share':>7}{'cumul.':>10}{'calls':>8}  function")
+        for p in profile["top"]:
+            print(f"{_t(p['tottime_s']):>10}{p['share']:>7.1%}{_t(p['cumtime_s']):>10}{p['calls']:>8}  {p['function']}")
+
+
+def main() -> int:
+    opts = PETSc.Options("bench_")
+    repeats = opts.getInt("repeats", 0)         # 0: each quantity's own number
+    only = opts.getString("only", "")
+    path = opts.getString("json", "")
+    profile = opts.getBool("profile", False)
+    check_unused(lambda name: name.startswith("bench_"))
+    if opts.hasName("repeats") and repeats < 1:
+        raise InputError(f"-bench_repeats: expected an integer >= 1, got {repeats}")
+    if only and only not in PARTS:
+        raise InputError(f"-bench_only: expected one of {', '.join(PARTS)}, got '{only}'")
+    if PETSc.COMM_WORLD.getSize() > 1:
+        raise InputError("the benchmark runs on one rank")
+    check_writable("bench_json", path or None)
+    load = os.getloadavg()[0]
+
+    parts = (only,) if only else PARTS
+    results = bench_influence(repeats) if "influence" in parts else {}
+    if "solve" in parts or "curve" in parts or profile:
+        problem, snes = mu1_problem()
+    if "solve" in parts:
+        results |= bench_solve(problem, snes, repeats)
+    if "curve" in parts:
+        results |= bench_curve(problem, snes, repeats)
+    top = profile_curve(problem, snes) if profile else None
+    info = {"program": "petsc-adhesion bench", "version": __version__,
+            "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(), "mpi_ranks": 1,
+            "openblas_num_threads": os.environ.get("OPENBLAS_NUM_THREADS", "unset"),
+            "load_average": load, "cpu_count": os.cpu_count()}
+    report(info, results, top)
+    if path:
+        write_json(path, {**info, "results": results, **({"curve_profile": top} if top else {})})
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except InputError as e:
+        print(f"petsc-adhesion bench: error: {e}", file=sys.stderr)
+        sys.exit(2)
+    except RuntimeError as e:
+        print(f"petsc-adhesion bench: FAILED: {e}", file=sys.stderr)
+        sys.exit(1)
