@@ -149,10 +149,11 @@ def start_lambda(model: Model, wall: float) -> float:
 def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
     """The whole load-approach curve with its events (the program's main job)."""
     model = problem.model
+    lam_max = opts.real("cont_lambda_max")
     settings = Settings(kind=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                         ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
                         max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
-                        lambda_max=opts.real("cont_lambda_max") or np.inf, F_max=opts.real("cont_F_max"),
+                        lambda_max=np.inf if lam_max is None else lam_max, F_max=opts.real("cont_F_max"),
                         max_steps=opts.int("cont_max_steps"), monitor=opts.flag("cont_monitor"))
     lam0 = opts.real("cont_lambda_start")
     lam0 = start_lambda(model, problem.law.wall) if lam0 is None else lam0
@@ -175,8 +176,8 @@ def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
                 if H is not None:
                     e["H"], e["P"] = H, problem.law(H)[0]
     # the contact edge: where the attraction peaks (P most negative), on rank 0's view of the curve
-    edges = np.array([problem.r[np.argmin(problem.law(H)[0])] for H in map(whole, (p.h for p in pts))
-                      if H is not None and np.min(problem.law(H)[0]) < 0])
+    pressures = [problem.law(H)[0] for H in map(whole, (p.h for p in pts)) if H is not None]
+    edges = np.array([problem.r[np.argmin(P)] for P in pressures if P.min() < 0])
     return {"points": pts, "events": finder.events, "pull_off": finder.pull_off(),
             "steps": len(pts) - 1, "rejected_steps": cont.rejected, "stop_reason": cont.stop_reason,
             "grid_warning": grid_warning(model, problem.r, edges, cont.folds), "wall_time_s": wall,
