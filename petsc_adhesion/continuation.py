@@ -257,6 +257,7 @@ class Settings:
     ds_max: float = 0.5
     newton_target: int = 5
     max_deviation: float = 0.1
+    dF_max: float = 0.2
     lambda_max: float = math.inf
     F_max: float = 2.0
     max_steps: int = 2000
@@ -319,43 +320,64 @@ class Continuation:
     def natural_ok(self, a: Point) -> bool:
         return self.set.kind == "natural" or (self.set.kind == "auto" and abs(a.tl) >= SWITCH)
 
+    def natural(self, a: Point, ds: float):
+        """Natural corrector (eq. 20-22) at lambda = a.lam + ds a.tl; tangent of eq. (16)-(19)."""
+        pb = self.pb
+        lam = a.lam + ds * a.tl
+        h = a.h + ds * a.th                               # eq. (20)
+        if not pb.inside(h):
+            return None
+        H = pb.create_vec()
+        H.setArray(h)
+        pb.lam = lam
+        if not fresh_retry(self.snes, H, pb.reuse):       # eq. (21)-(22)
+            return None
+        h = H.getArray(readonly=True).copy()
+        tan = self.natural_tangent(h, lam, a)
+        if tan is None:
+            return None
+        return h, lam, tan, self.snes.getIterationNumber(), self.snes.getLinearSolveIterations(), "natural"
+
+    def arclength(self, a: Point, ds: float):
+        """Pseudo-arclength corrector (eq. 24-25) at distance ds; tangent of the bordered system."""
+        sol = self.bordered.correct(a, ds)
+        if sol is None:
+            return None
+        h, lam, its, kits = sol
+        tan = self.bordered.tangent(h, lam, a.th, a.tl)
+        if tan is None:
+            return None
+        return h, lam, tan, its, kits, "arclength"
+
+    def correct(self, a: Point, ds: float):
+        """The point at step ds from a: the corrector the mode asks for, the other as fallback.
+
+        The natural one serves only away from folds (|lambdadot| >= 0.1), where
+        lambda is a good parameter; near the wall of a fine roughness rule it is
+        the more robust of the two.
+        """
+        first, second = (self.natural, self.arclength) if self.natural_ok(a) else (self.arclength, self.natural)
+        sol = first(a, ds)
+        if sol is None and (second is self.arclength or abs(a.tl) >= 0.1) and self.set.kind != "natural":
+            sol = second(a, ds)
+        return sol
+
     def step(self, a: Point, ds: float) -> Point | None:
         """One predictor-corrector step of length ds from a, or None (retry smaller)."""
         pb = self.pb
-        if self.natural_ok(a):
-            lam = a.lam + ds * a.tl
-            h = a.h + ds * a.th                       # eq. (20)
-            if not pb.inside(h):
-                return None
-            H = pb.create_vec()
-            H.setArray(h)
-            pb.lam = lam
-            if not fresh_retry(self.snes, H, pb.reuse):    # eq. (21)-(22)
-                return None
-            h = H.getArray(readonly=True).copy()
-            its, kits = self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
-            tan = self.natural_tangent(h, lam, a)
-            if tan is None:
-                return None
-            th, tl, tk = tan
-            kind = "natural"
-        else:
-            sol = self.bordered.correct(a, ds)
-            if sol is None:
-                return None
-            h, lam, its, kits = sol
-            tan = self.bordered.tangent(h, lam, a.th, a.tl)
-            if tan is None:
-                return None
-            th, tl, tk = tan
-            kind = "arclength"
+        sol = self.correct(a, ds)
+        if sol is None:
+            return None
+        h, lam, (th, tl, tk), its, kits, kind = sol
         # the corrector's distance from the predictor grows as ds^2 times the curvature;
         # a step that had to travel far may have cut across a fold pair unseen
         dh = h - (a.h + ds * a.th)
         dev = math.sqrt(pb.inner(dh, dh) + (lam - a.lam - ds * a.tl) ** 2) / ds
         if dev > self.set.max_deviation or pb.inner(a.th, th) + a.tl * tl < 0.8:
             return None
-        return self.make_point(h, lam, th, tl, ds=ds, its=its, ksp_its=kits + tk, kind=kind, dev=dev)
+        b = self.make_point(h, lam, th, tl, ds=ds, its=its, ksp_its=kits + tk, kind=kind, dev=dev)
+        # the curve F(lambda) is what users read: resolve it in F too
+        return b if abs(b.F - a.F) <= self.set.dF_max else None
 
     def done(self, b: Point) -> str:
         s = self.set
@@ -398,7 +420,7 @@ class Continuation:
             if self.stop_reason:
                 break
             # grow on fast Newton and a nearly straight curve, shrink on slow Newton
-            if b.its < s.newton_target and b.dev < 0.5 * s.max_deviation:
+            if b.its < s.newton_target and b.dev < 0.5 * s.max_deviation and abs(b.F - a.F) < 0.5 * s.dF_max:
                 ds = min(1.5 * ds, s.ds_max)
             elif b.its > s.newton_target:
                 ds = max(0.7 * ds, s.ds_min)

@@ -67,19 +67,18 @@ class EventFinder:
     def locate(self, a, b, f, level: float = 0.0):
         """The point between a and b where f = level, to self.tol in lambda."""
         cont = self.cont
-        sb = cont.pb.inner(a.th, b.h - a.h) + a.tl * (b.lam - a.lam)
+        # b's distance from a: along a's tangent for the arclength corrector, in lambda for the natural
+        sb = b.ds if b.ds and b.kind == ("natural" if cont.natural_ok(a) else "arclength") else \
+            cont.pb.inner(a.th, b.h - a.h) + a.tl * (b.lam - a.lam)
         cache = {}
 
         def g(s):
             if s not in cache:
-                sol = cont.bordered.correct(a, s)
+                sol = cont.correct(a, s) if s else (a.h, a.lam, (a.th, a.tl, 0), 0, 0, "")
                 if sol is None:
                     raise RuntimeError(f"event location failed near lambda = {a.lam:.6g}")
-                h, lam, _, _ = sol
-                tan = cont.bordered.tangent(h, lam, a.th, a.tl)
-                if tan is None:
-                    raise RuntimeError(f"event location failed near lambda = {a.lam:.6g}")
-                cache[s] = cont.make_point(h, lam, tan[0], tan[1], kind="event")
+                h, lam, (th, tl, _), *_ = sol
+                cache[s] = cont.make_point(h, lam, th, tl, kind="event")
             return f(cache[s]) - level
 
         # lambda moves by at most |s| along a unit tangent, so xtol in s bounds the error in lambda

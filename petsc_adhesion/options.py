@@ -80,6 +80,7 @@ TABLE = {o.name: o for o in [
     Option("cont_lambda_max", "real", None, "stop at this approach (default: past equilibrium)", -1e3, 1e3),
     Option("cont_F_max", "real", 2.0, "stop at this compressive load", -_INF, 1e6),
     Option("cont_max_steps", "int", 2000, "stop after this many accepted steps", 1, 10**7),
+    Option("cont_dF_max", "real", 0.2, "largest change of the load in one step", 0.0, 1e6, lo_open=True),
     Option("cont_max_folds", "int", 12, "stop after this many turning points (a grid that traps the "
            "contact edge makes dozens)", 0, 10**6),
     Option("cont_ds", "real", 0.05, "first arclength step", 0.0, 1e3, lo_open=True),

@@ -153,6 +153,7 @@ def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
     settings = Settings(kind=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                         ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
                         max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
+                        dF_max=opts.real("cont_dF_max"),
                         lambda_max=np.inf if lam_max is None else lam_max, F_max=opts.real("cont_F_max"),
                         max_steps=opts.int("cont_max_steps"), monitor=opts.flag("cont_monitor"))
     lam0 = opts.real("cont_lambda_start")
