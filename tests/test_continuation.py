@@ -251,16 +251,19 @@ def test_small_mu_follows_rigid_closed_form(dmt):
     assert shift["mu0.01"] > 0 and shift["mu0.005"] > 0
     assert 2.5 < shift["mu0.01"] / shift["mu0.005"] < 3.2
 
-    # the curve itself: F(lambda) against eq. (28) on [-2, 0.15] (61 points with ds_max 0.05).
+    # the curve itself: F(lambda) against eq. (28) on [-2, 0.12] (points every ds_max 0.05).
+    # Beyond 0.12 the repulsive rise is nearly vertical and the elastic shift in lambda shows
+    # as an F difference growing to 3e-2 at 0.18: there the equilibrium shift above is the test.
     # The deviation is made of (a) elastic deformation at mu = 0.01: the surfaces sag towards
     # each other, -1.7e-3 near lambda = -0.2 and +2.5e-3 on the steep repulsive rise near 0.1;
     # (b) the truncation at r_m = 10: the attraction beyond r_m, missing from F, is
     # (4/3) / (r_m^2/2 + 1 - lambda)^2 = 4.6e-4 .. 5.1e-4 here; (c) the mesh, O(h^2): the
-    # deviation changes by < 4e-5 from N = 531 to uniform N = 2001.  Measured max 3.05e-3.
+    # deviation changes by < 4e-5 from N = 531 to uniform N = 2001.  Measured with dense
+    # sampling: max 3.19e-3 at lambda = 0.08, -1.22e-3 at -0.17.
     c = dmt["mu0.01"].curve()
     lam, F = c["lambda"], c["F"]
-    sel = (lam >= -2.0) & (lam <= 0.15)
-    assert sel.sum() >= 40
+    sel = (lam >= -2.0) & (lam <= 0.12)
+    assert sel.sum() >= 35
     dev = np.abs(F[sel] - dmt_load(lam[sel]))
     assert dev.max() < 4e-3
     # far from contact (lambda < -1.5) elasticity is negligible and what is left is the
