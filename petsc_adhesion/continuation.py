@@ -23,7 +23,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from .residual import PCReuse, shorten_to_wall
-from .solver import default_pc
+from .solver import configure
 
 __all__ = ["Point", "Bordered", "Continuation"]
 
@@ -84,16 +84,9 @@ class Bordered:
         else:
             self.P = self.K
         self.snes = PETSc.SNES().create(comm)
-        self.snes.setType("newtonls")
         self.snes.setFunction(self.form_function, self.X.duplicate())
         self.snes.setJacobian(self.form_jacobian, self.K, self.P)
-        self.snes.setTolerances(rtol=1e-10, atol=1e-10, stol=1e-14, max_it=50)
-        ksp = self.snes.getKSP()
-        ksp.setType("gmres")
-        ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=400)
-        default_pc(ksp.getPC(), pb.pmat_kind)
-        self.snes.setLineSearchPreCheck(self.precheck)
-        self.snes.setFromOptions()
+        configure(self.snes, pb.pmat_kind, self.precheck)
         self.reuse = PCReuse(pb.reuse.its)
         # the hyperplane Q of eq. (24): through (h0, lam0), normal (th, tl), at distance ds
         self.h0, self.lam0, self.th, self.tl, self.ds = None, 0.0, None, 1.0, 0.0
@@ -138,9 +131,7 @@ class Bordered:
         """G_H at self.H (shell) and, with ``assemble``, the bordered matrix for the PC."""
         pb = self.pb
         pb.linearize(self.H, assemble=False)
-        if not assemble:
-            pass
-        elif pb.pmat_kind == "dense":
+        if assemble and pb.pmat_kind == "dense":
             a = self.P.getDenseArray()
             a[:, :-1][:self.nloc] = pb.jacobian_rows()
             a[:self.nloc, -1] = 1.0
@@ -148,7 +139,7 @@ class Bordered:
                 a[-1, :-1] = self.row.getDenseArray()[0]
                 a[-1, -1] = self.corner.getDenseArray()[0, 0]
             self.P.assemble()
-        elif pb.pmat_kind == "band":
+        elif assemble and pb.pmat_kind == "band":
             self._fill_band()
         self.K.assemble()
 

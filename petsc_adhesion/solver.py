@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from petsc4py import PETSc
 
-__all__ = ["create_snes", "default_pc", "solve"]
+__all__ = ["configure", "create_snes", "default_pc", "solve"]
 
 
 def default_pc(pc: PETSc.PC, pmat: str) -> None:
@@ -31,21 +31,29 @@ def default_pc(pc: PETSc.PC, pmat: str) -> None:
             opts.setValue("sub_pc_type", "lu" if pmat == "dense" else "ilu")
 
 
-def create_snes(problem, comm=None) -> PETSc.SNES:
-    """A Newton-Krylov SNES (GMRES) on ``problem`` at ``problem.lam``."""
-    comm = comm or problem.comm
-    snes = PETSc.SNES().create(comm)
+def configure(snes: PETSc.SNES, pmat: str, precheck) -> PETSc.SNES:
+    """Newton-Krylov (GMRES) defaults shared by the fixed-lambda and bordered SNES.
+
+    Tight enough for events located to 1e-8 in lambda; ``setFromOptions()``
+    comes last, so each default can be overridden at run time.
+    """
     snes.setType("newtonls")
-    snes.setFunction(problem.form_function, problem.create_vec())
-    snes.setJacobian(problem.form_jacobian, problem.J, problem.P)
     snes.setTolerances(rtol=1e-10, atol=1e-10, stol=1e-14, max_it=50)
     ksp = snes.getKSP()
     ksp.setType("gmres")
     ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=400)
-    default_pc(ksp.getPC(), problem.pmat_kind)
-    snes.setLineSearchPreCheck(problem.precheck)
+    default_pc(ksp.getPC(), pmat)
+    snes.setLineSearchPreCheck(precheck)
     snes.setFromOptions()
     return snes
+
+
+def create_snes(problem) -> PETSc.SNES:
+    """A Newton-Krylov SNES on ``problem`` at ``problem.lam``."""
+    snes = PETSc.SNES().create(problem.comm)
+    snes.setFunction(problem.form_function, problem.create_vec())
+    snes.setJacobian(problem.form_jacobian, problem.J, problem.P)
+    return configure(snes, problem.pmat_kind, problem.precheck)
 
 
 def solve(snes: PETSc.SNES, problem, lam: float, H: PETSc.Vec) -> bool:
