@@ -11,6 +11,7 @@ import time
 
 import numpy as np
 import petsc4py
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import __version__, grid
@@ -179,10 +180,32 @@ def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
     # the contact edge: where the attraction peaks (P most negative), on rank 0's view of the curve
     pressures = [problem.law(H)[0] for H in map(whole, (p.h for p in pts)) if H is not None]
     edges = np.array([problem.r[np.argmin(P)] for P in pressures if P.min() < 0])
-    return {"points": pts, "events": finder.events, "pull_off": finder.pull_off(),
+    pull_off = finder.pull_off()
+    return {"points": pts, "events": finder.events, "pull_off": pull_off,
             "steps": len(pts) - 1, "rejected_steps": cont.rejected, "stop_reason": cont.stop_reason,
             "grid_warning": grid_warning(model, problem.r, edges, cont.folds), "wall_time_s": wall,
-            "lambda_start": lam0}
+            "warnings": curve_warnings(problem, pts, pull_off), "lambda_start": lam0}
+
+
+#: Closer than this to the wall of the roughness rule, a state is set by its smallest weights.
+WALL_GAP = 1e-3
+
+
+def curve_warnings(problem: Problem, pts, pull_off) -> list[str]:
+    """What makes a traced curve untrustworthy, one line each."""
+    out = []
+    law = problem.law
+    gap = problem.comm.tompi4py().allreduce(min(float(p.h.min()) for p in pts) - law.wall, op=MPI.MIN)
+    if not law.smooth and gap < WALL_GAP:
+        out.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
+                   f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
+                   f"the loads there are properties of the rule and ill-conditioned; use fewer points")
+    lowest = min(p.F for p in pts)
+    if pull_off is not None and lowest < pull_off["F"] - 1e-9:
+        out.append(f"a computed point (F = {lowest:.6g}) is more tensile than the located pull-off "
+                   f"({pull_off['F']:.6g}): the load varies faster than the steps resolve; "
+                   f"lower -cont_dF_max or -cont_ds_max")
+    return out
 
 
 def curve_summary(res: dict) -> dict:
@@ -201,7 +224,8 @@ def curve_summary(res: dict) -> dict:
             "load_extrema": [brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
             "at_lambda": [brief(e) for e in ev if e["kind"] == "lambda"],
             "steps": res["steps"], "rejected_steps": res["rejected_steps"], "stop_reason": res["stop_reason"],
-            "grid_warning": res["grid_warning"], "wall_time_s": res["wall_time_s"]} | (
+            "grid_warning": res["grid_warning"], "warnings": res["warnings"],
+            "wall_time_s": res["wall_time_s"]} | (
                 {"error_estimate": res["error_estimate"]} if "error_estimate" in res else {})
 
 
@@ -323,5 +347,5 @@ def _report(s: dict) -> None:
         print(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}{_err(e)}")
     for e in s["at_lambda"]:
         print(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}")
-    if s["grid_warning"]:
-        print(f"  WARNING: {s['grid_warning']}")
+    for w in ([s["grid_warning"]] if s["grid_warning"] else []) + s["warnings"]:
+        print(f"  WARNING: {w}")
