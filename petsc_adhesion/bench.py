@@ -45,8 +45,8 @@ from .model import Model
 from .options import AppOptions, InputError, check_unused
 from .output import check_writable, write_json
 from .residual import Problem
-from .solver import create_snes, solve
-from .study import trace
+from .solver import solve
+from .study import discretize, trace
 
 __all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main"]
 
@@ -77,11 +77,9 @@ def bench_influence(repeats: int | None = None) -> dict:
     return out
 
 
-def mu1_problem() -> tuple[Problem, PETSc.SNES]:
-    """The default study's Problem (mu = 1, paper grid, dense PC) and its SNES."""
-    r = grid.paper(10.0)
-    problem = Problem(Model(mu=1.0), r, create_influence(r))
-    return problem, create_snes(problem)
+def mu1_problem(curve: bool) -> tuple[Problem, PETSc.SNES]:
+    """The default study's Problem (mu = 1, paper grid, dense PC) and its SNES, as the program makes them."""
+    return discretize(Model(mu=1.0), grid.paper(10.0), AppOptions(), curve=curve)
 
 
 def bench_solve(problem: Problem, snes: PETSc.SNES, repeats: int | None = None, lam: float = -2.0) -> dict:
@@ -197,10 +195,10 @@ def main() -> int:
 
     parts = (only,) if only else PARTS
     results = bench_influence(repeats) if "influence" in parts else {}
-    if "solve" in parts or "curve" in parts or profile:
-        problem, snes = mu1_problem()
     if "solve" in parts:
-        results |= bench_solve(problem, snes, repeats)
+        results |= bench_solve(*mu1_problem(curve=False), repeats)
+    if "curve" in parts or profile:
+        problem, snes = mu1_problem(curve=True)
     if "curve" in parts:
         results |= bench_curve(problem, snes, repeats)
     top = profile_curve(problem, snes) if profile else None

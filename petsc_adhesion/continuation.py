@@ -86,7 +86,7 @@ class Bordered:
         self.snes = PETSc.SNES().create(comm)
         self.snes.setFunction(self.form_function, self.X.duplicate())
         self.snes.setJacobian(self.form_jacobian, self.K, self.P)
-        configure(self.snes, pb.pmat_kind, self.precheck)
+        configure(self.snes, pb.pmat_kind, self.precheck, full_steps=True)
         self.reuse = PCReuse(pb.reuse.its)
         # the hyperplane Q of eq. (24): through (h0, lam0), normal (th, tl), at distance ds
         self.h0, self.lam0, self.th, self.tl, self.ds = None, 0.0, None, 1.0, 0.0
@@ -95,7 +95,7 @@ class Bordered:
     def split(self, X: PETSc.Vec):
         """Local H part of X and lambda (broadcast from the last rank)."""
         x = X.getArray(readonly=True)
-        lam = x[self.nloc] if self.last else None
+        lam = float(x[self.nloc]) if self.last else None
         return x[:self.nloc], self.comm.tompi4py().bcast(lam, root=self.comm.getSize() - 1)
 
     def join(self, h: np.ndarray, lam: float, X: PETSc.Vec | None = None) -> PETSc.Vec:
@@ -133,7 +133,7 @@ class Bordered:
         pb.linearize(self.H, assemble=False)
         if assemble and pb.pmat_kind == "dense":
             a = self.P.getDenseArray()
-            a[:, :-1][:self.nloc] = pb.jacobian_rows()
+            pb.jacobian_rows(a[:self.nloc, :-1])
             a[:self.nloc, -1] = 1.0
             if self.last:
                 a[-1, :-1] = self.row.getDenseArray()[0]
@@ -247,7 +247,7 @@ class Settings:
     ds_min: float = 1e-7
     ds_max: float = 0.5
     newton_target: int = 5
-    max_deviation: float = 0.1
+    max_deviation: float = 0.2
     dF_max: float = 0.2
     lambda_max: float = math.inf
     F_max: float = 2.0
@@ -311,7 +311,7 @@ class Continuation:
     def natural_ok(self, a: Point) -> bool:
         return self.set.kind == "natural" or (self.set.kind == "auto" and abs(a.tl) >= SWITCH)
 
-    def natural(self, a: Point, ds: float):
+    def natural(self, a: Point, ds: float, tangent: bool = True):
         """Natural corrector (eq. 20-22) at lambda = a.lam + ds a.tl; tangent of eq. (16)-(19)."""
         pb = self.pb
         lam = a.lam + ds * a.tl
@@ -324,33 +324,30 @@ class Continuation:
         if not fresh_retry(self.snes, H, pb.reuse):       # eq. (21)-(22)
             return None
         h = H.getArray(readonly=True).copy()
-        tan = self.natural_tangent(h, lam, a)
-        if tan is None:
-            return None
-        return h, lam, tan, self.snes.getIterationNumber(), self.snes.getLinearSolveIterations(), "natural"
+        its, kits = self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
+        tan = self.natural_tangent(h, lam, a) if tangent else (a.th, a.tl, 0)
+        return None if tan is None else (h, lam, tan, its, kits, "natural")
 
-    def arclength(self, a: Point, ds: float):
+    def arclength(self, a: Point, ds: float, tangent: bool = True):
         """Pseudo-arclength corrector (eq. 24-25) at distance ds; tangent of the bordered system."""
         sol = self.bordered.correct(a, ds)
         if sol is None:
             return None
         h, lam, its, kits = sol
-        tan = self.bordered.tangent(h, lam, a.th, a.tl)
-        if tan is None:
-            return None
-        return h, lam, tan, its, kits, "arclength"
+        tan = self.bordered.tangent(h, lam, a.th, a.tl) if tangent else (a.th, a.tl, 0)
+        return None if tan is None else (h, lam, tan, its, kits, "arclength")
 
-    def correct(self, a: Point, ds: float):
+    def correct(self, a: Point, ds: float, tangent: bool = True):
         """The point at step ds from a: the corrector the mode asks for, the other as fallback.
 
         The natural one serves only away from folds (|lambdadot| >= 0.1), where
         lambda is a good parameter; near the wall of a fine roughness rule it is
-        the more robust of the two.
+        the more robust of the two.  Without ``tangent`` the point gets a's.
         """
         first, second = (self.natural, self.arclength) if self.natural_ok(a) else (self.arclength, self.natural)
-        sol = first(a, ds)
+        sol = first(a, ds, tangent)
         if sol is None and (second is self.arclength or abs(a.tl) >= 0.1) and self.set.kind != "natural":
-            sol = second(a, ds)
+            sol = second(a, ds, tangent)
         return sol
 
     def step(self, a: Point, ds: float) -> Point | None:
@@ -368,7 +365,7 @@ class Continuation:
             return None
         b = self.make_point(h, lam, th, tl, ds=ds, its=its, ksp_its=kits + tk, kind=kind, dev=dev)
         # the curve F(lambda) is what users read: resolve it in F too
-        return b if abs(b.F - a.F) <= self.set.dF_max else None
+        return b if abs(b.F - a.F) <= self.set.dF_max * max(1.0, abs(a.F)) else None
 
     def done(self, b: Point) -> str:
         s = self.set
@@ -411,7 +408,7 @@ class Continuation:
             if self.stop_reason:
                 break
             # grow on fast Newton and a nearly straight curve, shrink on slow Newton
-            if b.its < s.newton_target and b.dev < 0.5 * s.max_deviation and abs(b.F - a.F) < 0.5 * s.dF_max:
+            if b.its < s.newton_target and b.dev < 0.5 * s.max_deviation and abs(b.F - a.F) < 0.5 * s.dF_max * max(1.0, abs(a.F)):
                 ds = min(1.5 * ds, s.ds_max)
             elif b.its > s.newton_target:
                 ds = max(0.7 * ds, s.ds_min)

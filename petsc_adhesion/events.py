@@ -28,9 +28,11 @@ __all__ = ["EventFinder", "grid_warning"]
 
 
 def _tests(targets):
-    tests = {"fold": lambda p: p.tl, "load_extremum": lambda p: p.dF, "equilibrium": lambda p: p.F}
+    """name -> (test function, whether it needs the tangent at each evaluation)."""
+    tests = {"fold": (lambda p: p.tl, True), "load_extremum": (lambda p: p.dF, True),
+             "equilibrium": (lambda p: p.F, False)}
     for t in targets:
-        tests[f"lambda={t!r}"] = lambda p, t=t: p.lam - t
+        tests[f"lambda={t!r}"] = (lambda p, t=t: p.lam - t, False)
     return tests
 
 
@@ -54,27 +56,31 @@ class EventFinder:
         self.events: list[dict] = []
 
     def __call__(self, a, b) -> None:
-        for name, f in self.tests.items():
+        for name, (f, tangent) in self.tests.items():
             fa, fb = f(a), f(b)
             if fa == 0.0 or fa * fb > 0:
                 continue
-            p = self.locate(a, b, f)
+            p = self.locate(a, b, f, tangent=tangent)
             kind = {"fold": "snap_on" if fa > 0 else "snap_off",
                     "load_extremum": "F_min" if fa < 0 else "F_max",
                     "equilibrium": "equilibrium"}.get(name, "lambda")
             self.events.append(self.record(kind, p, segment=len(self.cont.points) - 2))
 
-    def locate(self, a, b, f, level: float = 0.0):
-        """The point between a and b where f = level, to self.tol in lambda."""
+    def locate(self, a, b, f, level: float = 0.0, tangent: bool = True):
+        """The point between a and b where f = level, to self.tol in lambda.
+
+        Without ``tangent`` the evaluations skip the tangent solve (f must not
+        need it); the located point gets its own tangent at the end.
+        """
         cont = self.cont
         # b's distance from a: along a's tangent for the arclength corrector, in lambda for the natural
         sb = b.ds if b.ds and b.kind == ("natural" if cont.natural_ok(a) else "arclength") else \
             cont.pb.inner(a.th, b.h - a.h) + a.tl * (b.lam - a.lam)
         cache = {}
 
-        def g(s):
+        def g(s, tangent=tangent):
             if s not in cache:
-                sol = cont.correct(a, s) if s else (a.h, a.lam, (a.th, a.tl, 0), 0, 0, "")
+                sol = cont.correct(a, s, tangent) if s else (a.h, a.lam, (a.th, a.tl, 0), 0, 0, "")
                 if sol is None:
                     raise RuntimeError(f"event location failed near lambda = {a.lam:.6g}")
                 h, lam, (th, tl, _), *_ = sol
@@ -84,7 +90,9 @@ class EventFinder:
         # lambda moves by at most |s| along a unit tangent, so xtol in s bounds the error in lambda
         s = brentq(g, 0.0, sb, xtol=self.tol, rtol=4 * np.finfo(float).eps, maxiter=100) \
             if g(0.0) * g(sb) < 0 else (0.0 if g(0.0) == 0 else sb)
-        g(s)
+        if not tangent and s:
+            del cache[s]
+        g(s, True)
         return cache[s]
 
     def record(self, kind: str, p, segment: int) -> dict:
@@ -112,7 +120,7 @@ class EventFinder:
             for j in order:
                 a, b = pts[j], pts[j + 1]
                 if a.tl > 0 and b.tl > 0 and (a.lam - lf) * (b.lam - lf) <= 0:
-                    p = self.locate(a, b, lambda p: p.lam, level=lf)
+                    p = self.locate(a, b, lambda p: p.lam, level=lf, tangent=False)
                     ev["landing"] = {"lambda": p.lam, "F": p.F, "H0": self.record("x", p, j)["H0"]}
                     if self.profiles:
                         ev["landing"]["h"] = p.h

@@ -80,14 +80,14 @@ TABLE = {o.name: o for o in [
     Option("cont_lambda_max", "real", None, "stop at this approach (default: past equilibrium)", -1e3, 1e3),
     Option("cont_F_max", "real", 2.0, "stop at this compressive load", -_INF, 1e6),
     Option("cont_max_steps", "int", 2000, "stop after this many accepted steps", 1, 10**7),
-    Option("cont_dF_max", "real", 0.2, "largest change of the load in one step", 0.0, 1e6, lo_open=True),
+    Option("cont_dF_max", "real", 0.2, "largest change of the load in one step, relative above |F| = 1", 0.0, 1e6, lo_open=True),
     Option("cont_max_folds", "int", 12, "stop after this many turning points (a grid that traps the "
            "contact edge makes dozens)", 0, 10**6),
     Option("cont_ds", "real", 0.05, "first arclength step", 0.0, 1e3, lo_open=True),
     Option("cont_ds_min", "real", 1e-7, "smallest step before giving up", 0.0, 1e3, lo_open=True),
     Option("cont_ds_max", "real", 0.5, "largest step", 0.0, 1e3, lo_open=True),
     Option("cont_newton_target", "int", 5, "corrector iterations aimed at by the step control", 1, 100),
-    Option("cont_max_deviation", "real", 0.1, "largest corrector distance from the predictor, per unit step "
+    Option("cont_max_deviation", "real", 0.2, "largest corrector distance from the predictor, per unit step "
            "(bounds the step by the curvature)", 0.0, 10.0, lo_open=True),
     Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
     Option("cont_event_tol", "real", 1e-10, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),

@@ -112,7 +112,7 @@ class Problem:
         """Set the point of G_H (the shell) and, with ``assemble``, refill the PC matrix."""
         _, self.dp = self.pressure(H)
         if assemble and self.pmat_kind == "dense":
-            self.P.getDenseArray()[:] = self.jacobian_rows()
+            self.jacobian_rows(self.P.getDenseArray())
             self.P.assemble()
         elif assemble and self.pmat_kind == "band":
             self.P.setValuesCSR(*self.band_values())
@@ -127,11 +127,11 @@ class Problem:
         self._gather.scatter(self._dpv, self._dpall, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         return self._dpall.getArray(readonly=True)
 
-    def jacobian_rows(self) -> np.ndarray:
-        """Local rows of G_H = I - c A diag(P'), dense."""
-        rows = -self.c * self.A.getDenseArray() * self.dp_all()
-        rows[np.arange(self.hi - self.lo), np.arange(self.lo, self.hi)] += 1.0
-        return rows
+    def jacobian_rows(self, out: np.ndarray) -> np.ndarray:
+        """Local rows of G_H = I - c A diag(P'), dense, into ``out``."""
+        np.multiply(self.A.getDenseArray(), -self.c * self.dp_all(), out=out)
+        out[np.arange(self.hi - self.lo), np.arange(self.lo, self.hi)] += 1.0
+        return out
 
     def _dense_pmat(self) -> PETSc.Mat:
         P = PETSc.Mat().createDense(self.A.getSizes(), comm=self.comm)
@@ -208,7 +208,7 @@ def shorten_to_wall(problem: Problem, h: np.ndarray, Y: PETSc.Vec, y: np.ndarray
     y = Y.getArray(readonly=True) if y is None else y
     room = h - problem.law.wall
     toward = y > 0
-    alpha = np.min(TO_WALL * room[toward] / y[toward], initial=1.0)
+    alpha = float(np.min(TO_WALL * room[toward] / y[toward], initial=1.0))
     alpha = problem.comm.tompi4py().allreduce(alpha, op=MPI.MIN)
     if alpha < 1.0:
         Y.scale(alpha)

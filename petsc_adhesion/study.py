@@ -104,11 +104,11 @@ def fixed_solve(problem: Problem, snes: PETSc.SNES, lam: float, H: PETSc.Vec) ->
             "ksp_iterations": snes.getLinearSolveIterations(), "wall_time_s": wall}
 
 
-def discretize(model: Model, r: np.ndarray, opts: AppOptions):
-    """Influence matrix, problem and fixed-lambda SNES on grid r."""
+def discretize(model: Model, r: np.ndarray, opts: AppOptions, curve: bool = True):
+    """Influence matrix, problem and SNES on grid r (for a curve: its natural corrector)."""
     A = create_influence(r, PETSc.COMM_WORLD)
     problem = Problem(model, r, A, opts.choice("adh_pmat"), opts.int("adh_pmat_band"), opts.int("adh_pc_reuse_its"))
-    return problem, create_snes(problem)
+    return problem, create_snes(problem, full_steps=curve)
 
 
 def estimate_errors(fine: dict, coarse: dict, rmax: float) -> None:
@@ -265,7 +265,7 @@ def main() -> int:
     if plot and lam is not None:
         raise InputError("-plot: draws a curve; not with -adh_lambda")
 
-    problem, snes = discretize(model, r, opts)
+    problem, snes = discretize(model, r, opts, curve=lam is None)
     if helping:
         return 0
     if lam is None:
