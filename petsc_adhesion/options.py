@@ -235,6 +235,9 @@ def check_unused(judged=lambda name: True) -> None:
     left = [n for n in unused_options() if judged(n)]
     if left:
         name = left[0]
+        if name in _PETSC_COMMON:
+            raise InputError(f"-{name}: not used by the solvers this run configures "
+                             f"(e.g. a sub-PC option without a block PC)")
         near = difflib.get_close_matches(name, list(TABLE) + _PETSC_COMMON, n=1)
         hint = f" (did you mean -{near[0]}?)" if near else ""
         raise InputError(f"-{name}: unknown option{hint}; -help lists the options")

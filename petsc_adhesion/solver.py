@@ -25,9 +25,10 @@ def default_pc(pc: PETSc.PC, pmat: str) -> None:
         pc.setType("lu")
     else:
         pc.setType("bjacobi")
-        # the sub-PC type is set through the database: sub-KSPs exist only after setup
+        # the sub-PC type goes through the database (sub-KSPs exist only after setup),
+        # and only while block Jacobi is in effect: an unread option is an error here
         opts = PETSc.Options(pc.getOptionsPrefix() or "")
-        if not opts.hasName("sub_pc_type"):
+        if not opts.hasName("pc_type") and not opts.hasName("sub_pc_type"):
             opts.setValue("sub_pc_type", "lu" if pmat == "dense" else "ilu")
 
 

@@ -430,3 +430,16 @@ def test_snes_monitor_in_curve_run(curve):
 
 def test_curve_only_named_files(curve):
     assert files(curve["dir"]) == {"c.h5", "c.json"}
+
+
+@pytest.mark.parametrize("pc", [("-pc_type", "lu", "-pc_factor_mat_solver_type", "mumps"),
+                                ("-pc_type", "hypre")], ids=["mumps", "hypre"])
+def test_parallel_band_with_external_solvers(tmp_path, pc):
+    """The near-field AIJ matrix takes any PETSc PC in parallel: MUMPS LU, hypre BoomerAMG."""
+    ref, par = tmp_path / "ref.h5", tmp_path / "par.h5"
+    args = ("-adh_mu", 1, "-adh_lambda", -2, "-grid_type", "uniform", "-grid_n", 101)
+    assert run_cli(*args, "-out", ref).returncode == 0
+    proc = run_cli(*args, "-adh_pmat", "band", *pc, "-out", par, np=2)
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(ref) as a, h5py.File(par) as b:
+        assert np.max(np.abs(a["solution/H"][()] - b["solution/H"][()])) < 1e-9

@@ -1,0 +1,60 @@
+"""Stiff and extreme cases: tiny and huge mu, large roughness, strong compression."""
+import json
+
+import numpy as np
+import pytest
+
+from petsc_adhesion.model import DMT_EQUILIBRIUM
+from conftest import run_cli
+
+
+def trace(tmp_path, *args):
+    js, h5 = tmp_path / "s.json", tmp_path / "c.h5"
+    proc = run_cli(*args, "-summary", js, "-out", h5)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(js.read_text()), h5
+
+
+def test_tiny_mu_is_the_rigid_limit(tmp_path):
+    """mu = 1e-3: c = 3.4e-4, the elastic shift of the equilibrium scales with c ~ mu^1.5
+    (measured 0.0056 at mu = 0.01, so ~1.8e-4 here) and the pull-off is -1 up to the
+    truncation 5e-4 and the shift."""
+    s, _ = trace(tmp_path, "-adh_mu", 0.001)
+    assert abs(s["pull_off"]["F"] + 1) < 1e-3 and abs(s["pull_off"]["lambda"]) < 1e-3
+    assert 0 < s["equilibria"][-1]["lambda"] - DMT_EQUILIBRIUM < 5e-4
+    assert s["folds"] == [] and s["warnings"] == [] and s["grid_warning"] == ""
+
+
+@pytest.mark.parametrize("mu", [0.01, 1.0])
+def test_large_roughness(tmp_path, mu):
+    """sigma = 2: the wall of the 16-point rule is at H = 12.26; the attraction is weak and
+    spread out, the reduction of the pull-off above 99% and nearly independent of mu."""
+    s, h5 = trace(tmp_path, "-adh_mu", mu, "-adh_sigma", 2)
+    import h5py
+    with h5py.File(h5) as f:
+        H0 = f["curve/H0"][()]
+    assert np.all(H0 > 2 * 6.6256 - 1)                      # never at or past the wall
+    assert -0.01 < s["pull_off"]["F"] < -0.005
+    assert s["folds"] == [] and s["warnings"] == []
+
+
+def test_strong_compression(tmp_path):
+    """mu = 1 up to F = 50, where (H + 1)^-9 dominates: the curve goes on monotonically,
+    every state stays inside the domain, steps grow with the load (relative resolution)."""
+    s, h5 = trace(tmp_path, "-adh_mu", 1, "-cont_F_max", 50)
+    import h5py
+    with h5py.File(h5) as f:
+        lam, F, H0 = f["curve/lambda"][()], f["curve/F"][()], f["curve/H0"][()]
+    assert F[-1] >= 50 and np.all(np.isfinite(F))
+    after = lam > s["equilibria"][-1]["lambda"]
+    assert np.all(np.diff(F[after]) > 0)
+    assert H0.min() > -1                                     # gap H + 1 > 0
+    assert s["steps"] < 200
+
+
+def test_huge_mu_on_coarse_grid_is_caught(tmp_path):
+    """mu = 20 on the paper grid (h = 0.02): the cohesive zone 0.0084 is far below the
+    spacing; the run stops early on the staircase and names the spacing it needs."""
+    s, _ = trace(tmp_path, "-adh_mu", 20)
+    assert "turning points" in s["stop_reason"]
+    assert "needs spacing <= 0.00168" in s["grid_warning"]
