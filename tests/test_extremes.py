@@ -58,3 +58,22 @@ def test_huge_mu_on_coarse_grid_is_caught(tmp_path):
     s, _ = trace(tmp_path, "-adh_mu", 20)
     assert "turning points" in s["stop_reason"]
     assert "needs spacing <= 0.00168" in s["grid_warning"]
+
+
+def test_secondary_turning_points_at_mu5(tmp_path):
+    """mu = 5 (paper Fig. 9: secondary turning points from mu = 5 on), on a grid that resolves
+    the 0.067-wide cohesive zone (h = 0.01 on [0, 6]: 801 nodes).  Two fold pairs, snap-on and
+    snap-off alternating along the curve, the secondary pair inside the primary hysteresis.
+    The same four folds came out of a uniform 1001-node grid: -4.262812, -4.520195, -4.504167,
+    -8.189277 (to 3e-7, the difference of the two grids)."""
+    s, _ = trace(tmp_path, "-adh_mu", 5, "-grid_paper_extra", 300, "-cont_lambda_max", -3)
+    assert s["grid_warning"] == ""
+    kinds = [f["kind"] for f in s["folds"]]
+    assert kinds == ["snap_on", "snap_off", "snap_on", "snap_off"]
+    lam = [f["lambda"] for f in s["folds"]]
+    assert np.allclose(lam, [-4.262812, -4.520195, -4.504167, -8.189277], atol=2e-6)
+    on, off = lam[0], lam[3]
+    assert off < lam[1] < lam[2] < on                        # secondary pair inside the primary
+    assert all("landing" in f for f in s["folds"])
+    # the JKR-like limit: pull-off near -0.75 (the paper's Fig. 8: near JKR for mu >= 5)
+    assert -0.80 < s["pull_off"]["F"] < -0.75
