@@ -325,7 +325,8 @@ def _err(e: dict) -> str:
     if "lambda_err" not in e:
         return ""
     f = f", F +- {e['F_err']:.1e} (+ truncation {e['F_truncation']:.1e})" if "F" in e else ""
-    return f"   [error: lambda +- {e['lambda_err']:.1e}{f}]"
+    lam = f"lambda +- {e['lambda_err']:.1e}" if e["kind"] != "lambda" else "lambda exact"
+    return f"   [error: {lam}{f}]"
 
 
 def _model_attrs(model: Model) -> dict:
@@ -335,8 +336,10 @@ def _model_attrs(model: Model) -> dict:
 
 def _report(s: dict) -> None:
     po = s["pull_off"]
+    extra = f" + {s['error_estimate']['coarse_wall_time_s']:.3g} s for the error estimate" \
+        if "error_estimate" in s else ""
     print(f"mu = {s['mu']:g}  sigma = {s['sigma']:g}  N = {s['n_nodes']}  steps {s['steps']} "
-          f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s; stopped: {s['stop_reason']}")
+          f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s{extra}; stopped: {s['stop_reason']}")
     if po:
         print(f"  pull-off (load control)  lambda = {po['lambda']:.8f}  F = {po['F']:.8f}{_err(po)}")
     for f in s["folds"]:
@@ -346,6 +349,6 @@ def _report(s: dict) -> None:
     for e in s["equilibria"]:
         print(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}{_err(e)}")
     for e in s["at_lambda"]:
-        print(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}")
+        print(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}{_err(e)}")
     for w in ([s["grid_warning"]] if s["grid_warning"] else []) + s["warnings"]:
         print(f"  WARNING: {w}")
