@@ -8,6 +8,8 @@ import json
 import math
 import os
 import re
+import subprocess
+import sys
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -16,6 +18,7 @@ import pytest
 from petsc4py import PETSc
 
 import petsc_adhesion
+import conftest
 from conftest import run_cli
 from petsc_adhesion.options import TABLE
 
@@ -443,3 +446,18 @@ def test_parallel_band_with_external_solvers(tmp_path, pc):
     assert proc.returncode == 0, proc.stderr
     with h5py.File(ref) as a, h5py.File(par) as b:
         assert np.max(np.abs(a["solution/H"][()] - b["solution/H"][()])) < 1e-9
+
+
+def test_scene_leaves_out_what_it_does_not_need(tmp_path):
+    """No plotting import when nothing is drawn, no profiles not asked for."""
+    h5 = tmp_path / "c.h5"
+    code = ("import sys; from petsc_adhesion.cli import main; "
+            f"rc = main(['x', '-adh_mu', '0.5', '-grid_type', 'uniform', '-grid_n', '101', '-out', '{h5}']); "
+            "assert rc == 0; print('matplotlib' in sys.modules)")
+    env = conftest._env()
+    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, cwd=conftest.ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().splitlines()[-1] == "False"
+    with h5py.File(h5, "r") as f:
+        assert len(f["events"]) >= 2
+        assert all("H" not in g and "P" not in g for g in f["events"].values())
