@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from petsc4py import PETSc
 
+from .options import TABLE
 from .residual import PCReuse, shorten_to_wall
 from .solver import configure
 
@@ -150,7 +151,7 @@ class Bordered:
     # -- near-field bordered preconditioning matrix ------------------------------
     def _band_bordered(self, ext) -> PETSc.Mat:
         pb = self.pb
-        ai, aj = pb.band_pattern()
+        ai, _ = pb.band_pattern()
         N = pb.r.size
         counts = np.diff(ai) + 1                      # + the G_lambda column
         if self.last:
@@ -176,14 +177,13 @@ class Bordered:
         self.P.assemble()
 
     # -- use ---------------------------------------------------------------------
-    def correct(self, a: Point, ds: float, th=None, tl=None) -> tuple[np.ndarray, float, int, int] | None:
+    def correct(self, a: Point, ds: float) -> tuple[np.ndarray, float, int, int] | None:
         """Solve for the point at distance ds from ``a`` along its tangent (eq. 24-25).
 
         Returns (h, lambda, Newton its, KSP its), or None when Newton fails or
         the predictor leaves the domain.
         """
-        th = a.th if th is None else th
-        tl = a.tl if tl is None else tl
+        th, tl = a.th, a.tl
         h = a.h + ds * th
         if not self.pb.inside(h):
             return None
@@ -240,20 +240,26 @@ def krylov_retry(ksp: PETSc.KSP, A, P, b: PETSc.Vec, x: PETSc.Vec, reuse: PCReus
     return False
 
 
+def _default(name: str):
+    return TABLE[name].default
+
+
 @dataclass
 class Settings:
-    kind: str = "auto"
-    ds: float = 0.05
-    ds_min: float = 1e-7
-    ds_max: float = 0.5
-    newton_target: int = 5
-    max_deviation: float = 0.2
-    dF_max: float = 0.2
+    """Step control and stop criteria; the defaults are the options' (options.TABLE)."""
+
+    kind: str = _default("cont_type")
+    ds: float = _default("cont_ds")
+    ds_min: float = _default("cont_ds_min")
+    ds_max: float = _default("cont_ds_max")
+    newton_target: int = _default("cont_newton_target")
+    max_deviation: float = _default("cont_max_deviation")
+    dF_max: float = _default("cont_dF_max")
     lambda_max: float = math.inf
-    F_max: float = 2.0
-    max_steps: int = 2000
-    max_folds: int = 12
-    monitor: bool = False
+    F_max: float = _default("cont_F_max")
+    max_steps: int = _default("cont_max_steps")
+    max_folds: int = _default("cont_max_folds")
+    monitor: bool = _default("cont_monitor")
 
 
 class Continuation:

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["uniform", "paper", "load_weights", "l2_weights"]
+__all__ = ["uniform", "paper", "load_weights", "l2_weights", "PAPER_UNIFORM", "PAPER_EXTRA"]
+
+#: The paper's grid: 501 uniform nodes plus about 30 (N = 531).
+PAPER_UNIFORM, PAPER_EXTRA = 501, 30
 
 
 def uniform(n: int, rmax: float) -> np.ndarray:
@@ -16,7 +19,7 @@ def uniform(n: int, rmax: float) -> np.ndarray:
     return np.linspace(0.0, rmax, n)
 
 
-def paper(rmax: float, n_uniform: int = 501, extra: int = 30,
+def paper(rmax: float, n_uniform: int = PAPER_UNIFORM, extra: int = PAPER_EXTRA,
           refine_from: float = 0.0) -> np.ndarray:
     """The paper's node set: ``n_uniform`` uniform nodes plus ``extra`` nodes.
 

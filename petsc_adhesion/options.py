@@ -16,6 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
+from .grid import PAPER_EXTRA, PAPER_UNIFORM
+from .model import Model
+
 __all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "petsc_error", "print_help"]
 
 
@@ -52,14 +55,15 @@ def _fmt(x: float) -> str:
 
 
 _INF = math.inf
+_M = Model()
 TABLE = {o.name: o for o in [
     # model (paper eq. 9-14)
-    Option("adh_mu", "real", 1.0, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
-    Option("adh_sigma", "real", 0.0, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
-    Option("adh_roughness", "choice", "hermite", "roughness average of the pressure (eq. 14)",
+    Option("adh_mu", "real", _M.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
+    Option("adh_sigma", "real", _M.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
+    Option("adh_roughness", "choice", _M.roughness, "roughness average of the pressure (eq. 14)",
            choices=("none", "hermite")),
-    Option("adh_hermite_points", "int", 16, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
-    Option("adh_rmax", "real", 10.0, "end r_m of the computational domain", 0.0, 1e3, lo_open=True),
+    Option("adh_hermite_points", "int", _M.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
+    Option("adh_rmax", "real", _M.rmax, "end r_m of the computational domain", 0.0, 1e3, lo_open=True),
     Option("adh_lambda", "real", None, "solve at this one approach lambda only (no continuation)", -1e3, 1e3),
     Option("adh_guess", "string", None, "HDF5 result whose H(r) is the initial guess of -adh_lambda"),
     Option("adh_pmat", "choice", "dense", "matrix handed to the preconditioner: the assembled Jacobian, "
@@ -70,8 +74,8 @@ TABLE = {o.name: o for o in [
     # grid
     Option("grid_type", "choice", "paper", "node set", choices=("paper", "uniform")),
     Option("grid_n", "int", 531, "number of nodes of -grid_type uniform", 3, 200000),
-    Option("grid_paper_uniform", "int", 501, "uniform nodes of -grid_type paper", 3, 200000),
-    Option("grid_paper_extra", "int", 30, "midpoint nodes added by -grid_type paper", 0, 200000),
+    Option("grid_paper_uniform", "int", PAPER_UNIFORM, "uniform nodes of -grid_type paper", 3, 200000),
+    Option("grid_paper_extra", "int", PAPER_EXTRA, "midpoint nodes added by -grid_type paper", 0, 200000),
     Option("grid_paper_refine_from", "real", 0.0, "first refined element of -grid_type paper starts here", 0.0, 1e3),
     # continuation
     Option("cont_type", "choice", "auto", "corrector: switch at |lambdadot| < 0.5 (paper), or one kind",

@@ -14,9 +14,10 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from .grid import l2_weights, load_weights
+from .options import TABLE
 from .pressure import PressureLaw
 
-__all__ = ["Problem"]
+__all__ = ["Problem", "PCReuse", "shorten_to_wall", "TO_WALL"]
 
 #: Newton may cover at most this fraction of the way to the wall in one step.
 TO_WALL = 0.9
@@ -42,8 +43,8 @@ class Problem:
         many iterations (0: rebuild at every Newton iteration).
     """
 
-    def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat: str = "dense", band: int = 64,
-                 reuse_its: int = 10):
+    def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat: str = TABLE["adh_pmat"].default,
+                 band: int = TABLE["adh_pmat_band"].default, reuse_its: int = TABLE["adh_pc_reuse_its"].default):
         self.model, self.r, self.A = model, r, A
         self.comm = A.getComm()
         self.law = PressureLaw(model.sigma, model.roughness, model.hermite_points)
