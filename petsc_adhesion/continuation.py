@@ -23,7 +23,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from .options import TABLE
-from .residual import PCReuse, shorten_to_wall
+from .residual import PCReuse, preallocation, shorten_to_wall
 from .solver import configure
 
 __all__ = ["Point", "Bordered", "Continuation"]
@@ -150,30 +150,28 @@ class Bordered:
 
     # -- near-field bordered preconditioning matrix ------------------------------
     def _band_bordered(self, ext) -> PETSc.Mat:
-        pb = self.pb
-        ai, _ = pb.band_pattern()
-        N = pb.r.size
-        counts = np.diff(ai) + 1                      # + the G_lambda column
-        if self.last:
-            counts = np.append(counts, N + 1)
-        P = PETSc.Mat().createAIJ((ext, ext), nnz=(counts.astype(PETSc.IntType), counts.astype(PETSc.IntType)),
-                                  comm=self.comm)
+        ai, aj = self._band_csr(*self.pb.band_pattern(), np.zeros(0), np.zeros(0))[:2]
+        lo, hi = self.X.getOwnershipRange()
+        P = PETSc.Mat().createAIJ((ext, ext), nnz=preallocation(ai, aj, lo, hi), comm=self.comm)
         P.setUp()
         return P
 
-    def _fill_band(self) -> None:
-        pb = self.pb
-        ai, aj, v = pb.band_values()
-        N = pb.r.size
-        # append the G_lambda column (global column N) to every H row
+    def _band_csr(self, ai, aj, v, border):
+        """The near-field CSR of G_H with the G_lambda column and, on the last rank, the border row."""
+        N = self.pb.r.size
         j = np.insert(aj, ai[1:], N)
-        vals = np.insert(v, ai[1:], 1.0)
+        vals = np.insert(v, ai[1:], 1.0) if v.size else v
         ai2 = ai + np.arange(ai.size)
         if self.last:
             j = np.concatenate([j, np.arange(N + 1)])
-            vals = np.concatenate([vals, self.row.getDenseArray()[0], [self.corner.getDenseArray()[0, 0]]])
+            vals = np.concatenate([vals, border]) if v.size else vals
             ai2 = np.append(ai2, ai2[-1] + N + 1)
-        self.P.setValuesCSR(ai2.astype(PETSc.IntType), j.astype(PETSc.IntType), vals)
+        return ai2.astype(PETSc.IntType), j.astype(PETSc.IntType), vals
+
+    def _fill_band(self) -> None:
+        ai, aj, v = self.pb.band_values()
+        border = np.append(self.row.getDenseArray()[0], self.corner.getDenseArray()[0, 0]) if self.last else None
+        self.P.setValuesCSR(*self._band_csr(ai, aj, v, border))
         self.P.assemble()
 
     # -- use ---------------------------------------------------------------------

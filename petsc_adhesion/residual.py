@@ -17,7 +17,7 @@ from .grid import l2_weights, load_weights
 from .options import TABLE
 from .pressure import PressureLaw
 
-__all__ = ["Problem", "PCReuse", "shorten_to_wall", "TO_WALL"]
+__all__ = ["Problem", "PCReuse", "preallocation", "shorten_to_wall", "TO_WALL"]
 
 #: Newton may cover at most this fraction of the way to the wall in one step.
 TO_WALL = 0.9
@@ -160,7 +160,8 @@ class Problem:
         self._band_aj = (first.repeat(counts) + np.arange(counts.sum())
                          - np.repeat(self._band_ai[:-1], counts)).astype(PETSc.IntType)
         self._band_rows = np.repeat(np.arange(self.hi - self.lo), counts)
-        P = PETSc.Mat().createAIJ(self.A.getSizes(), nnz=(counts, counts), comm=self.comm)
+        P = PETSc.Mat().createAIJ(self.A.getSizes(), nnz=preallocation(self._band_ai, self._band_aj,
+                                                                     self.lo, self.hi), comm=self.comm)
         P.setUp()
         return P
 
@@ -178,6 +179,13 @@ class Problem:
         rule, node by node; all ranks scale by the same factor.
         """
         return shorten_to_wall(self, H.getArray(readonly=True), Y)
+
+
+def preallocation(ai: np.ndarray, aj: np.ndarray, lo: int, hi: int):
+    """(diagonal, off-diagonal) block counts per local CSR row, columns [lo, hi) owned here."""
+    rows = np.repeat(np.arange(ai.size - 1), np.diff(ai))
+    d = np.bincount(rows, weights=(aj >= lo) & (aj < hi), minlength=ai.size - 1).astype(PETSc.IntType)
+    return d, (np.diff(ai) - d).astype(PETSc.IntType)
 
 
 class PCReuse:
