@@ -1,0 +1,40 @@
+"""The documentation cannot rot: its example output and figures come from the code."""
+import os
+import re
+
+import pytest
+
+from conftest import ROOT, run_cli
+
+
+def test_readme_example_is_what_the_demo_prints(tmp_path):
+    readme = open(os.path.join(ROOT, "README.md")).read()
+    block = re.search(r"```\n(mu = 1 .*?)```", readme, re.S).group(1)
+    proc = run_cli("-options_file", "options/demo.opts", "-out", tmp_path / "d.h5",
+                   "-summary", tmp_path / "d.json", "-plot", tmp_path / "d.png")
+    assert proc.returncode == 0, proc.stderr
+    number = r"-?\d+\.\d{6,}"                     # the 8-digit event values, not times
+    documented = re.findall(number, block)
+    printed = re.findall(number, proc.stdout)
+    assert len(documented) >= 10 and documented == printed
+    assert (tmp_path / "d.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("doc", ["results.md", "numerics.md", "model.md", "output.md"])
+def test_figures_exist_and_name_their_command(doc):
+    text = open(os.path.join(ROOT, "docs", doc)).read()
+    for png in re.findall(r"\(figures/(\w+)\.png\)", text):
+        assert os.path.exists(os.path.join(ROOT, "docs", "figures", f"{png}.png"))
+        table = open(os.path.join(ROOT, "docs", "figures", f"{png}.md")).read()
+        assert f"made by: ./run figures {png}" in table
+        assert f"./run figures {png}" in text
+
+
+def test_every_options_file_sets_up(tmp_path):
+    """Each options file parses, its application options are known and in range, its
+    output paths are writable (relative to results/, as ./run study makes it);
+    -help stops after the set-up."""
+    (tmp_path / "results").mkdir()
+    for name in sorted(os.listdir(os.path.join(ROOT, "options"))):
+        proc = run_cli("-options_file", os.path.join(ROOT, "options", name), "-help", cwd=tmp_path)
+        assert proc.returncode == 0, (name, proc.stderr)
