@@ -24,6 +24,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
+from .grid import PAPER_UNIFORM
+
 __all__ = ["EventFinder", "grid_warning"]
 
 
@@ -159,6 +161,11 @@ def grid_warning(model, r: np.ndarray, edges: np.ndarray, folds: int) -> str:
     need = zone / NODES_PER_ZONE
     if hmax <= need and folds <= MAX_TRUE_FOLDS:
         return ""
+    # a paper grid that refines [0, r_edge + 2] enough (the edge may travel further than seen)
+    h0 = model.rmax / (PAPER_UNIFORM - 1)
+    extra = min(int(np.ceil(min(hi + 2.0, model.rmax) / h0)), PAPER_UNIFORM - 1)
+    split = max(2, int(np.ceil(h0 / need)))
     return (f"{folds} turning points; grid spacing {hmax:.3g} where the contact edge travels "
             f"(r in [{lo:.3g}, {hi:.3g}]) does not resolve the cohesive zone {zone:.3g} at mu = {model.mu:g}: "
-            f"this case needs spacing <= {need:.3g} there")
+            f"this case needs spacing <= {need:.3g} there, e.g. -grid_type paper "
+            f"-grid_paper_extra {extra} -grid_paper_split {split} ({PAPER_UNIFORM + extra * (split - 1)} nodes)")

@@ -20,21 +20,23 @@ def uniform(n: int, rmax: float) -> np.ndarray:
 
 
 def paper(rmax: float, n_uniform: int = PAPER_UNIFORM, extra: int = PAPER_EXTRA,
-          refine_from: float = 0.0) -> np.ndarray:
-    """The paper's node set: ``n_uniform`` uniform nodes plus ``extra`` nodes.
+          refine_from: float = 0.0, split: int = 2) -> np.ndarray:
+    """The paper's node set: ``n_uniform`` uniform nodes plus refined elements.
 
     The paper adds about 30 nodes "where H and P change fastest" to 501
-    uniform ones (N = 531) without saying where.  Our rule: the extra nodes are
-    the midpoints of the ``extra`` uniform elements that start at or after
-    ``refine_from``.  The default, ``refine_from = 0``, halves the spacing on
-    [0, 30 h] where the pressure peaks for small mu and at the centre of the
-    contact; move it to the contact edge of the case at hand for large mu.
+    uniform ones (N = 531) without saying where.  Our rule: the ``extra``
+    uniform elements that start at or after ``refine_from`` are split into
+    ``split`` equal parts (by default their midpoints: 30 nodes).  The default,
+    ``refine_from = 0``, halves the spacing on [0, 30 h] where the pressure
+    peaks for small mu and at the centre of the contact.  For large mu, refine
+    the whole range the contact edge travels (see events.grid_warning).
     """
     r = uniform(n_uniform, rmax)
     first = int(np.searchsorted(r, refine_from - 1e-12 * rmax))
     first = min(first, n_uniform - 1 - extra)
-    mid = 0.5 * (r[first:first + extra] + r[first + 1:first + extra + 1])
-    return np.sort(np.concatenate([r, mid]))
+    a, h = r[first:first + extra], r[1] - r[0]
+    inner = (a[:, None] + h * np.arange(1, split)[None, :] / split).ravel()
+    return np.sort(np.concatenate([r, inner]))
 
 
 def load_weights(r: np.ndarray) -> np.ndarray:

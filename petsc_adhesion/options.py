@@ -75,7 +75,8 @@ TABLE = {o.name: o for o in [
     Option("grid_type", "choice", "paper", "node set", choices=("paper", "uniform")),
     Option("grid_n", "int", 531, "number of nodes of -grid_type uniform", 3, 200000),
     Option("grid_paper_uniform", "int", PAPER_UNIFORM, "uniform nodes of -grid_type paper", 3, 200000),
-    Option("grid_paper_extra", "int", PAPER_EXTRA, "midpoint nodes added by -grid_type paper", 0, 200000),
+    Option("grid_paper_extra", "int", PAPER_EXTRA, "elements refined by -grid_type paper", 0, 200000),
+    Option("grid_paper_split", "int", 2, "parts each refined element is split into", 2, 1000),
     Option("grid_paper_refine_from", "real", 0.0, "first refined element of -grid_type paper starts here", 0.0, 1e3),
     # continuation
     Option("cont_type", "choice", "auto", "corrector: switch at |lambdadot| < 0.5 (paper), or one kind",

@@ -45,13 +45,14 @@ def read_grid(opts: AppOptions, model: Model) -> np.ndarray:
     kind = opts.choice("grid_type")
     n, nu = opts.int("grid_n"), opts.int("grid_paper_uniform")
     extra, start = opts.int("grid_paper_extra"), opts.real("grid_paper_refine_from")
+    split = opts.int("grid_paper_split")
     if kind == "uniform":
         return grid.uniform(n, model.rmax)
     if extra > nu - 1:
         raise InputError(f"-grid_paper_extra: expected an integer in [0, {nu - 1}], got {extra}")
     if start >= model.rmax:
         raise InputError(f"-grid_paper_refine_from: expected a real in [0, {model.rmax:g}), got {start:g}")
-    return grid.paper(model.rmax, nu, extra, start)
+    return grid.paper(model.rmax, nu, extra, start, split)
 
 
 def gather(v: PETSc.Vec) -> np.ndarray:
@@ -181,10 +182,11 @@ def trace(problem: Problem, snes: PETSc.SNES, opts: AppOptions) -> dict:
     pressures = [problem.law(H)[0] for H in map(whole, (p.h for p in pts)) if H is not None]
     edges = np.array([problem.r[np.argmin(P)] for P in pressures if P.min() < 0])
     pull_off = finder.pull_off()
+    coarse = grid_warning(model, problem.r, edges, cont.folds)
     return {"points": pts, "events": finder.events, "pull_off": pull_off,
             "steps": len(pts) - 1, "rejected_steps": cont.rejected, "stop_reason": cont.stop_reason,
-            "grid_warning": grid_warning(model, problem.r, edges, cont.folds), "wall_time_s": wall,
-            "warnings": curve_warnings(problem, pts, pull_off), "lambda_start": lam0}
+            "grid_warning": coarse, "wall_time_s": wall,
+            "warnings": curve_warnings(problem, pts, None if coarse else pull_off), "lambda_start": lam0}
 
 
 #: Closer than this to the wall of the roughness rule, a state is set by its smallest weights.
@@ -192,7 +194,11 @@ WALL_GAP = 1e-3
 
 
 def curve_warnings(problem: Problem, pts, pull_off) -> list[str]:
-    """What makes a traced curve untrustworthy, one line each."""
+    """What makes a traced curve untrustworthy, one line each.
+
+    ``pull_off`` None skips the check of the pull-off against the curve (when
+    the grid warning already explains a curve of spurious folds).
+    """
     out = []
     law = problem.law
     gap = problem.comm.tompi4py().allreduce(min(float(p.h.min()) for p in pts) - law.wall, op=MPI.MIN)
