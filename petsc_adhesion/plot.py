@@ -79,7 +79,7 @@ def curve_figure(path: str, out: str) -> None:
     load_approach(ax, res)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out, dpi=120)
+    fig.savefig(out, dpi=120, format="png")
     plt.close(fig)
 
 

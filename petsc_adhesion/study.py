@@ -5,7 +5,6 @@ load-approach curve by continuation (the default).
 """
 from __future__ import annotations
 
-import os
 import sys
 import time
 
@@ -279,36 +278,40 @@ def main() -> int:
         if opts.flag("cont_error_estimate"):
             coarse = r[::2] if r.size % 2 else np.append(r[::2], r[-1])
             estimate_errors(res, trace(*discretize(model, coarse, opts), opts), model.rmax)
-        check_unused()
-        if comm.getRank() == 0:
-            info = _versions(comm)
-            model_attrs = _model_attrs(model)
-            summ = {**info, **model_attrs, "n_nodes": int(r.size), **curve_summary(res)}
-            tree = {**info, "kind": "curve", "options": opts.db.getAll(), "model": model_attrs, "grid": {"r": r},
-                    **curve_tree(res),
-                    "summary": {k: v for k, v in summ.items() if not isinstance(v, (list, dict)) and v is not None}}
-            if out:
-                write_h5(out, tree)
-            if plot:
-                draw(plot, tree, out)
-            if summary:
-                write_json(summary, summ)
-            _report(summ)
-        return 0
-    res = fixed_solve(problem, snes, lam, _guess(problem, lam, guess))
-    check_unused()
+    else:
+        res = fixed_solve(problem, snes, lam, _guess(problem, lam, guess))
+    check_unused()                          # PETSc has read all of its options by now
     if comm.getRank() == 0:
-        info = _versions(comm)
-        model_attrs = _model_attrs(model)
-        brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
-        if out:
-            write_h5(out, {**info, "kind": "solve", "options": opts.db.getAll(), "model": model_attrs,
-                           "grid": {"r": r}, "solution": {"H": res["H"], "P": res["P"], **brief}})
-        if summary:
-            write_json(summary, {**info, **model_attrs, "n_nodes": int(r.size), **brief})
-        print(f"lambda = {lam:.10g}  F = {res['F']:.10g}  H0 = {res['H0']:.10g}  "
-              f"Newton {res['snes_iterations']}  KSP {res['ksp_iterations']}  {res['wall_time_s']:.3g} s")
+        head = {**_versions(comm), "options": opts.db.getAll(), "model": _model_attrs(model), "grid": {"r": r}}
+        (write_curve if lam is None else write_solve)(res, head, out, summary, plot)
     return 0
+
+
+def write_curve(res: dict, head: dict, out, summary, plot) -> None:
+    """Files and report of a traced curve (schema in docs/output.md)."""
+    flat = {k: v for k, v in head.items() if k not in ("options", "model", "grid")}
+    summ = {**flat, **head["model"], "n_nodes": int(head["grid"]["r"].size), **curve_summary(res)}
+    tree = {**head, "kind": "curve", **curve_tree(res),
+            "summary": {k: v for k, v in summ.items() if not isinstance(v, (list, dict)) and v is not None}}
+    if out:
+        write_h5(out, tree)
+    if plot:
+        draw(plot, tree, out)
+    if summary:
+        write_json(summary, summ)
+    _report(summ)
+
+
+def write_solve(res: dict, head: dict, out, summary, plot) -> None:
+    """Files and report of a fixed-lambda solve."""
+    brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
+    if out:
+        write_h5(out, {**head, "kind": "solve", "solution": {"H": res["H"], "P": res["P"], **brief}})
+    if summary:
+        flat = {k: v for k, v in head.items() if k not in ("options", "model", "grid")}
+        write_json(summary, {**flat, **head["model"], "n_nodes": int(head["grid"]["r"].size), **brief})
+    print(f"lambda = {res['lambda']:.10g}  F = {res['F']:.10g}  H0 = {res['H0']:.10g}  "
+          f"Newton {res['snes_iterations']}  KSP {res['ksp_iterations']}  {res['wall_time_s']:.3g} s")
 
 
 def draw(png: str, tree: dict, h5: str | None) -> None:
@@ -323,8 +326,7 @@ def draw(png: str, tree: dict, h5: str | None) -> None:
             h5 = f"{tmp}/curve.h5"
             write_h5(h5, tree)
         with atomic(png) as target:
-            curve_figure(h5, target + ".png")
-            os.replace(target + ".png", target)
+            curve_figure(h5, target)
 
 
 def _err(e: dict) -> str:
