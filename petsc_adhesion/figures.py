@@ -161,7 +161,7 @@ def convergence():
         a2.loglog(times[:-1], err, "o-", label=name)
         orders = np.log2(np.abs(np.diff(x[:-1])[:-1] / np.diff(x[:-1])[1:]))
         rows.append([name, _f(ref, ".8f")] + [_f(e, ".1e") for e in err] + [" ".join(f"{o:.2f}" for o in orders)])
-    a1.loglog(ns[:-1], 0.5 * (np.array(ns[:-1]) / 100.0) ** -2, "k:", label="N^-2")
+    a1.loglog(ns[:-1], 2e-3 * (np.array(ns[:-1]) / 100.0) ** -2, "k:", label="N^-2")
     a1.set_xlabel("nodes N (uniform on [0, 10])")
     a2.set_xlabel("continuation time (s), one rank")
     for a in (a1, a2):
