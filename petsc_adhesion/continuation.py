@@ -290,11 +290,7 @@ class Continuation:
         return a * p, a, ksp.getIterationNumber()
 
     def make_point(self, h, lam, th, tl, **kw) -> Point:
-        pb = self.pb
-        H = pb.create_vec()
-        H.setArray(h)
-        F = pb.load(H)
-        dF = pb.comm.tompi4py().allreduce(float(pb.load_gradient(H) @ th))
+        F, dF = self.pb.load_rate(h, th)
         return Point(h=h, lam=lam, F=F, th=th, tl=tl, dF=dF, **kw)
 
     def start(self, lam0: float) -> Point:

@@ -95,10 +95,11 @@ class Problem:
         p, _ = self.pressure(H)
         return self.comm.tompi4py().allreduce(float(self.q @ p))
 
-    def load_gradient(self, H: PETSc.Vec) -> np.ndarray:
-        """Local part of dF/dH = (8/3) q P'(H)."""
-        _, dp = self.pressure(H)
-        return self.q * dp
+    def load_rate(self, h: np.ndarray, th: np.ndarray) -> tuple[float, float]:
+        """F (eq. 26) of the local H values h, and its rate dF/ds = (8/3) q . (P'(H) th)."""
+        p, dp = self.law(h)
+        F, dF = self.comm.tompi4py().allreduce(np.array([self.q @ p, self.q @ (dp * th)]))
+        return float(F), float(dF)
 
     def inner(self, u: np.ndarray, v: np.ndarray) -> float:
         """(1/r_m) integral u v dr on local parts, summed over ranks."""
