@@ -16,8 +16,7 @@ grid-independent inner product <u, v> = (1/r_m) integral u v dr for H.
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from petsc4py import PETSc

@@ -256,7 +256,7 @@ def main() -> int:
     lam = opts.real("adh_lambda")
     guess = opts.string("adh_guess")
     out, summary, plot = opts.string("out"), opts.string("summary"), opts.string("plot")
-    pmat, band = opts.choice("adh_pmat"), opts.int("adh_pmat_band")
+    pmat = opts.choice("adh_pmat")
     if pmat == "dense" and comm.getSize() == 1 and r.size > 20000:
         raise InputError(f"-adh_pmat: dense needs {8 * r.size**2 / 2**30:.1f} GiB at N = {r.size}; use band or shell")
     if guess is not None and lam is None:

@@ -1,6 +1,5 @@
 """Newton never leaves the domain: every gap H - sqrt(2) sigma x_l + 1 stays positive."""
 import numpy as np
-import pytest
 
 from petsc_adhesion import residual
 from petsc_adhesion.solver import solve
