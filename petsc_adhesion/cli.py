@@ -16,6 +16,28 @@ def _options_files(argv: list[str]) -> list[str]:
     return [argv[i + 1] if i + 1 < len(argv) else "" for i, a in enumerate(argv) if a == "-options_file"]
 
 
+def _options_file_error(path: str) -> str | None:
+    """What PETSc would abort on in an options file, said in one line (None: fine).
+
+    Its syntax: a line is '-name [value]' or 'alias -name -other', '#' and '!'
+    start comments; a nested -options_file is checked too.
+    """
+    if not path or not os.path.isfile(path) or not os.access(path, os.R_OK):
+        return f"-options_file: cannot read '{path}'"
+    with open(path, errors="replace") as f:
+        for n, line in enumerate(f, 1):
+            tokens = line.split("#")[0].split("!")[0].split()
+            ok = not tokens or (tokens[0] == "alias" and len(tokens) == 3) or \
+                (tokens[0].startswith("-") and len(tokens) <= 2)
+            if not ok:
+                return f"-options_file {path}: line {n}: expected '-name [value]', got '{line.strip()}'"
+            if tokens and tokens[0] == "-options_file":
+                inner = _options_file_error(tokens[1] if len(tokens) > 1 else "")
+                if inner:
+                    return inner
+    return None
+
+
 def _error(msg: str, status: int) -> int:
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK", os.environ.get("PMI_RANK", "0")))
     if rank == 0:
@@ -25,10 +47,11 @@ def _error(msg: str, status: int) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv if argv is None else argv)
-    # PETSc aborts with a page of text on an unreadable options file: say it in one line first
+    # PETSc aborts with a page of text on a bad options file: say it in one line first
     for path in _options_files(argv):
-        if not path or not os.path.isfile(path) or not os.access(path, os.R_OK):
-            return _error(f"-options_file: cannot read '{path}'", 2)
+        bad = _options_file_error(path)
+        if bad:
+            return _error(bad, 2)
     import petsc4py
     petsc4py.init(argv)
     from petsc4py import PETSc

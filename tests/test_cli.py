@@ -464,3 +464,19 @@ def test_scene_leaves_out_what_it_does_not_need(tmp_path):
     with h5py.File(h5, "r") as f:
         assert len(f["events"]) >= 2
         assert all("H" not in g and "P" not in g for g in f["events"].values())
+
+
+@pytest.mark.parametrize("text, line", [("adh_mu 1\n", 1), ("# ok\n-adh_mu\n-adh_lambda -2 extra\n", 3),
+                                        ("-options_file /nonexistent.opts\n", None)],
+                         ids=["no-dash", "extra-token", "nested-unreadable"])
+def test_malformed_options_file_is_one_line(tmp_path, text, line):
+    """PETSc would abort with a page of text and a traceback: the program says it in one line."""
+    opts = tmp_path / "bad.opts"
+    opts.write_text(text)
+    proc = run_cli("-options_file", opts, "-adh_lambda", -2, "-out", tmp_path / "x.h5")
+    assert proc.returncode == 2
+    err = proc.stderr.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("petsc-adhesion: error: -options_file"), proc.stderr
+    if line:
+        assert f"line {line}:" in err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.opts"]
