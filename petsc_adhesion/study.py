@@ -139,6 +139,20 @@ def estimate_errors(fine: dict, coarse: dict, rmax: float) -> None:
                                                            for k, v in by_kind(fine["events"]).items())}
 
 
+def check_memory(n: int, pmat: str, curve: bool, ranks: int) -> None:
+    """Refuse a grid whose dense matrices cannot fit: A, and G_H and the bordered
+    matrix when assembled densely, N^2 doubles each, split over the ranks."""
+    import os
+
+    dense = 1 + (pmat == "dense") * (1 + curve)
+    need = 8.0 * n * n * dense / ranks
+    have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    if need > 0.8 * have:
+        raise InputError(f"-grid_n: N = {n} needs {need / 2**30:.0f} GiB a rank for {dense} dense N x N "
+                         f"matrices, this machine has {have / 2**30:.0f} GiB; use fewer nodes, more ranks, "
+                         f"or -adh_pmat band")
+
+
 def start_lambda(model: Model, wall: float) -> float:
     """Default first approach: the sphere well out of reach of the surface forces.
 
@@ -256,9 +270,7 @@ def main() -> int:
     lam = opts.real("adh_lambda")
     guess = opts.string("adh_guess")
     out, summary, plot = opts.string("out"), opts.string("summary"), opts.string("plot")
-    pmat = opts.choice("adh_pmat")
-    if pmat == "dense" and comm.getSize() == 1 and r.size > 20000:
-        raise InputError(f"-adh_pmat: dense needs {8 * r.size**2 / 2**30:.1f} GiB at N = {r.size}; use band or shell")
+    check_memory(r.size, opts.choice("adh_pmat"), lam is None, comm.getSize())
     if guess is not None and lam is None:
         raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
     for name in TABLE:                      # read every app option now, so a typo is caught before any work
