@@ -66,5 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     except PETSc.Error as e:
         bad = petsc_error(e)
         return _error(str(bad), 2) if bad else _error(f"PETSc error {e.ierr}", 1)
+    except OSError as e:
+        return _error(f"cannot write '{e.filename}': {e.strerror}", 1)
     except (RuntimeError, FloatingPointError) as e:
         return _error(str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__, 1)

@@ -51,4 +51,5 @@ class Model:
         A grid must resolve it; coarser grids trap the edge between nodes and
         show spurious turning points.
         """
-        return 0.75 * self.mu ** -1.5 if self.mu > 0 else math.inf
+        scale = self.mu**1.5
+        return 0.75 / scale if scale > 0 else math.inf

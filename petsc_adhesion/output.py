@@ -18,23 +18,31 @@ __all__ = ["check_writable", "write_h5", "write_json", "atomic"]
 
 
 def check_writable(option: str, path: str | None) -> None:
-    """Fail early, before any work, when ``path`` cannot be created."""
+    """Fail early, before any work, when ``path`` cannot be created (by trying)."""
     if path is None:
         return
     folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
-        raise InputError(f"-{option}: cannot write '{path}' (no writable directory '{folder}')")
+    if os.path.isdir(path):
+        raise InputError(f"-{option}: '{path}' is a directory")
+    if not os.path.isdir(folder):
+        raise InputError(f"-{option}: cannot write '{path}' (no directory '{folder}')")
+    try:
+        with atomic(path, keep=False):
+            pass
+    except OSError as e:
+        raise InputError(f"-{option}: cannot write '{path}' ({e.strerror})") from None
 
 
 @contextmanager
-def atomic(path: str):
-    """Yield a temporary path next to ``path``; rename it to ``path`` on success."""
+def atomic(path: str, keep: bool = True):
+    """Yield a temporary path next to ``path``; rename it to ``path`` on success (``keep``)."""
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=folder)
     os.close(fd)
     try:
         yield tmp
-        os.replace(tmp, path)
+        if keep:
+            os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)

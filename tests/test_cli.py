@@ -480,3 +480,14 @@ def test_malformed_options_file_is_one_line(tmp_path, text, line):
     if line:
         assert f"line {line}:" in err[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.opts"]
+
+
+@pytest.mark.parametrize("option", ["-out", "-summary", "-plot"])
+def test_unwritable_output_is_one_line(tmp_path, option):
+    """A directory in place of a file, or a place no file can be created: refused before any work."""
+    (tmp_path / "d").mkdir()
+    for target in (tmp_path / "d", "/proc/petsc-adhesion.out"):
+        proc = run_cli(option, target, "-grid_type", "uniform", "-grid_n", 51)
+        err = proc.stderr.strip().splitlines()
+        assert proc.returncode == 2 and len(err) == 1 and err[0].startswith(f"petsc-adhesion: error: {option}:")
+    assert [p.name for p in tmp_path.iterdir()] == ["d"] and not any((tmp_path / "d").iterdir())
