@@ -20,6 +20,8 @@ import numpy as np
 from .model import dmt_load
 from .plot import load_approach, profiles, read
 
+__all__ = ["FIGURES", "run", "runs"]
+
 OUT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs", "figures")
 TMP = tempfile.mkdtemp(prefix="petsc-adhesion-figures-")
 
