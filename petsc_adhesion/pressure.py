@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from .model import Model
+
 __all__ = ["PressureLaw", "RULES"]
 
 
@@ -40,7 +42,7 @@ class PressureLaw:
         Points of the rule.
     """
 
-    def __init__(self, sigma: float = 0.0, rule: str = "hermite", n: int = 16):
+    def __init__(self, sigma: float = 0.0, rule: str = Model.roughness, n: int = Model.hermite_points):
         if sigma == 0.0:
             rule = "none"
         self.sigma, self.rule, self.n = sigma, rule, (1 if rule == "none" else n)
