@@ -11,12 +11,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Model", "tabor", "dmt_load", "DMT_EQUILIBRIUM"]
+__all__ = ["Model", "tabor", "scales", "dmt_load", "DMT_EQUILIBRIUM"]
 
 
 def tabor(R: float, gamma: float, E: float, epsilon: float) -> float:
     """Tabor parameter mu = (R gamma^2 / (E^2 epsilon^3))^(1/3), eq. (9)."""
     return (R * gamma**2 / (E**2 * epsilon**3)) ** (1.0 / 3.0)
+
+
+def scales(R: float, gamma: float, E: float, epsilon: float) -> dict:
+    """The units of the dimensionless results, in SI (section "The Mathematical Theory").
+
+    R radius (m), gamma work of adhesion (J/m^2), E combined modulus of eq. (2)
+    (Pa), epsilon equilibrium spacing (m).
+    """
+    return {"force_N": 2 * math.pi * R * gamma, "approach_m": epsilon, "radius_m": math.sqrt(epsilon * R),
+            "pressure_Pa": 8 * gamma / (3 * epsilon)}
 
 
 def dmt_load(lam):

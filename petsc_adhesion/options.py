@@ -59,6 +59,8 @@ _M = Model()
 TABLE = {o.name: o for o in [
     # model (paper eq. 9-14)
     Option("adh_mu", "real", _M.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
+    Option("adh_physical", "reals", (), "R,gamma,E,epsilon in SI (m, J/m^2, Pa, m): mu from eq. (9), "
+           "results also in SI", 0.0, 1e12, lo_open=True),
     Option("adh_sigma", "real", _M.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
     Option("adh_roughness", "choice", _M.roughness, "roughness average of the pressure (eq. 14)",
            choices=("none", "hermite")),

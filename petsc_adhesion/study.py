@@ -17,7 +17,7 @@ from . import __version__, grid
 from .continuation import Continuation, Settings
 from .events import EventFinder, grid_warning
 from .influence import create_influence
-from .model import Model
+from .model import Model, scales, tabor
 from .options import TABLE, AppOptions, InputError, check_unused, print_help
 from .output import check_writable, write_h5, write_json
 from .residual import Problem
@@ -32,8 +32,21 @@ def _is_app(name: str) -> bool:
     return name.startswith(_APP) or name in TABLE
 
 
+def read_physical(opts: AppOptions) -> tuple | None:
+    phys = opts.reals("adh_physical")
+    if phys and len(phys) != 4:
+        raise InputError(f"-adh_physical: expected 4 positive reals R,gamma,E,epsilon (SI), got {len(phys)}")
+    if phys and opts.db.hasName("adh_mu"):
+        raise InputError("-adh_mu: not with -adh_physical, which sets mu by eq. (9)")
+    return phys or None
+
+
 def read_model(opts: AppOptions) -> Model:
-    model = Model(mu=opts.real("adh_mu"), sigma=opts.real("adh_sigma"), rmax=opts.real("adh_rmax"),
+    phys = read_physical(opts)
+    mu = tabor(*phys) if phys else opts.real("adh_mu")
+    if phys and not 0 <= mu <= TABLE["adh_mu"].hi:
+        raise InputError(f"-adh_physical: gives mu = {mu:.3g}, outside [0, {TABLE['adh_mu'].hi:g}]")
+    model = Model(mu=mu, sigma=opts.real("adh_sigma"), rmax=opts.real("adh_rmax"),
                   roughness=opts.choice("adh_roughness"), hermite_points=opts.int("adh_hermite_points"))
     if model.roughness == "none" and model.sigma > 0:
         raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
@@ -294,7 +307,10 @@ def main() -> int:
         res = fixed_solve(problem, snes, lam, _guess(problem, lam, guess))
     check_unused()                          # PETSc has read all of its options by now
     if comm.getRank() == 0:
-        head = {**_versions(comm), "options": opts.db.getAll(), "model": _model_attrs(model), "grid": {"r": r}}
+        phys = read_physical(opts)
+        units = {"scales": scales(*phys)} if phys else {}
+        head = {**_versions(comm), "options": opts.db.getAll(), "model": _model_attrs(model), "grid": {"r": r},
+                **units}
         (write_curve if lam is None else write_solve)(res, head, out, summary, plot)
     return 0
 
@@ -303,6 +319,10 @@ def write_curve(res: dict, head: dict, out, summary, plot) -> None:
     """Files and report of a traced curve (schema in docs/output.md)."""
     flat = {k: v for k, v in head.items() if k not in ("options", "model", "grid")}
     summ = {**flat, **head["model"], "n_nodes": int(head["grid"]["r"].size), **curve_summary(res)}
+    if "scales" in head and summ["pull_off"]:
+        sc = head["scales"]
+        summ["pull_off"] |= {"F_N": summ["pull_off"]["F"] * sc["force_N"],
+                             "lambda_m": summ["pull_off"]["lambda"] * sc["approach_m"]}
     tree = {**head, "kind": "curve", **curve_tree(res),
             "summary": {k: v for k, v in summ.items() if not isinstance(v, (list, dict)) and v is not None}}
     if out:
@@ -362,6 +382,9 @@ def _report(s: dict) -> None:
           f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s{extra}; stopped: {s['stop_reason']}")
     if po:
         print(f"  pull-off (load control)  lambda = {po['lambda']:.8f}  F = {po['F']:.8f}{_err(po)}")
+        if "F_N" in po:
+            print(f"                           = {po['F_N']:.6g} N at an approach of {po['lambda_m']:.6g} m "
+                  f"(mu = {s['mu']:.4g} from -adh_physical)")
     for f in s["folds"]:
         land = f.get("landing")
         to = f"  -> lands at F = {land['F']:.8f}" if land else ""
