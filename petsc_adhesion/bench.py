@@ -14,11 +14,12 @@ a measurement, not a test.
 * solve: Newton at mu = 1, lambda = -2 on the paper grid, from the rigid guess
   (eq. 27), a fresh guess each repeat; the influence matrix and the SNES are
   built once, untimed.  The SNES keeps its preconditioner between solves by
-  design (:class:`~petsc_adhesion.residual.PCReuse`); each repeat expires it,
+  design (:class:`~petsc_adhesion.solver.PCReuse`); each repeat expires it,
   so every repeat assembles and factors it again.
 * curve: :func:`~petsc_adhesion.study.trace` with the program's defaults
-  (mu = 1, paper grid): the time of the call, its steps, and a check that it
-  found both turning points, the pull-off and the equilibrium.
+  (mu = 1, paper grid): the time of the call (its solvers made inside, as in
+  the program), its steps, and a check that it found both turning points,
+  the pull-off and the equilibrium.
 
 ``-bench_profile`` profiles one more curve (cProfile, which slows the Python
 side) and prints the ten functions of largest own time; ``-log_view`` gives PETSc's account of all runs.
@@ -42,10 +43,10 @@ from petsc4py import PETSc
 from . import __version__, grid
 from .influence import create_influence
 from .model import Model
-from .options import AppOptions, InputError, check_unused
+from .options import AppOptions, InputError, check_unused, read_settings
 from .output import check_writable, write_json
-from .residual import Problem
-from .solver import solve
+from .problem import Problem
+from .solver import Newton
 from .study import discretize, trace
 
 __all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main"]
@@ -77,25 +78,30 @@ def bench_influence(repeats: int | None = None) -> dict:
     return out
 
 
-def mu1_problem(curve: bool) -> tuple[Problem, PETSc.SNES]:
-    """The default study's Problem (mu = 1, paper grid, dense PC) and its SNES, as the program makes them."""
-    return discretize(Model(mu=1.0), grid.paper(10.0), AppOptions(), curve=curve)
+def mu1_problem() -> Problem:
+    """The default study's Problem (mu = 1, paper grid, dense PC), as the program makes it."""
+    return discretize(Model(mu=1.0), grid.paper(10.0))
 
 
-def bench_solve(problem: Problem, snes: PETSc.SNES, repeats: int | None = None, lam: float = -2.0) -> dict:
+def bench_solve(problem: Problem, repeats: int | None = None, lam: float = -2.0) -> dict:
     """One fixed-lambda Newton solve from the rigid guess (target 20 ms), refactoring each repeat."""
+    newton = Newton(problem)
+    H = problem.create_vec()
     times = []
     for _ in range(repeats or 7):
-        H = problem.rigid(lam, problem.create_vec())
-        problem.reuse.expire()
+        problem.rigid(lam, H)
+        newton.reuse.expire()
         t0 = time.perf_counter()
-        ok = solve(snes, problem, lam, H)
+        ok = newton.solve(lam, H)
         times.append(time.perf_counter() - t0)
         if not ok:
-            raise RuntimeError(f"Newton did not converge at lambda = {lam:g} (reason {snes.getConvergedReason()})")
+            raise RuntimeError(f"Newton did not converge at lambda = {lam:g} "
+                               f"(reason {newton.snes.getConvergedReason()})")
+    its, kits = newton.iterations
+    newton.destroy()
+    H.destroy()
     return {"solve": row(f"solve, mu = {problem.model.mu:g}, lambda = {lam:g}, N = {problem.r.size}", times, 0.020,
-                         snes_iterations=snes.getIterationNumber(),
-                         ksp_iterations=snes.getLinearSolveIterations())}
+                         snes_iterations=its, ksp_iterations=kits)}
 
 
 def check_curve(res: dict) -> dict:
@@ -113,13 +119,17 @@ def check_curve(res: dict) -> dict:
             "equilibrium_lambda": first["equilibrium"]["lambda"]}
 
 
-def bench_curve(problem: Problem, snes: PETSc.SNES, repeats: int | None = None) -> dict:
-    """The whole default curve (target 1 s), each repeat from an expired preconditioner."""
+def _trace(problem: Problem) -> dict:
+    """The program's default curve on ``problem``, step control from the options (-cont_*)."""
+    return trace(problem, read_settings(AppOptions()), problem.far_approach())
+
+
+def bench_curve(problem: Problem, repeats: int | None = None) -> dict:
+    """The whole default curve (target 1 s), each repeat with fresh solvers (as the program makes them)."""
     times = []
     for _ in range(repeats or 5):
-        problem.reuse.expire()
         t0 = time.perf_counter()
-        res = trace(problem, snes, AppOptions())
+        res = _trace(problem)
         times.append(time.perf_counter() - t0)
         marks = check_curve(res)
     return {"curve": row(f"curve, mu = {problem.model.mu:g}, N = {problem.r.size}", times, 1.0, **marks)}
@@ -132,11 +142,10 @@ def _where(key: tuple) -> str:
     return f"{os.path.join(*path.split(os.sep)[-2:])}:{line}({name})"
 
 
-def profile_curve(problem: Problem, snes: PETSc.SNES, top: int = 10) -> dict:
+def profile_curve(problem: Problem, top: int = 10) -> dict:
     """Profiled time of one traced curve and its ``top`` functions by own time (cProfile's tottime)."""
-    problem.reuse.expire()
     prof = cProfile.Profile()
-    check_curve(prof.runcall(trace, problem, snes, AppOptions()))
+    check_curve(prof.runcall(_trace, problem))
     st = pstats.Stats(prof)
     best = sorted(st.stats.items(), key=lambda kv: kv[1][2], reverse=True)[:top]
     return {"total_s": st.total_tt,
@@ -195,13 +204,12 @@ def main() -> int:
 
     parts = (only,) if only else PARTS
     results = bench_influence(repeats) if "influence" in parts else {}
+    problem = mu1_problem() if parts != ("influence",) or profile else None
     if "solve" in parts:
-        results |= bench_solve(*mu1_problem(curve=False), repeats)
-    if "curve" in parts or profile:
-        problem, snes = mu1_problem(curve=True)
+        results |= bench_solve(problem, repeats)
     if "curve" in parts:
-        results |= bench_curve(problem, snes, repeats)
-    top = profile_curve(problem, snes) if profile else None
+        results |= bench_curve(problem, repeats)
+    top = profile_curve(problem) if profile else None
     info = {"program": "petsc-adhesion bench", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(), "mpi_ranks": 1,
             "openblas_num_threads": os.environ.get("OPENBLAS_NUM_THREADS", "unset"),

@@ -13,6 +13,7 @@ __all__ = ["main"]
 
 
 def _options_files(argv: list[str]) -> list[str]:
+    """The files named by -options_file on the command line."""
     return [argv[i + 1] if i + 1 < len(argv) else "" for i, a in enumerate(argv) if a == "-options_file"]
 
 
@@ -39,13 +40,16 @@ def _options_file_error(path: str) -> str | None:
 
 
 def _error(msg: str, status: int) -> int:
-    rank = int(os.environ.get("OMPI_COMM_WORLD_RANK", os.environ.get("PMI_RANK", "0")))
-    if rank == 0:
-        print(f"petsc-adhesion: error: {msg}", file=sys.stderr)
+    """Say ``msg`` once, on rank 0's stderr; return the exit status."""
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.Get_rank() == 0:
+        print(f"petsc-adhesion: error: {msg}", file=sys.stderr, flush=True)
     return status
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the program on ``argv`` (default: sys.argv); the exit status: 0, 1 (failed), 2 (bad input)."""
     argv = list(sys.argv if argv is None else argv)
     # PETSc aborts with a page of text on a bad options file: say it in one line first
     for path in _options_files(argv):

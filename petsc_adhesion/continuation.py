@@ -1,420 +1,437 @@
-"""Predictor-corrector continuation of G(H, lambda) = 0 (paper, "Numerical Procedure").
+"""Predictor-corrector continuation of G(x, p) = 0 in one parameter p (paper, "Numerical Procedure").
 
-The curve is followed in the unknowns X = (H, lambda), measured in the
-grid-independent inner product <u, v> = (1/r_m) integral u v dr for H.
+The core knows nothing of the problem beyond this protocol (in the manner of
+pacopy's ``f``, ``df_dlmbda``, ``jacobian_solver``, ``inner``):
 
-* Natural corrector (eq. 20-22): Newton on G(H; lambda) = 0 at the predicted
-  lambda, with the fixed-lambda SNES; tangent from G_H phi_0 = -G_lambda with
-  the normalisation and sign rule of eq. (16)-(19).  Fails at a turning point,
-  where G_H is singular.
+=================================  ============================================================
+``comm``                           the PETSc communicator
+``parameter``                      name of p, for monitors
+``create_vec()``                   a Vec in the layout of x and of G
+``residual(x, p, G)``              G(x, p) into the Vec G, at the p passed in
+``dG_dp(x, p, out)``               dG/dp on the local rows, into the array ``out``
+``linearize(x, p)``                set the point of ``jacobian``
+``jacobian``                       the Mat G_x at that point (may be a shell)
+``create_pmat(bordered)``          the Mat the PC is built from, for G_x or for the bordered
+                                   matrix [[G_x, G_p], [w xdot^T, pdot]]; None: the operator
+``fill_pmat(P, border=None)``      assemble it at the linearization point (border: a
+                                   :class:`~petsc_adhesion.preconditioning.Border`)
+``setup_pc(pc)``                   the default PC for that matrix
+``weights``                        local weights w of the inner product <u, v> = sum w u v
+``inside(x)``                      domain guard: is the local part x admissible (collective)
+``step_fraction(x, y)``            domain guard: largest fraction of the step x -> x - y allowed
+``observe(x, p, xdot, pdot)``      named observables and their rates d/ds: two dicts
+=================================  ============================================================
+
+x arrays are the rank's local parts (numpy); the parameter is a float.
+
+The curve is followed in X = (x, p) with the inner product <x, y> + p q.
+
+* Natural corrector (eq. 20-22): Newton on G(x; p) = 0 at the predicted p;
+  tangent from G_x phi_0 = -G_p with the normalisation and sign rule of
+  eq. (16)-(19).  Fails at a turning point, where G_x is singular.
 * Pseudo-arclength corrector (eq. 24-25): Newton on [G; Q] = 0, whose Jacobian
-  is the bordered matrix [[G_H, G_lambda], [Hdot^T, lambdadot]], a MatNest
-  holding the shell G_H; regular at a fold.  Its tangent solves the same
+  is the bordered matrix [[G_x, G_p], [xdot^T W, pdot]], a MatNest holding
+  the problem's operator; regular at a fold.  Its tangent solves the same
   bordered matrix with right-hand side (0, 1), which also keeps eq. (19).
-* ``auto`` (the paper's switch) takes the natural step while |lambdadot| >= 0.5.
+* ``auto`` (the paper's switch) takes the natural step while |pdot| >= 0.5.
+
+Step control (:class:`Settings`): halve on a failed corrector, a predictor
+outside the domain, a turn of the tangent, a corrector far from its predictor
+(curvature), or a large change of the watched observable; grow on fast Newton
+and a nearly straight curve.
+
+Solvers and their options prefixes: the natural corrector ``nat_`` (also the
+first point), the arclength corrector ``arc_`` (also every tangent along it).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from petsc4py import PETSc
 
-from .options import TABLE
-from .residual import PCReuse, preallocation, shorten_to_wall
-from .solver import configure
+from .preconditioning import Border
+from .solver import PC_REUSE_ITS, Newton, PCReuse, create_snes, fresh_retry, guard, krylov_retry
 
-__all__ = ["Point", "Bordered", "Continuation"]
+__all__ = ["Point", "Settings", "Bordered", "Continuation", "NATURAL_PREFIX", "ARCLENGTH_PREFIX", "CORRECTORS"]
 
-#: The paper's switch to pseudo-arclength below this |lambdadot|.
-SWITCH = 0.5
+NATURAL_PREFIX, ARCLENGTH_PREFIX = "nat_", "arc_"
+#: What -cont_type accepts: the paper's switch, or one corrector throughout.
+CORRECTORS = ("auto", "natural", "arclength")
 
 
 @dataclass
 class Point:
-    """A computed point of the curve, with its unit tangent (local parts of H)."""
+    """A computed point of the curve with its unit tangent (local parts of x)."""
 
-    h: np.ndarray
-    lam: float
-    F: float
-    th: np.ndarray
-    tl: float
-    dF: float                 # dF/ds along the tangent
-    ds: float = 0.0           # the step that reached it
-    dev: float = 0.0          # |corrector - predictor| / ds: the curvature the step met
-    its: int = 0              # Newton iterations of the corrector
+    x: np.ndarray
+    p: float
+    xdot: np.ndarray
+    pdot: float
+    values: dict = field(default_factory=dict)   # observables
+    rates: dict = field(default_factory=dict)    # their d/ds along the tangent
+    ds: float = 0.0             # the step that reached it
+    deviation: float = 0.0      # |corrector - predictor| / ds: the curvature the step met
+    newton_its: int = 0         # Newton iterations of the corrector
     ksp_its: int = 0
-    kind: str = "start"       # "natural" | "arclength" | "start" | "event"
+    corrector: str = "start"    # "natural" | "arclength" | "start" | "event"
+
+
+@dataclass
+class Settings:
+    """Step control and stop criteria; the one place of their defaults.
+
+    Step lengths are measured in the inner product of X = (x, p).
+    """
+
+    corrector: str = "auto"         # one of CORRECTORS
+    ds: float = 0.05                # first step
+    ds_min: float = 1e-7            # give up below
+    ds_max: float = 0.5
+    newton_target: int = 5          # corrector iterations aimed at
+    max_deviation: float = 0.2      # largest corrector distance from the predictor per unit step
+    min_turn_cosine: float = 0.8    # smallest cosine between successive tangents (37 degrees)
+    grow: float = 1.5               # step factor after an easy step
+    shrink: float = 0.7             # after a slow one (more than newton_target iterations)
+    cut: float = 0.5                # after a rejected one
+    grow_margin: float = 0.5        # easy: deviation and observable change below this share of their bounds
+    switch: float = 0.5             # auto: natural corrector while |pdot| >= switch (the paper's)
+    natural_fallback: float = 0.1   # natural corrector as fallback only while |pdot| >= this
+    observable: str | None = None   # the observable bounded per step and stopped on
+    observable_step: float = 0.2    # its largest change in one step, relative above magnitude 1
+    observable_max: float = math.inf  # stop when the observable reaches this
+    p_max: float = math.inf         # stop when the parameter reaches this
+    max_steps: int = 2000
+    max_folds: int = 12             # stop after this many turning points
+    pc_reuse_its: int = PC_REUSE_ITS
+    monitor: bool = False           # one line a step
 
 
 class Bordered:
-    """The pseudo-arclength system [G(H, lambda); Q] = 0 and its SNES (eq. 24-25).
+    """The pseudo-arclength system [G(x, p); Q] = 0 and its SNES (eq. 24-25), prefix ``arc_``.
 
-    X = (H, lambda) is one PETSc Vec, lambda its last entry (on the last rank),
-    so the MatNest's blocks line up with X without index sets.
+    X = (x, p) is one PETSc Vec, p its last entry (on the last rank), so the
+    MatNest's blocks line up with X without index sets.
     """
 
-    def __init__(self, problem):
+    def __init__(self, problem, pc_reuse_its: int = PC_REUSE_ITS):
         pb = self.pb = problem
         comm = self.comm = pb.comm
-        N = pb.r.size
-        self.nloc = pb.hi - pb.lo
+        self._mpi = comm.tompi4py()
+        self.x, self.G = pb.create_vec(), pb.create_vec()
+        self.nloc, N = self.x.getLocalSize(), self.x.getSize()
         self.last = comm.getRank() == comm.getSize() - 1
         n1 = 1 if self.last else 0
         self.X = PETSc.Vec().createMPI((self.nloc + n1, N + 1), comm=comm)
-        self.H, self.G = pb.create_vec(), pb.create_vec()
+        self.rhs, self.z, self.start, self.R = (self.X.duplicate() for _ in range(4))
 
         def dense(rows, cols):
             M = PETSc.Mat().createDense((rows, cols), comm=comm)
             M.setUp()
             return M
 
-        self.col = dense((self.nloc, N), (n1, 1))          # G_lambda = 1
-        self.col.getDenseArray()[:] = 1.0
-        self.col.assemble()
-        self.row = dense((n1, 1), (self.nloc, N))          # weighted Hdot^T
-        self.corner = dense((n1, 1), (n1, 1))              # lambdadot
-        self.K = PETSc.Mat().createNest([[pb.J, self.col], [self.row, self.corner]], comm=comm)
-        ext = (self.nloc + n1, N + 1)
-        if pb.pmat_kind == "dense":
-            self.P = dense(ext, ext)
-        elif pb.pmat_kind == "band":
-            self.P = self._band_bordered(ext)
-        else:
-            self.P = self.K
-        self.snes = PETSc.SNES().create(comm)
-        self.snes.setFunction(self.form_function, self.X.duplicate())
-        self.snes.setJacobian(self.form_jacobian, self.K, self.P)
-        configure(self.snes, pb.pmat_kind, self.precheck, full_steps=True)
-        self.reuse = PCReuse(pb.reuse.its)
-        # the hyperplane Q of eq. (24): through (h0, lam0), normal (th, tl), at distance ds
-        self.h0, self.lam0, self.th, self.tl, self.ds = None, 0.0, None, 1.0, 0.0
+        self.column = dense((self.nloc, N), (n1, 1))        # G_p
+        self.row = dense((n1, 1), (self.nloc, N))           # weighted xdot^T
+        self.corner = dense((n1, 1), (n1, 1))               # pdot
+        self.gp = np.zeros(self.nloc)
+        self.K = PETSc.Mat().createNest([[pb.jacobian, self.column], [self.row, self.corner]], comm=comm)
+        self.pmat = pb.create_pmat(bordered=True)
+        self.reuse = PCReuse(pc_reuse_its)
+        self.snes = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R, self.form_jacobian,
+                                self.K, self.pmat or self.K, pb.setup_pc, self.precheck, full_steps=True)
+        # the hyperplane Q of eq. (24): through (x0, p0), normal (xdot, pdot), at distance ds
+        self.x0, self.p0, self.xdot, self.pdot, self.ds = None, 0.0, None, 1.0, 0.0
+        self.p = 0.0
 
-    # -- X = (H, lambda) ---------------------------------------------------------
+    # -- X = (x, p) --------------------------------------------------------------
     def split(self, X: PETSc.Vec):
-        """Local H part of X and lambda (broadcast from the last rank)."""
-        x = X.getArray(readonly=True)
-        lam = float(x[self.nloc]) if self.last else None
-        return x[:self.nloc], self.comm.tompi4py().bcast(lam, root=self.comm.getSize() - 1)
+        """Local x part of X and p (broadcast from the last rank)."""
+        a = X.getArray(readonly=True)
+        p = float(a[self.nloc]) if self.last else None
+        return a[:self.nloc], self._mpi.bcast(p, root=self.comm.getSize() - 1)
 
-    def join(self, h: np.ndarray, lam: float, X: PETSc.Vec | None = None) -> PETSc.Vec:
+    def join(self, x: np.ndarray, p: float, X: PETSc.Vec | None = None) -> PETSc.Vec:
         X = X or self.X
-        X.setArray(np.append(h, lam) if self.last else h)
+        X.setArray(np.append(x, p) if self.last else x)
         return X
 
-    def set_border(self, th: np.ndarray, tl: float) -> None:
-        """Bottom row (w * Hdot)^T, lambdadot of the bordered matrix."""
-        full = self.comm.tompi4py().allgather(self.pb.w * th)
+    def inner(self, u: np.ndarray, v: np.ndarray) -> float:
+        """<u, v> of local parts, summed over ranks."""
+        return self._mpi.allreduce(float(np.dot(self.pb.weights * u, v)))
+
+    def set_border(self, xdot: np.ndarray, pdot: float) -> None:
+        """Bottom row (W xdot)^T, pdot of the bordered matrix."""
+        full = self._mpi.allgather(self.pb.weights * xdot)
         if self.last:
             self.row.getDenseArray()[:] = np.concatenate(full)
-            self.corner.getDenseArray()[:] = tl
+            self.corner.getDenseArray()[:] = pdot
         self.row.assemble()
         self.corner.assemble()
         self.K.assemble()
 
     # -- SNES callbacks ----------------------------------------------------------
     def form_function(self, snes, X, R):
-        """[G(H, lambda); Q(H, lambda)] with Q of eq. (24)."""
-        h, lam = self.split(X)
-        self.H.setArray(h)
-        self.pb.residual(self.H, lam, self.G)
-        q = self.pb.inner(self.th, h - self.h0) + self.tl * (lam - self.lam0) - self.ds
+        """[G(x, p); Q(x, p)] with Q of eq. (24)."""
+        x, p = self.split(X)
+        self.x.setArray(x)
+        self.pb.residual(self.x, p, self.G)
+        q = self.inner(self.xdot, x - self.x0) + self.pdot * (p - self.p0) - self.ds
         self.join(self.G.getArray(readonly=True), q, R)
 
     def form_jacobian(self, snes, X, K, P):
-        h, _ = self.split(X)
-        self.H.setArray(h)
+        x, self.p = self.split(X)
+        self.x.setArray(x)
         self.linearize(self.reuse(snes.getKSP()))
 
-    def linearize(self, assemble: bool) -> None:
-        """G_H at self.H (shell) and, with ``assemble``, the bordered matrix for the PC."""
+    def linearize(self, refill: bool) -> None:
+        """G_x and G_p at (self.x, self.p) and, with ``refill``, the bordered matrix for the PC."""
         pb = self.pb
-        pb.linearize(self.H, assemble=False)
-        if assemble and pb.pmat_kind == "dense":
-            a = self.P.getDenseArray()
-            pb.jacobian_rows(a[:self.nloc, :-1])
-            a[:self.nloc, -1] = 1.0
-            if self.last:
-                a[-1, :-1] = self.row.getDenseArray()[0]
-                a[-1, -1] = self.corner.getDenseArray()[0, 0]
-            self.P.assemble()
-        elif assemble and pb.pmat_kind == "band":
-            self._fill_band()
+        pb.linearize(self.x, self.p)
+        pb.dG_dp(self.x, self.p, self.gp)
+        self.column.getDenseArray()[:, 0] = self.gp
+        self.column.assemble()
+        if refill and self.pmat is not None:
+            row = self.row.getDenseArray()[0] if self.last else None
+            corner = float(self.corner.getDenseArray()[0, 0]) if self.last else 0.0
+            pb.fill_pmat(self.pmat, Border(self.gp, row, corner))
         self.K.assemble()
 
     def precheck(self, X, Y, *args) -> bool:
-        h, _ = self.split(X)
-        return shorten_to_wall(self.pb, h, Y, Y.getArray(readonly=True)[:self.nloc])
-
-    # -- near-field bordered preconditioning matrix ------------------------------
-    def _band_bordered(self, ext) -> PETSc.Mat:
-        ai, aj = self._band_csr(*self.pb.band_pattern(), np.zeros(0), np.zeros(0))[:2]
-        lo, hi = self.X.getOwnershipRange()
-        P = PETSc.Mat().createAIJ((ext, ext), nnz=preallocation(ai, aj, lo, hi), comm=self.comm)
-        P.setUp()
-        return P
-
-    def _band_csr(self, ai, aj, v, border):
-        """The near-field CSR of G_H with the G_lambda column and, on the last rank, the border row."""
-        N = self.pb.r.size
-        j = np.insert(aj, ai[1:], N)
-        vals = np.insert(v, ai[1:], 1.0) if v.size else v
-        ai2 = ai + np.arange(ai.size)
-        if self.last:
-            j = np.concatenate([j, np.arange(N + 1)])
-            vals = np.concatenate([vals, border]) if v.size else vals
-            ai2 = np.append(ai2, ai2[-1] + N + 1)
-        return ai2.astype(PETSc.IntType), j.astype(PETSc.IntType), vals
-
-    def _fill_band(self) -> None:
-        ai, aj, v = self.pb.band_values()
-        border = np.append(self.row.getDenseArray()[0], self.corner.getDenseArray()[0, 0]) if self.last else None
-        self.P.setValuesCSR(*self._band_csr(ai, aj, v, border))
-        self.P.assemble()
+        x, _ = self.split(X)
+        return guard(self.pb, x, Y, Y.getArray(readonly=True)[:self.nloc])
 
     # -- use ---------------------------------------------------------------------
-    def correct(self, a: Point, ds: float) -> tuple[np.ndarray, float, int, int] | None:
+    def correct(self, a: Point, ds: float):
         """Solve for the point at distance ds from ``a`` along its tangent (eq. 24-25).
 
-        Returns (h, lambda, Newton its, KSP its), or None when Newton fails or
+        Returns (x, p, Newton its, KSP its), or None when Newton fails or
         the predictor leaves the domain.
         """
-        th, tl = a.th, a.tl
-        h = a.h + ds * th
-        if not self.pb.inside(h):
+        x = a.x + ds * a.xdot
+        if not self.pb.inside(x):
             return None
-        self.h0, self.lam0, self.th, self.tl, self.ds = a.h, a.lam, th, tl, ds
-        self.set_border(th, tl)
-        if not fresh_retry(self.snes, self.join(h, a.lam + ds * tl), self.reuse):
+        self.x0, self.p0, self.xdot, self.pdot, self.ds = a.x, a.p, a.xdot, a.pdot, ds
+        self.set_border(a.xdot, a.pdot)
+        if not fresh_retry(self.snes, self.join(x, a.p + ds * a.pdot), self.reuse, self.start):
             return None
-        h, lam = self.split(self.X)
-        return h.copy(), lam, self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
+        x, p = self.split(self.X)
+        return x.copy(), p, self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
 
-    def tangent(self, h: np.ndarray, lam: float, th: np.ndarray, tl: float):
-        """Unit tangent at (h, lam) oriented along (th, tl): solve [[G_H, 1], [w th, tl]] z = (0, 1)."""
-        self.H.setArray(h)
-        self.set_border(th, tl)
-        rhs = self.X.duplicate()
-        rhs.set(0.0)
+    def tangent(self, x: np.ndarray, p: float, xdot: np.ndarray, pdot: float):
+        """Unit tangent at (x, p) oriented along (xdot, pdot): solve [[G_x, G_p], [W xdot, pdot]] z = (0, 1).
+
+        Returns (xdot, pdot, KSP its) or None when GMRES fails.
+        """
+        self.x.setArray(x)
+        self.p = p
+        self.set_border(xdot, pdot)
+        self.rhs.set(0.0)
         if self.last:
-            rhs.setValue(rhs.getSize() - 1, 1.0)
-        rhs.assemble()
-        z = self.X.duplicate()
+            self.rhs.setValue(self.rhs.getSize() - 1, 1.0)
+        self.rhs.assemble()
         ksp = self.snes.getKSP()
-        if not krylov_retry(ksp, self.K, self.P, rhs, z, self.reuse, self.linearize):
+        if not krylov_retry(ksp, self.K, self.pmat or self.K, self.rhs, self.z, self.reuse, self.linearize):
             return None
-        zh, zl = self.split(z)
-        norm = math.sqrt(self.pb.inner(zh, zh) + zl * zl)
-        return zh / norm, zl / norm, ksp.getIterationNumber()
+        zx, zp = self.split(self.z)
+        norm = math.sqrt(self.inner(zx, zx) + zp * zp)
+        return zx / norm, zp / norm, ksp.getIterationNumber()
 
-
-def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse) -> bool:
-    """Solve from X in place; after a failure, once more with a fresh preconditioner.
-
-    A factorization kept from a distant point of the curve can make the first
-    linear solve fail where Newton itself is fine.
-    """
-    x0 = X.copy()
-    for _ in range(2):
-        snes.solve(None, X)
-        if snes.getConvergedReason() > 0:
-            return True
-        reuse.expire()
-        x0.copy(X)
-    return False
-
-
-def krylov_retry(ksp: PETSc.KSP, A, P, b: PETSc.Vec, x: PETSc.Vec, reuse: PCReuse, linearize) -> bool:
-    """Solve A x = b at the point set by ``linearize(assemble)``; retry once with a fresh PC."""
-    for _ in range(2):
-        linearize(reuse(ksp))
-        ksp.setOperators(A, P)
-        ksp.solve(b, x)
-        if ksp.getConvergedReason() > 0:
-            return True
-        reuse.expire()
-    return False
-
-
-def _default(name: str):
-    return TABLE[name].default
-
-
-@dataclass
-class Settings:
-    """Step control and stop criteria; the defaults are the options' (options.TABLE)."""
-
-    kind: str = _default("cont_type")
-    ds: float = _default("cont_ds")
-    ds_min: float = _default("cont_ds_min")
-    ds_max: float = _default("cont_ds_max")
-    newton_target: int = _default("cont_newton_target")
-    max_deviation: float = _default("cont_max_deviation")
-    dF_max: float = _default("cont_dF_max")
-    lambda_max: float = math.inf
-    F_max: float = _default("cont_F_max")
-    max_steps: int = _default("cont_max_steps")
-    max_folds: int = _default("cont_max_folds")
-    monitor: bool = _default("cont_monitor")
+    def destroy(self) -> None:
+        """Free the PETSc objects made here."""
+        for obj in (self.snes, self.K, self.pmat, self.column, self.row, self.corner,
+                    self.X, self.rhs, self.z, self.start, self.R, self.x, self.G):
+            if obj is not None:
+                obj.destroy()
 
 
 class Continuation:
-    """Trace the curve from a start point; collect the points and step statistics."""
+    """Trace a curve of G(x, p) = 0 from a start point; collect the points and step statistics.
 
-    def __init__(self, problem, snes: PETSc.SNES, settings: Settings):
-        self.pb, self.snes, self.set = problem, snes, settings
-        self.bordered = Bordered(problem)
+    ``stop`` after :meth:`run`: (reason, value) with reason one of
+    "observable_max", "p_max", "max_steps", "max_folds", "ds_min".
+    """
+
+    def __init__(self, problem, settings: Settings | None = None):
+        self.pb, self.set = problem, settings or Settings()
+        self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its)
+        self.bordered = Bordered(problem, self.set.pc_reuse_its)
+        self._x, self._xt, self._rhs, self._phi = (problem.create_vec() for _ in range(4))
+        self._gp = np.zeros(self._x.getLocalSize())
         self.points: list[Point] = []
         self.rejected = 0
         self.folds = 0
-        self.stop_reason = ""
+        self.stop: tuple[str, float] | None = None
+
+    def inner(self, u: np.ndarray, v: np.ndarray) -> float:
+        return self.bordered.inner(u, v)
 
     # -- tangents -----------------------------------------------------------
-    def natural_tangent(self, h: np.ndarray, lam: float, prev: Point):
-        """Tangent of eq. (16)-(19): G_H phi_0 = -G_lambda, a = +-1/sqrt(1 + |phi_0|^2)."""
-        pb = self.pb
-        H = pb.create_vec()
-        H.setArray(h)
-        rhs, phi = pb.create_vec(), pb.create_vec()
-        rhs.set(-1.0)
-        ksp = self.snes.getKSP()
-        if not krylov_retry(ksp, pb.J, pb.P, rhs, phi, pb.reuse,
-                            lambda assemble: pb.linearize(H, assemble)):
+    def natural_tangent(self, x: np.ndarray, p: float, prev: Point):
+        """Tangent of eq. (16)-(19): G_x phi_0 = -G_p, a = +-1/sqrt(1 + |phi_0|^2)."""
+        pb, newton = self.pb, self.newton
+        self._xt.setArray(x)
+        self._rhs.setArray(-pb.dG_dp(self._xt, p, self._gp))
+        ksp = newton.snes.getKSP()
+        if not krylov_retry(ksp, pb.jacobian, newton.pmat or pb.jacobian, self._rhs, self._phi, newton.reuse,
+                            lambda refill: newton.linearize(self._xt, refill)):
             return None
-        p = phi.getArray(readonly=True).copy()
-        a = 1.0 / math.sqrt(1.0 + pb.inner(p, p))
-        if a * (pb.inner(prev.th, p) + prev.tl) < 0:      # eq. (19)
+        phi = self._phi.getArray(readonly=True).copy()
+        a = 1.0 / math.sqrt(1.0 + self.inner(phi, phi))
+        if a * (self.inner(prev.xdot, phi) + prev.pdot) < 0:      # eq. (19)
             a = -a
-        return a * p, a, ksp.getIterationNumber()
+        return a * phi, a, ksp.getIterationNumber()
 
-    def make_point(self, h, lam, th, tl, **kw) -> Point:
-        F, dF = self.pb.load_rate(h, th)
-        return Point(h=h, lam=lam, F=F, th=th, tl=tl, dF=dF, **kw)
+    def make_point(self, x, p, xdot, pdot, **kw) -> Point:
+        """A Point with the problem's observables at (x, p) along (xdot, pdot)."""
+        values, rates = self.pb.observe(x, p, xdot, pdot)
+        return Point(x=x, p=p, xdot=xdot, pdot=pdot, values=values, rates=rates, **kw)
 
-    def start(self, lam0: float) -> Point:
-        """Solve at lam0 from the rigid guess; tangent pointing to larger lambda."""
-        pb = self.pb
-        H = pb.rigid(lam0, pb.create_vec())
-        pb.lam = lam0
-        self.snes.solve(None, H)
-        if self.snes.getConvergedReason() <= 0:
-            raise RuntimeError(f"no solution at the start lambda = {lam0:g}; give -cont_lambda_start further apart")
-        h = H.getArray(readonly=True).copy()
-        guess = Point(h=h, lam=lam0, F=0.0, th=np.zeros_like(h), tl=1.0, dF=0.0)
-        th, tl, kits = self.bordered.tangent(h, lam0, guess.th, 1.0)
-        return self.make_point(h, lam0, th, tl, its=self.snes.getIterationNumber(),
-                               ksp_its=self.snes.getLinearSolveIterations() + kits)
+    def start(self, guess: PETSc.Vec, p0: float) -> Point:
+        """Solve at p0 from ``guess`` (natural corrector's SNES); tangent pointing to larger p.
+
+        RuntimeError when Newton or the tangent fails there.
+        """
+        x = guess.copy()
+        if not self.newton.solve(p0, x):
+            x.destroy()
+            raise RuntimeError(f"no solution at the start {self.pb.parameter} = {p0:g}")
+        a = x.getArray(readonly=True).copy()
+        x.destroy()
+        tan = self.bordered.tangent(a, p0, np.zeros_like(a), 1.0)
+        if tan is None:
+            raise RuntimeError(f"no tangent at the start {self.pb.parameter} = {p0:g}")
+        xdot, pdot, kits = tan
+        its, lits = self.newton.iterations
+        return self.make_point(a, p0, xdot, pdot, newton_its=its, ksp_its=lits + kits)
 
     # -- one step -------------------------------------------------------------
     def natural_ok(self, a: Point) -> bool:
-        return self.set.kind == "natural" or (self.set.kind == "auto" and abs(a.tl) >= SWITCH)
+        """Whether the step from a takes the natural corrector first."""
+        s = self.set
+        return s.corrector == "natural" or (s.corrector == "auto" and abs(a.pdot) >= s.switch)
 
     def natural(self, a: Point, ds: float, tangent: bool = True):
-        """Natural corrector (eq. 20-22) at lambda = a.lam + ds a.tl; tangent of eq. (16)-(19)."""
-        pb = self.pb
-        lam = a.lam + ds * a.tl
-        h = a.h + ds * a.th                               # eq. (20)
-        if not pb.inside(h):
+        """Natural corrector (eq. 20-22) at p = a.p + ds a.pdot; tangent of eq. (16)-(19)."""
+        p = a.p + ds * a.pdot
+        x = a.x + ds * a.xdot                               # eq. (20)
+        if not self.pb.inside(x):
             return None
-        H = pb.create_vec()
-        H.setArray(h)
-        pb.lam = lam
-        if not fresh_retry(self.snes, H, pb.reuse):       # eq. (21)-(22)
+        self._x.setArray(x)
+        if not self.newton.solve(p, self._x, retry=True):   # eq. (21)-(22)
             return None
-        h = H.getArray(readonly=True).copy()
-        its, kits = self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
-        tan = self.natural_tangent(h, lam, a) if tangent else (a.th, a.tl, 0)
-        return None if tan is None else (h, lam, tan, its, kits, "natural")
+        x = self._x.getArray(readonly=True).copy()
+        its, kits = self.newton.iterations
+        tan = self.natural_tangent(x, p, a) if tangent else (a.xdot, a.pdot, 0)
+        return None if tan is None else (x, p, tan, its, kits, "natural")
 
     def arclength(self, a: Point, ds: float, tangent: bool = True):
         """Pseudo-arclength corrector (eq. 24-25) at distance ds; tangent of the bordered system."""
         sol = self.bordered.correct(a, ds)
         if sol is None:
             return None
-        h, lam, its, kits = sol
-        tan = self.bordered.tangent(h, lam, a.th, a.tl) if tangent else (a.th, a.tl, 0)
-        return None if tan is None else (h, lam, tan, its, kits, "arclength")
+        x, p, its, kits = sol
+        tan = self.bordered.tangent(x, p, a.xdot, a.pdot) if tangent else (a.xdot, a.pdot, 0)
+        return None if tan is None else (x, p, tan, its, kits, "arclength")
 
     def correct(self, a: Point, ds: float, tangent: bool = True):
         """The point at step ds from a: the corrector the mode asks for, the other as fallback.
 
-        The natural one serves only away from folds (|lambdadot| >= 0.1), where
-        lambda is a good parameter; near the wall of a fine roughness rule it is
+        The natural one serves only away from folds (|pdot| >= ``natural_fallback``),
+        where p is a good parameter; near the wall of a fine roughness rule it is
         the more robust of the two.  Without ``tangent`` the point gets a's.
+        Returns (x, p, (xdot, pdot, tangent KSP its), Newton its, KSP its, corrector) or None.
         """
+        s = self.set
         first, second = (self.natural, self.arclength) if self.natural_ok(a) else (self.arclength, self.natural)
         sol = first(a, ds, tangent)
-        if sol is None and (second is self.arclength or abs(a.tl) >= 0.1) and self.set.kind != "natural":
+        if sol is None and (second is self.arclength or abs(a.pdot) >= s.natural_fallback) \
+                and s.corrector != "natural":
             sol = second(a, ds, tangent)
         return sol
 
+    def _observable_bound(self, a: Point) -> float:
+        return self.set.observable_step * max(1.0, abs(a.values[self.set.observable]))
+
     def step(self, a: Point, ds: float) -> Point | None:
         """One predictor-corrector step of length ds from a, or None (retry smaller)."""
-        pb = self.pb
+        s = self.set
         sol = self.correct(a, ds)
         if sol is None:
             return None
-        h, lam, (th, tl, tk), its, kits, kind = sol
+        x, p, (xdot, pdot, tangent_its), its, kits, kind = sol
         # the corrector's distance from the predictor grows as ds^2 times the curvature;
         # a step that had to travel far may have cut across a fold pair unseen
-        dh = h - (a.h + ds * a.th)
-        dev = math.sqrt(pb.inner(dh, dh) + (lam - a.lam - ds * a.tl) ** 2) / ds
-        if dev > self.set.max_deviation or pb.inner(a.th, th) + a.tl * tl < 0.8:
+        dx = x - (a.x + ds * a.xdot)
+        deviation = math.sqrt(self.inner(dx, dx) + (p - a.p - ds * a.pdot) ** 2) / ds
+        if deviation > s.max_deviation or self.inner(a.xdot, xdot) + a.pdot * pdot < s.min_turn_cosine:
             return None
-        b = self.make_point(h, lam, th, tl, ds=ds, its=its, ksp_its=kits + tk, kind=kind, dev=dev)
-        # the curve F(lambda) is what users read: resolve it in F too
-        return b if abs(b.F - a.F) <= self.set.dF_max * max(1.0, abs(a.F)) else None
+        b = self.make_point(x, p, xdot, pdot, ds=ds, newton_its=its, ksp_its=kits + tangent_its,
+                            corrector=kind, deviation=deviation)
+        # the observable is what users read: resolve the curve in it too
+        if s.observable is not None and abs(b.values[s.observable] - a.values[s.observable]) > self._observable_bound(a):
+            return None
+        return b
 
-    def done(self, b: Point) -> str:
+    def done(self, b: Point) -> tuple[str, float] | None:
+        """The stop criterion b meets, as (reason, value), or None."""
         s = self.set
-        if b.F >= s.F_max:
-            return f"load F = {b.F:.4g} >= -cont_F_max {s.F_max:g}"
-        if b.lam >= s.lambda_max:
-            return f"approach lambda = {b.lam:.4g} >= -cont_lambda_max {s.lambda_max:g}"
+        if s.observable is not None and b.values[s.observable] >= s.observable_max:
+            return "observable_max", b.values[s.observable]
+        if b.p >= s.p_max:
+            return "p_max", b.p
         if len(self.points) > s.max_steps:
-            return f"-cont_max_steps {s.max_steps} reached"
+            return "max_steps", s.max_steps
         if self.folds > s.max_folds:
-            return f"more than -cont_max_folds {s.max_folds} turning points"
-        return ""
+            return "max_folds", s.max_folds
+        return None
 
-    def run(self, lam0: float, on_step=None):
-        """Trace from lam0 until a stop criterion; ``on_step(a, b)`` sees every accepted step."""
+    def run(self, start: Point, on_step=None) -> list[Point]:
+        """Trace from ``start`` until a stop criterion; ``on_step(a, b)`` sees every accepted step."""
         s = self.set
-        a = self.start(lam0)
+        a = start
         self.points.append(a)
         ds = s.ds
         self.monitor(a)
         while True:
             b = self.step(a, ds)
             if b is None:
-                self.pb.reuse.expire()
+                self.newton.reuse.expire()
                 self.bordered.reuse.expire()
                 self.rejected += 1
-                ds *= 0.5
+                ds *= s.cut
                 if ds < s.ds_min:
-                    where = "a turning point (natural continuation cannot pass it)" \
-                        if s.kind == "natural" else "a point it cannot pass"
-                    self.stop_reason = f"step below -cont_ds_min at lambda = {a.lam:.6g}: {where}"
+                    self.stop = ("ds_min", a.p)
                     break
                 continue
             self.points.append(b)
-            self.folds += a.tl * b.tl < 0
+            self.folds += a.pdot * b.pdot < 0
             self.monitor(b)
             if on_step:
                 on_step(a, b)
-            self.stop_reason = self.done(b)
-            if self.stop_reason:
+            self.stop = self.done(b)
+            if self.stop:
                 break
-            # grow on fast Newton and a nearly straight curve, shrink on slow Newton
-            if b.its < s.newton_target and b.dev < 0.5 * s.max_deviation and abs(b.F - a.F) < 0.5 * s.dF_max * max(1.0, abs(a.F)):
-                ds = min(1.5 * ds, s.ds_max)
-            elif b.its > s.newton_target:
-                ds = max(0.7 * ds, s.ds_min)
+            easy = b.deviation < s.grow_margin * s.max_deviation and (
+                s.observable is None or abs(b.values[s.observable] - a.values[s.observable])
+                < s.grow_margin * self._observable_bound(a))
+            if b.newton_its < s.newton_target and easy:
+                ds = min(s.grow * ds, s.ds_max)
+            elif b.newton_its > s.newton_target:
+                ds = max(s.shrink * ds, s.ds_min)
             a = b
         return self.points
 
-    def monitor(self, p: Point) -> None:
-        if self.set.monitor and self.pb.comm.getRank() == 0:
-            print(f"{len(self.points) - 1:4d} CONT lambda {p.lam: .10e} F {p.F: .10e} ds {p.ds:.3e} "
-                  f"{p.kind[:3]} Newton {p.its} KSP {p.ksp_its}", flush=True)
+    def monitor(self, pt: Point) -> None:
+        """One line a point with -cont_monitor (rank 0)."""
+        if self.set.monitor:
+            obs = "".join(f" {k} {v: .10e}" for k, v in pt.values.items())
+            PETSc.Sys.Print(f"{len(self.points) - 1:4d} CONT {self.pb.parameter} {pt.p: .10e}{obs} ds {pt.ds:.3e} "
+                            f"{pt.corrector[:3]} Newton {pt.newton_its} KSP {pt.ksp_its}", comm=self.pb.comm)
+
+    def destroy(self) -> None:
+        """Free the PETSc objects made here."""
+        self.newton.destroy()
+        self.bordered.destroy()
+        for v in (self._x, self._xt, self._rhs, self._phi):
+            v.destroy()

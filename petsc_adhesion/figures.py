@@ -17,7 +17,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .model import dmt_load
+from .reference import rigid_load
 from .plot import load_approach, profiles, read
 
 __all__ = ["FIGURES", "run", "runs"]
@@ -80,7 +80,7 @@ def smooth():
     res = runs([("-adh_mu", m) for m in mus])
     fig, ax = plt.subplots(figsize=(7, 5))
     lam = np.linspace(-4, 0.6, 300)
-    ax.plot(lam, dmt_load(lam), "k:", label="mu = 0, eq. (28)")
+    ax.plot(lam, rigid_load(lam), "k:", label="mu = 0, eq. (28)")
     rows = []
     for m, (s, h5) in zip(mus, res):
         load_approach(ax, read(h5), label=f"mu = {m:g}")

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["uniform", "paper", "load_weights", "l2_weights", "PAPER_UNIFORM", "PAPER_EXTRA"]
+__all__ = ["uniform", "paper", "load_weights", "l2_weights", "PAPER_UNIFORM", "PAPER_EXTRA", "PAPER_SPLIT"]
 
-#: The paper's grid: 501 uniform nodes plus about 30 (N = 531).
-PAPER_UNIFORM, PAPER_EXTRA = 501, 30
+#: The paper's grid: 501 uniform nodes plus about 30 (N = 531): 30 elements halved.
+PAPER_UNIFORM, PAPER_EXTRA, PAPER_SPLIT = 501, 30, 2
 
 
 def uniform(n: int, rmax: float) -> np.ndarray:
@@ -20,7 +20,7 @@ def uniform(n: int, rmax: float) -> np.ndarray:
 
 
 def paper(rmax: float, n_uniform: int = PAPER_UNIFORM, extra: int = PAPER_EXTRA,
-          refine_from: float = 0.0, split: int = 2) -> np.ndarray:
+          refine_from: float = 0.0, split: int = PAPER_SPLIT) -> np.ndarray:
     """The paper's node set: ``n_uniform`` uniform nodes plus refined elements.
 
     The paper adds about 30 nodes "where H and P change fastest" to 501
@@ -29,7 +29,7 @@ def paper(rmax: float, n_uniform: int = PAPER_UNIFORM, extra: int = PAPER_EXTRA,
     ``split`` equal parts (by default their midpoints: 30 nodes).  The default,
     ``refine_from = 0``, halves the spacing on [0, 30 h] where the pressure
     peaks for small mu and at the centre of the contact.  For large mu, refine
-    the whole range the contact edge travels (see events.grid_warning).
+    the whole range the contact edge travels (see resolution.check).
     """
     r = uniform(n_uniform, rmax)
     first = int(np.searchsorted(r, refine_from - 1e-12 * rmax))

@@ -1,4 +1,4 @@
-"""The dimensionless model of Cheng, Dunn and Brach (2002): its groups and limits.
+"""The dimensionless model of Cheng, Dunn and Brach (2002): its parameters, groups and units.
 
 Lengths normal to the surface are in units of the equilibrium spacing epsilon
 (H = h/epsilon - 1, lambda = alpha/epsilon, sigma = sigma_s/epsilon), radii in
@@ -9,9 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-__all__ = ["Model", "tabor", "scales", "dmt_load", "DMT_EQUILIBRIUM"]
+__all__ = ["Model", "tabor", "scales"]
 
 
 def tabor(R: float, gamma: float, E: float, epsilon: float) -> float:
@@ -27,16 +25,6 @@ def scales(R: float, gamma: float, E: float, epsilon: float) -> dict:
     """
     return {"force_N": 2 * math.pi * R * gamma, "approach_m": epsilon, "radius_m": math.sqrt(epsilon * R),
             "pressure_Pa": 8 * gamma / (3 * epsilon)}
-
-
-def dmt_load(lam):
-    """Load of a rigid sphere, mu = 0: F = [1 - 4 (1-lambda)^6] / [3 (1-lambda)^8], eq. (28)."""
-    g = 1.0 - np.asarray(lam, dtype=float)
-    return (1.0 - 4.0 * g**6) / (3.0 * g**8)
-
-
-#: Approach of zero load at mu = 0: 1 - 2^(-1/3), from eq. (28).
-DMT_EQUILIBRIUM = 1.0 - 2.0 ** (-1.0 / 3.0)
 
 
 @dataclass(frozen=True)

@@ -1,14 +1,14 @@
-"""Application options: the one place where their defaults, ranges and help live.
+"""Application options: their table (help, ranges, checks) and their reading into objects.
 
-Each option is read from the PETSc options database where it is used
-(``opts.real("adh_mu")``); this table is what makes the value checked, its
-default single and ``-help`` complete.  PETSc's own options (``-snes_*``,
-``-ksp_*``, ``-pc_*``, ``-log_view`` ...) are left to PETSc; any option that
-nobody used by the end of a run is reported as unknown (:func:`check_unused`).
+The defaults belong to the objects the options configure (``Model``, the grid,
+the continuation ``Settings``, the solvers), and this table reads them from
+there: the numerical modules never import the command line.  PETSc's own
+options (``-snes_*``, ``-ksp_*``, ``-pc_*``, ``-log_view`` ...) are left to
+PETSc, solver by solver through their prefixes; any option that nobody used
+by the end of a run is reported as unknown (:func:`check_unused`).
 """
 from __future__ import annotations
 
-import ctypes
 import difflib
 import math
 from dataclasses import dataclass
@@ -16,10 +16,15 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-from .grid import PAPER_EXTRA, PAPER_UNIFORM
-from .model import Model
+from . import capi, grid, preconditioning
+from .continuation import ARCLENGTH_PREFIX, CORRECTORS, NATURAL_PREFIX, Settings
+from .events import EVENT_TOL
+from .model import Model, tabor
+from .solver import PC_REUSE_ITS
 
-__all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "petsc_error", "print_help"]
+__all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "petsc_error", "print_help",
+           "read_model", "read_grid", "read_settings", "read_physical", "read_guess", "check_memory",
+           "F_MAX", "SOLVER_PREFIXES"]
 
 
 class InputError(Exception):
@@ -28,6 +33,8 @@ class InputError(Exception):
 
 @dataclass(frozen=True)
 class Option:
+    """One application option: its kind, default, help and accepted values."""
+
     name: str
     kind: str          # "real" | "int" | "choice" | "string" | "flag" | "reals"
     default: object
@@ -38,6 +45,7 @@ class Option:
     choices: tuple = ()
 
     def allowed(self) -> str:
+        """What the option accepts, in words."""
         if self.kind == "choice":
             return "one of " + ", ".join(self.choices)
         if self.kind in ("real", "int", "reals"):
@@ -54,51 +62,61 @@ def _fmt(x: float) -> str:
     return "inf" if x == math.inf else "-inf" if x == -math.inf else f"{x:g}"
 
 
+#: The load at which a curve stops by default: past equilibrium, into compression.
+F_MAX = 2.0
+#: Options prefixes of the three solvers: (prefix, what it solves).
+SOLVER_PREFIXES = (("", "the fixed-approach solve (-adh_lambda)"),
+                   (NATURAL_PREFIX, "the continuation's natural corrector and first point"),
+                   (ARCLENGTH_PREFIX, "its arclength corrector and tangents"))
+
 _INF = math.inf
-_M = Model()
+_S = Settings
 TABLE = {o.name: o for o in [
     # model (paper eq. 9-14)
-    Option("adh_mu", "real", _M.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
+    Option("adh_mu", "real", Model.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
     Option("adh_physical", "reals", (), "R,gamma,E,epsilon in SI (m, J/m^2, Pa, m): mu from eq. (9), "
            "results also in SI", 0.0, 1e12, lo_open=True),
-    Option("adh_sigma", "real", _M.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
-    Option("adh_roughness", "choice", _M.roughness, "roughness average of the pressure (eq. 14)",
+    Option("adh_sigma", "real", Model.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
+    Option("adh_roughness", "choice", Model.roughness, "roughness average of the pressure (eq. 14)",
            choices=("none", "hermite")),
-    Option("adh_hermite_points", "int", _M.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
-    Option("adh_rmax", "real", _M.rmax, "end r_m of the computational domain", 0.0, 1e3, lo_open=True),
+    Option("adh_hermite_points", "int", Model.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
+    Option("adh_rmax", "real", Model.rmax, "end r_m of the computational domain", 0.0, 1e3, lo_open=True),
     Option("adh_lambda", "real", None, "solve at this one approach lambda only (no continuation)", -1e3, 1e3),
     Option("adh_guess", "string", None, "HDF5 result whose H(r) is the initial guess of -adh_lambda"),
     Option("adh_pmat", "choice", "dense", "matrix handed to the preconditioner: the assembled Jacobian, "
-           "its near-field band (AIJ), or the shell itself", choices=("dense", "band", "shell")),
-    Option("adh_pmat_band", "int", 64, "half bandwidth of -adh_pmat band", 0, 10**6),
-    Option("adh_pc_reuse_its", "int", 10, "keep the preconditioner while Krylov needs at most this many "
+           "its near-field band (AIJ), or the shell itself", choices=preconditioning.KINDS),
+    Option("adh_pmat_band", "int", preconditioning.BAND, "half bandwidth of -adh_pmat band", 0, 10**6),
+    Option("adh_pc_reuse_its", "int", PC_REUSE_ITS, "keep the preconditioner while Krylov needs at most this many "
            "iterations (0: rebuild at every Newton iteration)", 0, 10**6),
     # grid
     Option("grid_type", "choice", "paper", "node set", choices=("paper", "uniform")),
-    Option("grid_n", "int", 531, "number of nodes of -grid_type uniform", 3, 200000),
-    Option("grid_paper_uniform", "int", PAPER_UNIFORM, "uniform nodes of -grid_type paper", 3, 200000),
-    Option("grid_paper_extra", "int", PAPER_EXTRA, "elements refined by -grid_type paper", 0, 200000),
-    Option("grid_paper_split", "int", 2, "parts each refined element is split into", 2, 1000),
+    Option("grid_n", "int", grid.PAPER_UNIFORM + grid.PAPER_EXTRA, "number of nodes of -grid_type uniform",
+           3, 200000),
+    Option("grid_paper_uniform", "int", grid.PAPER_UNIFORM, "uniform nodes of -grid_type paper", 3, 200000),
+    Option("grid_paper_extra", "int", grid.PAPER_EXTRA, "elements refined by -grid_type paper", 0, 200000),
+    Option("grid_paper_split", "int", grid.PAPER_SPLIT, "parts each refined element is split into", 2, 1000),
     Option("grid_paper_refine_from", "real", 0.0, "first refined element of -grid_type paper starts here", 0.0, 1e3),
     # continuation
-    Option("cont_type", "choice", "auto", "corrector: switch at |lambdadot| < 0.5 (paper), or one kind",
-           choices=("auto", "natural", "arclength")),
+    Option("cont_type", "choice", _S.corrector, f"corrector: switch at |lambdadot| < {_S.switch:g} (paper), "
+           "or one kind", choices=CORRECTORS),
     Option("cont_lambda_start", "real", None, "first approach (default: below the reach of the forces)", -1e3, 1e3),
     Option("cont_lambda_max", "real", None, "stop at this approach (default: past equilibrium)", -1e3, 1e3),
-    Option("cont_F_max", "real", 2.0, "stop at this compressive load", -_INF, 1e6),
-    Option("cont_max_steps", "int", 2000, "stop after this many accepted steps", 1, 10**7),
-    Option("cont_dF_max", "real", 0.2, "largest change of the load in one step, relative above |F| = 1", 0.0, 1e6, lo_open=True),
-    Option("cont_max_folds", "int", 12, "stop after this many turning points (a grid that traps the "
+    Option("cont_F_max", "real", F_MAX, "stop at this compressive load", -_INF, 1e6),
+    Option("cont_max_steps", "int", _S.max_steps, "stop after this many accepted steps", 1, 10**7),
+    Option("cont_dF_max", "real", _S.observable_step, "largest change of the load in one step, relative above "
+           "|F| = 1", 0.0, 1e6, lo_open=True),
+    Option("cont_max_folds", "int", _S.max_folds, "stop after this many turning points (a grid that traps the "
            "contact edge makes dozens)", 0, 10**6),
-    Option("cont_ds", "real", 0.05, "first arclength step", 0.0, 1e3, lo_open=True),
-    Option("cont_ds_min", "real", 1e-7, "smallest step before giving up", 0.0, 1e3, lo_open=True),
-    Option("cont_ds_max", "real", 0.5, "largest step", 0.0, 1e3, lo_open=True),
-    Option("cont_newton_target", "int", 5, "corrector iterations aimed at by the step control", 1, 100),
-    Option("cont_max_deviation", "real", 0.2, "largest corrector distance from the predictor, per unit step "
-           "(bounds the step by the curvature)", 0.0, 10.0, lo_open=True),
+    Option("cont_ds", "real", _S.ds, "first arclength step", 0.0, 1e3, lo_open=True),
+    Option("cont_ds_min", "real", _S.ds_min, "smallest step before giving up", 0.0, 1e3, lo_open=True),
+    Option("cont_ds_max", "real", _S.ds_max, "largest step", 0.0, 1e3, lo_open=True),
+    Option("cont_newton_target", "int", _S.newton_target, "corrector iterations aimed at by the step control",
+           1, 100),
+    Option("cont_max_deviation", "real", _S.max_deviation, "largest corrector distance from the predictor, per "
+           "unit step (bounds the step by the curvature)", 0.0, 10.0, lo_open=True),
     Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
-    Option("cont_event_tol", "real", 1e-10, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
-    Option("cont_monitor", "flag", False, "one line a continuation step"),
+    Option("cont_event_tol", "real", EVENT_TOL, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
+    Option("cont_monitor", "flag", _S.monitor, "one line a continuation step"),
     Option("cont_error_estimate", "flag", False, "trace again on every other node and give each event "
            "its discretization error (Richardson) and the load truncated beyond r_m"),
     # output
@@ -174,6 +192,11 @@ class AppOptions:
             return False
         raise self._bad(o, raw)
 
+    def read_all(self) -> None:
+        """Read (and so check) every application option now, before any work."""
+        for name, o in TABLE.items():
+            getattr(self, o.kind)(name)
+
 
 def _strict_int(s: str) -> int:
     x = float(s)
@@ -182,32 +205,88 @@ def _strict_int(s: str) -> int:
     return int(x)
 
 
-def _petsc_int():
-    return ctypes.c_int64 if np.dtype(PETSc.IntType).itemsize == 8 else ctypes.c_int32
+# -- options into objects ------------------------------------------------------------
+def read_physical(opts: AppOptions) -> tuple | None:
+    """The four SI inputs of -adh_physical, or None."""
+    phys = opts.reals("adh_physical")
+    if phys and len(phys) != 4:
+        raise InputError(f"-adh_physical: expected 4 positive reals R,gamma,E,epsilon (SI), got {len(phys)}")
+    if phys and opts.db.hasName("adh_mu"):
+        raise InputError("-adh_mu: not with -adh_physical, which sets mu by eq. (9)")
+    return phys or None
 
 
-def unused_options() -> list[str]:
-    """Names of the options in the database that no object has read.
-
-    petsc4py has no binding of PetscOptionsLeftGet, so it is called through
-    ctypes on the symbols that petsc4py's extension module already links.
-    """
-    lib = ctypes.CDLL(PETSc.__file__)
-    argtypes = [ctypes.c_void_p, ctypes.POINTER(_petsc_int()),
-                ctypes.POINTER(ctypes.POINTER(ctypes.c_char_p)),
-                ctypes.POINTER(ctypes.POINTER(ctypes.c_char_p))]
-    get, restore = lib.PetscOptionsLeftGet, lib.PetscOptionsLeftRestore
-    get.argtypes = restore.argtypes = argtypes
-    n = _petsc_int()()
-    names = ctypes.POINTER(ctypes.c_char_p)()
-    values = ctypes.POINTER(ctypes.c_char_p)()
-    if get(None, ctypes.byref(n), ctypes.byref(names), ctypes.byref(values)):
-        raise RuntimeError("PetscOptionsLeftGet failed")
-    left = [names[i].decode() for i in range(n.value)]
-    restore(None, ctypes.byref(n), ctypes.byref(names), ctypes.byref(values))
-    return left
+def read_model(opts: AppOptions) -> Model:
+    """The model of -adh_mu (or -adh_physical), -adh_sigma, -adh_rmax and the roughness rule."""
+    phys = read_physical(opts)
+    mu = tabor(*phys) if phys else opts.real("adh_mu")
+    if phys and not 0 <= mu <= TABLE["adh_mu"].hi:
+        raise InputError(f"-adh_physical: gives mu = {mu:.3g}, outside [0, {TABLE['adh_mu'].hi:g}]")
+    model = Model(mu=mu, sigma=opts.real("adh_sigma"), rmax=opts.real("adh_rmax"),
+                  roughness=opts.choice("adh_roughness"), hermite_points=opts.int("adh_hermite_points"))
+    if model.roughness == "none" and model.sigma > 0:
+        raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
+    return model
 
 
+def read_grid(opts: AppOptions, model: Model) -> np.ndarray:
+    """The nodes of -grid_type on [0, r_m]."""
+    kind = opts.choice("grid_type")
+    nu, extra = opts.int("grid_paper_uniform"), opts.int("grid_paper_extra")
+    start, split = opts.real("grid_paper_refine_from"), opts.int("grid_paper_split")
+    if kind == "uniform":
+        return grid.uniform(opts.int("grid_n"), model.rmax)
+    if extra > nu - 1:
+        raise InputError(f"-grid_paper_extra: expected an integer in [0, {nu - 1}], got {extra}")
+    if start >= model.rmax:
+        raise InputError(f"-grid_paper_refine_from: expected a real in [0, {model.rmax:g}), got {start:g}")
+    return grid.paper(model.rmax, nu, extra, start, split)
+
+
+def read_settings(opts: AppOptions) -> Settings:
+    """The continuation's step control and stops; the load F is the observable watched."""
+    lam_max = opts.real("cont_lambda_max")
+    return Settings(corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
+                    ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
+                    max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
+                    observable="F", observable_step=opts.real("cont_dF_max"), observable_max=opts.real("cont_F_max"),
+                    p_max=math.inf if lam_max is None else lam_max, max_steps=opts.int("cont_max_steps"),
+                    pc_reuse_its=opts.int("adh_pc_reuse_its"), monitor=opts.flag("cont_monitor"))
+
+
+def check_memory(n: int, pmat: str, curve: bool, ranks: int) -> None:
+    """Refuse a grid whose dense matrices cannot fit: A, and G_H and the bordered
+    matrix when assembled densely, N^2 doubles each, split over the ranks."""
+    import os
+
+    dense = 1 + (pmat == "dense") * (1 + curve)
+    need = 8.0 * n * n * dense / ranks
+    have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    if need > 0.8 * have:
+        raise InputError(f"-grid_n: N = {n} needs {need / 2**30:.0f} GiB a rank for {dense} dense N x N "
+                         f"matrices, this machine has {have / 2**30:.0f} GiB; use fewer nodes, more ranks, "
+                         f"or -adh_pmat band")
+
+
+def read_guess(problem, lam: float, path: str | None) -> PETSc.Vec:
+    """The initial H of a fixed-approach solve: the rigid state, or H(r) of -adh_guess interpolated."""
+    H = problem.rigid(lam, problem.create_vec())
+    if path is None:
+        return H
+    try:
+        import h5py
+        with h5py.File(path, "r") as f:
+            r0, h0 = f["grid/r"][()], f["solution/H"][()]
+    except (OSError, KeyError) as e:
+        raise InputError(f"-adh_guess: cannot read grid/r and solution/H from '{path}' ({e})") from None
+    h = np.interp(problem.r[problem.lo:problem.hi], r0, h0)
+    if not np.all(np.isfinite(h)) or np.any(h <= problem.law.wall):
+        raise InputError(f"-adh_guess: H in '{path}' is not finite and above the wall {problem.law.wall:g}")
+    H.setArray(h)
+    return H
+
+
+# -- PETSc's errors and options ------------------------------------------------------
 #: PETSc error codes that mean a bad option value: unknown type, wrong argument, out of range.
 _INPUT_CODES = (86, 62, 63)
 
@@ -220,16 +299,19 @@ def petsc_error(err: PETSc.Error) -> InputError | None:
     """
     if err.ierr not in _INPUT_CODES:
         return None
-    lib = ctypes.CDLL(PETSc.__file__)
-    get = lib.PetscErrorMessage
-    get.argtypes = [ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(ctypes.c_char_p)]
-    text, specific = ctypes.c_char_p(), ctypes.c_char_p()
-    get(err.ierr, ctypes.byref(text), ctypes.byref(specific))
-    detail = (specific.value or text.value or b"").decode(errors="replace").strip()
+    detail = capi.error_message(err.ierr)
     words = set(detail.replace("'", " ").replace('"', " ").split())
     named = [k for k, v in PETSc.Options().getAll().items() if v and v in words]
     where = f"-{named[0]} {PETSc.Options().getString(named[0])}: " if named else ""
     return InputError(f"{where}{detail}")
+
+
+# A few PETSc options users type, for the did-you-mean hint only.
+_PETSC_COMMON = ["snes_monitor", "ksp_monitor", "snes_view", "ksp_view", "log_view",
+                 "snes_rtol", "snes_atol", "snes_max_it", "ksp_rtol", "ksp_type", "pc_type",
+                 "snes_lag_preconditioner", "options_file", "help", "snes_converged_reason",
+                 "ksp_converged_reason", "pc_factor_mat_solver_type", "sub_pc_type"]
+_SOLVER_OPTIONS = ("snes_", "ksp_", "pc_", "sub_", "mat_")
 
 
 def check_unused(judged=lambda name: True) -> None:
@@ -239,27 +321,28 @@ def check_unused(judged=lambda name: True) -> None:
     all read up front, before any work; or all of them at the end of a run,
     when PETSc has read its own.
     """
-    left = [n for n in unused_options() if judged(n)]
-    if left:
-        name = left[0]
-        if name in _PETSC_COMMON:
-            raise InputError(f"-{name}: not used by the solvers this run configures "
-                             f"(e.g. a sub-PC option without a block PC)")
-        near = difflib.get_close_matches(name, list(TABLE) + _PETSC_COMMON, n=1)
-        hint = f" (did you mean -{near[0]}?)" if near else ""
-        raise InputError(f"-{name}: unknown option{hint}; -help lists the options")
-
-
-# A few PETSc options users type, for the did-you-mean hint only.
-_PETSC_COMMON = ["snes_monitor", "ksp_monitor", "snes_view", "ksp_view", "log_view",
-                 "snes_rtol", "snes_atol", "snes_max_it", "ksp_rtol", "ksp_type", "pc_type",
-                 "snes_lag_preconditioner", "options_file", "help", "snes_converged_reason",
-                 "ksp_converged_reason", "pc_factor_mat_solver_type", "sub_pc_type"]
+    left = [n for n in capi.options_left() if judged(n)]
+    if not left:
+        return
+    name = left[0]
+    bare = next((name[len(p):] for p, _ in SOLVER_PREFIXES if p and name.startswith(p)), name)
+    if bare in _PETSC_COMMON and bare.startswith(_SOLVER_OPTIONS):
+        where = ", ".join(f"-{p}{bare} for {what}" for p, what in SOLVER_PREFIXES)
+        block = " (and a sub-PC option needs a block PC)" if bare.startswith("sub_") else ""
+        raise InputError(f"-{name}: not used by the solvers this run configures{block}; use {where}")
+    near = difflib.get_close_matches(name, list(TABLE) + _PETSC_COMMON
+                                     + [p + n for p, _ in SOLVER_PREFIXES if p for n in _PETSC_COMMON], n=1)
+    hint = f" (did you mean -{near[0]}?)" if near else ""
+    raise InputError(f"-{name}: unknown option{hint}; -help lists the options")
 
 
 def print_help(out) -> None:
-    """Write the application options, as PETSc's -help writes its own."""
+    """Write the application options and the solvers' prefixes, as PETSc's -help writes its own."""
     out.write("petsc-adhesion application options (PETSc's follow):\n")
     for o in TABLE.values():
         default = "" if o.default in (None, ()) else f" <{o.default}>"
         out.write(f"  -{o.name}{default}: {o.help}; {o.allowed()}\n")
+    out.write("Solvers, each tuned by PETSc's options under its own prefix (-{prefix}snes_*, -{prefix}ksp_*, "
+              "-{prefix}pc_*):\n")
+    for prefix, what in SOLVER_PREFIXES:
+        out.write(f"  -{prefix}snes_...: {what}\n")

@@ -1,7 +1,9 @@
-"""Results to files: HDF5 (h5py) and a JSON summary, written by rank 0, atomically.
+"""Result files: their layout (docs/output.md) and their writing, by rank 0, atomically.
 
 A file is written under a temporary name in its target directory and renamed
 into place, so a reader never sees a partial file and a failed run leaves none.
+The layout of a curve or a solve is built here from the result dicts of
+:mod:`petsc_adhesion.results`, once for the JSON summary and the HDF5 tree.
 """
 from __future__ import annotations
 
@@ -14,7 +16,8 @@ import numpy as np
 
 from .options import InputError
 
-__all__ = ["check_writable", "write_h5", "write_json", "atomic"]
+__all__ = ["check_writable", "atomic", "write_h5", "write_json", "curve_summary", "curve_tree",
+           "write_curve", "write_solve"]
 
 
 def check_writable(option: str, path: str | None) -> None:
@@ -48,11 +51,6 @@ def atomic(path: str, keep: bool = True):
             os.remove(tmp)
 
 
-def _attrs(node, d: dict) -> None:
-    for k, v in d.items():
-        node.attrs[k] = "" if v is None else v
-
-
 def _write(group, tree: dict) -> None:
     """Dicts become groups; arrays datasets; scalars and strings attributes."""
     for key, val in tree.items():
@@ -65,10 +63,11 @@ def _write(group, tree: dict) -> None:
         elif isinstance(val, np.ndarray):
             group.create_dataset(key, data=val)
         else:
-            _attrs(group, {key: val})
+            group.attrs[key] = "" if val is None else val
 
 
 def write_h5(path: str, tree: dict) -> None:
+    """The tree as an HDF5 file (see :func:`_write`), atomically."""
     import h5py
 
     with atomic(path) as tmp:
@@ -87,7 +86,91 @@ def _plain(x):
 
 
 def write_json(path: str, summary: dict) -> None:
+    """The summary as JSON (no NaN allowed), atomically."""
     with atomic(path) as tmp:
         with open(tmp, "w") as f:
             json.dump(_plain(summary), f, indent=1, allow_nan=False)
             f.write("\n")
+
+
+# -- layout ---------------------------------------------------------------------
+_BRIEF = ("kind", "lambda", "F", "H0", "stable", "lambda_err", "F_err", "F_truncation")
+
+
+def _brief(e: dict) -> dict:
+    out = {k: v for k, v in e.items() if k in _BRIEF}
+    if "landing" in e:
+        out["landing"] = {k: v for k, v in e["landing"].items() if k in ("lambda", "F", "H0")}
+    return out
+
+
+def _common(head: dict) -> dict:
+    """The keys every summary has: versions, the model and the grid size."""
+    flat = {k: v for k, v in head.items() if k not in ("options", "model", "grid")}
+    return {**flat, **head["model"], "n_nodes": int(head["grid"]["r"].size)}
+
+
+def curve_summary(res: dict, head: dict) -> dict:
+    """The JSON summary of a traced curve."""
+    ev, po = res["events"], res["pull_off"]
+    s = {**_common(head),
+         "pull_off": _brief(po) if po else None,
+         "folds": [_brief(e) for e in ev if e["kind"] in ("snap_on", "snap_off")],
+         "equilibria": [{k: v for k, v in _brief(e).items() if k != "F"} for e in ev if e["kind"] == "equilibrium"],
+         "load_extrema": [_brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
+         "at_lambda": [_brief(e) for e in ev if e["kind"] == "lambda"],
+         "steps": res["steps"], "rejected_steps": res["rejected_steps"], "stop_reason": res["stop_reason"],
+         "grid_warning": res["grid_warning"], "warnings": res["warnings"], "wall_time_s": res["wall_time_s"]}
+    if "error_estimate" in res:
+        s["error_estimate"] = res["error_estimate"]
+    if "scales" in head and s["pull_off"]:
+        sc = head["scales"]
+        s["pull_off"] |= {"F_N": s["pull_off"]["F"] * sc["force_N"], "lambda_m": s["pull_off"]["lambda"] * sc["approach_m"]}
+    return s
+
+
+def curve_tree(res: dict, head: dict, summary: dict) -> dict:
+    """The HDF5 tree of a traced curve: the points, the events, and the summary's scalars."""
+    pts = res["points"]
+    curve = {"lambda": np.array([p.p for p in pts]), "F": np.array([p.values["F"] for p in pts]),
+             "stable": np.array([p.pdot > 0 for p in pts]), "ds": np.array([p.ds for p in pts]),
+             "newton_its": np.array([p.newton_its for p in pts]), "ksp_its": np.array([p.ksp_its for p in pts]),
+             "H0": np.array([p.x[0] for p in pts]), "lambdadot": np.array([p.pdot for p in pts]),
+             "corrector": np.array([p.corrector for p in pts], dtype="S9")}
+    events = [{k: v for k, v in e.items() if k != "segment"} for e in res["events"]]
+    return {**head, "kind": "curve", "curve": curve, "events": events,
+            "summary": {k: v for k, v in summary.items() if not isinstance(v, (list, dict)) and v is not None}}
+
+
+def write_curve(res: dict, head: dict, out, summary, plot) -> dict:
+    """Files of a traced curve; returns the summary."""
+    summ = curve_summary(res, head)
+    tree = curve_tree(res, head, summ)
+    if out:
+        write_h5(out, tree)
+    if plot:
+        _draw(plot, tree, out)
+    if summary:
+        write_json(summary, summ)
+    return summ
+
+
+def write_solve(res: dict, head: dict, out, summary) -> None:
+    """Files of a fixed-approach solve."""
+    brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
+    if out:
+        write_h5(out, {**head, "kind": "solve", "solution": {"H": res["H"], "P": res["P"], **brief}})
+    if summary:
+        write_json(summary, {**_common(head), **brief})
+
+
+def _draw(png: str, tree: dict, h5: str | None) -> None:
+    """The curve figure; plotting is imported only here."""
+    from .plot import curve_figure
+
+    with tempfile.TemporaryDirectory() as tmp:
+        if h5 is None:
+            h5 = f"{tmp}/curve.h5"
+            write_h5(h5, tree)
+        with atomic(png) as target:
+            curve_figure(h5, target)

@@ -1,75 +1,204 @@
-"""Newton (SNES) for G(H; lambda) = 0 at a fixed approach lambda.
+"""Newton-Krylov (SNES + GMRES) for G(x; p) = 0 at a fixed parameter p, for any problem of the protocol.
 
-The SNES gets the residual of eq. (12), the shell Jacobian and a
-preconditioning matrix from :class:`~petsc_adhesion.residual.Problem`, and the
-domain guard as its line-search pre-check.  Defaults are set here, before
-``setFromOptions()``, so every one of them can be overridden at run time.
+The problem (see :mod:`petsc_adhesion.continuation` for the protocol) supplies
+the residual, its linearization as an operator (often a shell), the matrix the
+preconditioner is built from, and the domain guard.  Each SNES gets its own
+options prefix and its defaults before ``setFromOptions()``, so every default
+can be overridden at run time, solver by solver, and nothing is written into
+the options database.
+
+    petsc-adhesion -adh_lambda -2 -snes_monitor -ksp_monitor   # the fixed-approach solve
+    petsc-adhesion -nat_snes_monitor -arc_ksp_converged_reason  # the continuation's correctors
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["configure", "create_snes", "default_pc", "solve"]
+from . import capi
+
+__all__ = ["Tolerances", "create_snes", "PCReuse", "fresh_retry", "krylov_retry", "guard", "Newton",
+           "PC_REUSE_ITS"]
+
+#: Keep a preconditioner while GMRES needs at most this many iterations with it.
+PC_REUSE_ITS = 10
 
 
-def default_pc(pc: PETSc.PC, pmat: str) -> None:
-    """Preconditioner for the kind of matrix it gets (overridable: -pc_type ...).
+@dataclass(frozen=True)
+class Tolerances:
+    """Newton-Krylov defaults, tight enough for events located to 1e-8 in the parameter."""
 
-    dense: LU on one rank, block Jacobi with dense LU per rank otherwise;
-    band: LU of the near-field AIJ on one rank, block Jacobi + ILU in parallel;
-    shell: none.
+    snes_rtol: float = 1e-10
+    snes_atol: float = 1e-10
+    snes_stol: float = 1e-14
+    snes_max_it: int = 50
+    ksp_rtol: float = 1e-10
+    ksp_atol: float = 1e-13
+    ksp_max_it: int = 400
+
+
+def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, jacobian,
+                J: PETSc.Mat, P: PETSc.Mat, setup_pc, precheck, full_steps: bool = False,
+                tol: Tolerances = Tolerances()) -> PETSc.SNES:
+    """A Newton-Krylov SNES with prefix ``prefix``, configured, then ``setFromOptions()``.
+
+    Parameters
+    ----------
+    function, jacobian
+        SNES callbacks ``(snes, x, f)`` and ``(snes, x, J, P)``.
+    J, P
+        The linearization (operator) and the matrix the preconditioner is built from.
+    setup_pc
+        ``setup_pc(pc)`` sets the default preconditioner for the kind of P.
+    precheck
+        Line-search pre-check ``(x, y, ...) -> bool`` that shortens the step y (domain guard).
+    full_steps
+        Newton starts from a continuation predictor, close to the solution, where full
+        steps (still shortened by the guard) need no backtracking: the ``basic`` line
+        search, which halves the residual evaluations of the default ``bt``.
     """
-    if pmat == "shell":
-        pc.setType("none")
-    elif pc.getComm().getSize() == 1:
-        pc.setType("lu")
-    else:
-        pc.setType("bjacobi")
-        # the sub-PC type goes through the database (sub-KSPs exist only after setup),
-        # and only while block Jacobi is in effect: an unread option is an error here
-        opts = PETSc.Options(pc.getOptionsPrefix() or "")
-        if not opts.hasName("pc_type") and not opts.hasName("sub_pc_type"):
-            opts.setValue("sub_pc_type", "lu" if pmat == "dense" else "ilu")
-
-
-def configure(snes: PETSc.SNES, pmat: str, precheck, full_steps: bool = False) -> PETSc.SNES:
-    """Newton-Krylov (GMRES) defaults shared by the fixed-lambda and bordered SNES.
-
-    Tight enough for events located to 1e-8 in lambda; ``setFromOptions()``
-    comes last, so each default can be overridden at run time.  ``full_steps``:
-    Newton starts from a continuation predictor, close to the curve, where full
-    steps (shortened at the wall) need no backtracking: the ``basic`` line search
-    unless the user chose one; it halves the residual evaluations of ``bt``.
-    """
-    opts = PETSc.Options(snes.getOptionsPrefix() or "")
-    # petsc4py 3.18 has no SNESLineSearch object: the default goes through the
-    # database, for this setFromOptions only, so that it does not leak into others
-    default_ls = full_steps and not opts.hasName("snes_linesearch_type")
-    if default_ls:
-        opts.setValue("snes_linesearch_type", "basic")
+    snes = PETSc.SNES().create(comm)
+    snes.setOptionsPrefix(prefix)
+    snes.setFunction(function, residual)
+    snes.setJacobian(jacobian, J, P)
     snes.setType("newtonls")
-    snes.setTolerances(rtol=1e-10, atol=1e-10, stol=1e-14, max_it=50)
+    if full_steps:
+        capi.set_linesearch_type(snes, "basic")
+    snes.setTolerances(rtol=tol.snes_rtol, atol=tol.snes_atol, stol=tol.snes_stol, max_it=tol.snes_max_it)
     ksp = snes.getKSP()
     ksp.setType("gmres")
-    ksp.setTolerances(rtol=1e-10, atol=1e-13, max_it=400)
-    default_pc(ksp.getPC(), pmat)
+    ksp.setTolerances(rtol=tol.ksp_rtol, atol=tol.ksp_atol, max_it=tol.ksp_max_it)
+    setup_pc(ksp.getPC())
     snes.setLineSearchPreCheck(precheck)
     snes.setFromOptions()
-    if default_ls:
-        opts.delValue("snes_linesearch_type")
     return snes
 
 
-def create_snes(problem, full_steps: bool = False) -> PETSc.SNES:
-    """A Newton-Krylov SNES on ``problem`` at ``problem.lam`` (``full_steps``: see configure)."""
-    snes = PETSc.SNES().create(problem.comm)
-    snes.setFunction(problem.form_function, problem.create_vec())
-    snes.setJacobian(problem.form_jacobian, problem.J, problem.P)
-    return configure(snes, problem.pmat_kind, problem.precheck, full_steps)
+class PCReuse:
+    """When to refill a preconditioning matrix: only when its factorization got stale.
+
+    PETSc's PCSetUp refactors only a matrix whose state changed, so a matrix
+    left alone keeps its factorization across Newton iterations and
+    continuation steps.  Refill when the last Krylov solve of ``ksp`` failed or
+    took more than ``its`` iterations, or after :meth:`expire`.
+    """
+
+    def __init__(self, its: int = PC_REUSE_ITS):
+        self.its, self.stale = its, True
+
+    def expire(self) -> None:
+        """Refill at the next linearization."""
+        self.stale = True
+
+    def __call__(self, ksp: PETSc.KSP) -> bool:
+        """Whether to refill now (and, by asking, the matrix counts as fresh)."""
+        refill = self.stale or ksp.getConvergedReason() < 0 or ksp.getIterationNumber() > self.its
+        self.stale = False
+        return refill
 
 
-def solve(snes: PETSc.SNES, problem, lam: float, H: PETSc.Vec) -> bool:
-    """Solve G(H; lam) = 0 in place from the guess in H; True when converged."""
-    problem.lam = lam
-    snes.solve(None, H)
-    return snes.getConvergedReason() > 0
+def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse, work: PETSc.Vec) -> bool:
+    """Solve from X in place; after a failure, once more from X with a fresh preconditioner.
+
+    A factorization kept from a distant point of the curve can make the first
+    linear solve fail where Newton itself is fine.  ``work`` keeps the start.
+    """
+    X.copy(work)
+    for _ in range(2):
+        snes.solve(None, X)
+        if snes.getConvergedReason() > 0:
+            return True
+        reuse.expire()
+        work.copy(X)
+    return False
+
+
+def krylov_retry(ksp: PETSc.KSP, A: PETSc.Mat, P: PETSc.Mat, b: PETSc.Vec, x: PETSc.Vec,
+                 reuse: PCReuse, linearize) -> bool:
+    """Solve A x = b at the point set by ``linearize(refill)``; retry once with a fresh PC."""
+    for _ in range(2):
+        linearize(reuse(ksp))
+        ksp.setOperators(A, P)
+        ksp.solve(b, x)
+        if ksp.getConvergedReason() > 0:
+            return True
+        reuse.expire()
+    return False
+
+
+def guard(problem, x: np.ndarray, Y: PETSc.Vec, y: np.ndarray | None = None) -> bool:
+    """Shorten the Newton step Y (new x = x - y) by the problem's domain guard; True if shortened.
+
+    ``y`` is the part of Y acting on x when Y also holds other unknowns.
+    The problem returns the same fraction on all ranks.
+    """
+    alpha = problem.step_fraction(x, Y.getArray(readonly=True) if y is None else y)
+    if alpha < 1.0:
+        Y.scale(alpha)
+        return True
+    return False
+
+
+class Newton:
+    """SNES on G(x; p) = 0 at a parameter p given to :meth:`solve`.
+
+    Parameters
+    ----------
+    problem
+        Implements the protocol of :mod:`petsc_adhesion.continuation`.
+    prefix
+        Options prefix of the SNES ("" for the fixed-approach solve, "nat_" for
+        the natural corrector of the continuation).
+    full_steps
+        See :func:`create_snes`.
+    pc_reuse_its
+        See :class:`PCReuse`.
+    """
+
+    def __init__(self, problem, prefix: str = "", full_steps: bool = False, pc_reuse_its: int = PC_REUSE_ITS):
+        self.pb, self.p = problem, 0.0
+        self.pmat = problem.create_pmat(bordered=False)
+        self.reuse = PCReuse(pc_reuse_its)
+        self.work = problem.create_vec()
+        self.snes = create_snes(problem.comm, prefix, self._function, problem.create_vec(), self._jacobian,
+                                problem.jacobian, self.pmat or problem.jacobian, problem.setup_pc,
+                                self._precheck, full_steps)
+
+    def _function(self, snes, x, G):
+        self.pb.residual(x, self.p, G)
+
+    def _jacobian(self, snes, x, J, P):
+        self.linearize(x, self.reuse(snes.getKSP()))
+
+    def linearize(self, x: PETSc.Vec, refill: bool) -> None:
+        """The operator at (x, p) and, with ``refill``, its preconditioning matrix."""
+        self.pb.linearize(x, self.p)
+        if refill and self.pmat is not None:
+            self.pb.fill_pmat(self.pmat)
+
+    def _precheck(self, x, y, *args) -> bool:
+        return guard(self.pb, x.getArray(readonly=True), y)
+
+    def solve(self, p: float, x: PETSc.Vec, retry: bool = False) -> bool:
+        """Solve G(x; p) = 0 in place from the guess in x; True when converged.
+
+        ``retry``: after a failure, once more with a fresh preconditioner.
+        """
+        self.p = p
+        if retry:
+            return fresh_retry(self.snes, x, self.reuse, self.work)
+        self.snes.solve(None, x)
+        return self.snes.getConvergedReason() > 0
+
+    @property
+    def iterations(self) -> tuple[int, int]:
+        """Newton and Krylov iterations of the last solve."""
+        return self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()
+
+    def destroy(self) -> None:
+        """Free the PETSc objects made here."""
+        for obj in (self.snes, self.pmat, self.work):
+            if obj is not None:
+                obj.destroy()

@@ -38,13 +38,13 @@ def cli():
 
 
 def make_problem(mu=1.0, sigma=0.0, r=None, pmat="dense", **model):
-    """A Problem and its SNES on grid r (default: uniform, 201 nodes)."""
-    from petsc_adhesion import grid
+    """A Problem and its fixed-approach Newton solver on grid r (default: uniform, 201 nodes)."""
+    from petsc_adhesion import grid, preconditioning
     from petsc_adhesion.influence import create_influence
     from petsc_adhesion.model import Model
-    from petsc_adhesion.residual import Problem
-    from petsc_adhesion.solver import create_snes
+    from petsc_adhesion.problem import Problem
+    from petsc_adhesion.solver import Newton
 
     r = grid.uniform(201, 10.0) if r is None else r
-    pb = Problem(Model(mu=mu, sigma=sigma, **model), r, create_influence(r), pmat)
-    return pb, create_snes(pb)
+    pb = Problem(Model(mu=mu, sigma=sigma, **model), r, create_influence(r), preconditioning.create(pmat))
+    return pb, Newton(pb)

@@ -405,7 +405,7 @@ def test_parallel_writes_once(parallel_runs, key):
 @pytest.fixture(scope="module")
 def curve(tmp_path_factory):
     d = tmp_path_factory.mktemp("curve")
-    proc = run_cli("-adh_mu", "0.5", *FAST, "-cont_monitor", "-snes_monitor",
+    proc = run_cli("-adh_mu", "0.5", *FAST, "-cont_monitor", "-nat_snes_monitor", "-arc_snes_monitor",
                    "-out", d / "c.h5", "-summary", d / "c.json")
     assert proc.returncode == 0, proc.stderr
     with h5py.File(d / "c.h5", "r") as f:

@@ -25,7 +25,7 @@ import pytest
 from conftest import run_cli
 from petsc_adhesion.grid import load_weights
 from petsc_adhesion.influence import influence_rows
-from petsc_adhesion.model import DMT_EQUILIBRIUM, dmt_load
+from petsc_adhesion.reference import RIGID_EQUILIBRIUM, rigid_load
 from petsc_adhesion.pressure import PressureLaw
 
 h5py = pytest.importorskip("h5py")
@@ -241,13 +241,13 @@ def test_small_mu_follows_rigid_closed_form(dmt):
     # one equilibrium, near 1 - 2^(-1/3) = 0.2063 (moved by elasticity, NOTES 7), and the
     # paper's "lambda_e = 0.21" for the smooth surface
     (eq,) = s["equilibria"]
-    assert abs(eq["lambda"] - DMT_EQUILIBRIUM) < 0.01
+    assert abs(eq["lambda"] - RIGID_EQUILIBRIUM) < 0.01
     assert abs(eq["lambda"] - 0.21) <= 0.01
     assert s["folds"] == []
 
     # the shift of the equilibrium is elastic: it scales with c ~ mu^1.5 (ratio 2^1.5 = 2.83
     # from mu = 0.005 to 0.01); measured 2.86.  Truncation and mesh move it by < 1e-4.
-    shift = {k: dmt[k].summary["equilibria"][0]["lambda"] - DMT_EQUILIBRIUM for k in ("mu0.01", "mu0.005")}
+    shift = {k: dmt[k].summary["equilibria"][0]["lambda"] - RIGID_EQUILIBRIUM for k in ("mu0.01", "mu0.005")}
     assert shift["mu0.01"] > 0 and shift["mu0.005"] > 0
     assert 2.5 < shift["mu0.01"] / shift["mu0.005"] < 3.2
 
@@ -264,14 +264,14 @@ def test_small_mu_follows_rigid_closed_form(dmt):
     lam, F = c["lambda"], c["F"]
     sel = (lam >= -2.0) & (lam <= 0.12)
     assert sel.sum() >= 35
-    dev = np.abs(F[sel] - dmt_load(lam[sel]))
+    dev = np.abs(F[sel] - rigid_load(lam[sel]))
     assert dev.max() < 4e-3
     # far from contact (lambda < -1.5) elasticity is negligible and what is left is the
     # truncation: F - F_28 within 1e-4 of (4/3)/(r_m^2/2 + 1 - lambda)^2
     far = lam <= -1.5
     assert far.sum() >= 10
     tail = (4.0 / 3.0) / (50.0 + 1.0 - lam[far]) ** 2
-    assert np.all(np.abs(F[far] - dmt_load(lam[far]) - tail) < 1e-4)
+    assert np.all(np.abs(F[far] - rigid_load(lam[far]) - tail) < 1e-4)
 
 
 # -- 2. mu = 1: snap-on, snap-off, landings ------------------------------------------

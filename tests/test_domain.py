@@ -1,8 +1,7 @@
 """Newton never leaves the domain: every gap H - sqrt(2) sigma x_l + 1 stays positive."""
 import numpy as np
 
-from petsc_adhesion import residual
-from petsc_adhesion.solver import solve
+from petsc_adhesion import problem, solver
 from conftest import make_problem
 
 
@@ -14,13 +13,13 @@ def test_step_across_the_wall_is_shortened():
     y = np.zeros_like(h)
     y[:5] = h[:5] - pb.law.wall + 1.0          # new H = h - y lies 1 below the wall
     Y.setArray(y)
-    assert pb.precheck(H, Y)
+    assert solver.guard(pb, h, Y)
     new = h - Y.getArray()
     room = h - pb.law.wall
-    assert np.all(new - pb.law.wall >= (1 - residual.TO_WALL) * room - 1e-12)
+    assert np.all(new - pb.law.wall >= (1 - problem.TO_WALL) * room - 1e-12)
     # a step that stays inside is left alone
     Y.setArray(0.5 * (h - pb.law.wall))
-    assert not pb.precheck(H, Y)
+    assert not solver.guard(pb, h, Y)
     assert np.allclose(Y.getArray(), 0.5 * (h - pb.law.wall))
 
 
@@ -29,7 +28,7 @@ def test_newton_through_the_wall_region_converges(monkeypatch):
     wall of the 16-point rule (measured: 16 of 26); each is shortened, the residual is never
     evaluated outside, and Newton converges."""
     crossings, shortened = [], []
-    orig = residual.shorten_to_wall
+    orig = solver.guard
 
     def spy(pb, h, Y, y=None):
         yy = (Y.getArray(readonly=True) if y is None else y).copy()
@@ -38,8 +37,8 @@ def test_newton_through_the_wall_region_converges(monkeypatch):
         shortened.append(changed)
         return changed
 
-    monkeypatch.setattr(residual, "shorten_to_wall", spy)
-    pb, snes = make_problem(mu=1.0, sigma=0.5)
+    monkeypatch.setattr(solver, "guard", spy)
+    pb, newton = make_problem(mu=1.0, sigma=0.5)
     seen = []
     inner = pb.law.__call__
 
@@ -50,7 +49,7 @@ def test_newton_through_the_wall_region_converges(monkeypatch):
 
     pb.law.__class__ = Law
     H = pb.rigid(0.0, pb.create_vec())
-    assert solve(snes, pb, 0.0, H)
+    assert newton.solve(0.0, H)
     assert sum(crossings) >= 1
     assert all(s for c, s in zip(crossings, shortened) if c)
     assert min(seen) > 0                          # never evaluated at a closed gap
@@ -62,12 +61,12 @@ def test_newton_through_the_wall_region_converges(monkeypatch):
 def test_continuation_step_leaving_the_domain_is_retried_smaller():
     """A predictor beyond the wall is refused before any evaluation (step retried at half)."""
     from petsc_adhesion.continuation import Continuation, Settings
-    pb, snes = make_problem(mu=1.0, sigma=0.5)
-    cont = Continuation(pb, snes, Settings())
-    a = cont.start(-3.0)
-    assert a.th[0] < 0 and a.tl > 0          # approaching: lambda up, H down
+    pb, _ = make_problem(mu=1.0, sigma=0.5)
+    cont = Continuation(pb, Settings(observable="F"))
+    a = cont.start(pb.rigid(-3.0, pb.create_vec()), -3.0)
+    assert a.xdot[0] < 0 and a.pdot > 0          # approaching: lambda up, H down
     # a step long enough to push the predicted H(0) twice as far as the wall
-    big = 2 * (a.h[0] - pb.law.wall) / -a.th[0]
-    assert not pb.inside(a.h + big * a.th)
+    big = 2 * (a.x[0] - pb.law.wall) / -a.xdot[0]
+    assert not pb.inside(a.x + big * a.xdot)
     assert cont.step(a, big) is None
     assert cont.step(a, 0.05) is not None

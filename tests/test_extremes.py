@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from petsc_adhesion.model import DMT_EQUILIBRIUM
+from petsc_adhesion.reference import RIGID_EQUILIBRIUM
 from conftest import run_cli
 
 
@@ -21,7 +21,7 @@ def test_tiny_mu_is_the_rigid_limit(tmp_path):
     truncation 5e-4 and the shift."""
     s, _ = trace(tmp_path, "-adh_mu", 0.001)
     assert abs(s["pull_off"]["F"] + 1) < 1e-3 and abs(s["pull_off"]["lambda"]) < 1e-3
-    assert 0 < s["equilibria"][-1]["lambda"] - DMT_EQUILIBRIUM < 5e-4
+    assert 0 < s["equilibria"][-1]["lambda"] - RIGID_EQUILIBRIUM < 5e-4
     assert s["folds"] == [] and s["warnings"] == [] and s["grid_warning"] == ""
 
 

@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 from petsc_adhesion import grid
-from petsc_adhesion.model import DMT_EQUILIBRIUM, dmt_load
-from petsc_adhesion.solver import solve
+from petsc_adhesion.reference import RIGID_EQUILIBRIUM, load_beyond, rigid_load
 from conftest import make_problem
 
 RMAX = 10.0
@@ -18,30 +17,29 @@ RMAX = 10.0
 
 def truncation(lam):
     """eq. (28) minus the load carried inside r_m: the part beyond r_m."""
-    g = 1 - lam + RMAX**2 / 2
-    return (8 / 3) * (g**-8 / 8 - g**-2 / 2)
+    return load_beyond(RMAX, lam)
 
 
 def load(n, lam):
-    pb, snes = make_problem(mu=0.0, r=grid.uniform(n, RMAX))
+    pb, newton = make_problem(mu=0.0, r=grid.uniform(n, RMAX))
     H = pb.rigid(lam, pb.create_vec())
     H.shift(0.05)   # start off the solution
-    assert solve(snes, pb, lam, H)
+    assert newton.solve(lam, H)
     assert np.allclose(H.getArray(), -lam + pb.r**2 / 2, rtol=0, atol=1e-13)
     return pb.load(H)
 
 
 def test_closed_form_limits():
-    assert dmt_load(0.0) == pytest.approx(-1.0, rel=1e-15)
-    assert dmt_load(DMT_EQUILIBRIUM) == pytest.approx(0.0, abs=1e-14)
-    assert DMT_EQUILIBRIUM == pytest.approx(0.20630, abs=1e-5)
+    assert rigid_load(0.0) == pytest.approx(-1.0, rel=1e-15)
+    assert rigid_load(RIGID_EQUILIBRIUM) == pytest.approx(0.0, abs=1e-14)
+    assert RIGID_EQUILIBRIUM == pytest.approx(0.20630, abs=1e-5)
 
 
 @pytest.mark.parametrize("lam, order", [(-1.0, 2), (0.0, 4), (0.2, 2)])
 def test_load_converges_to_truncated_closed_form(lam, order):
     """Second order; fourth at lambda = 0, where the h^2 term of Euler-Maclaurin,
     proportional to d/dr [P(H(r)) r] at r = 0 = P(H(0)) = P(0), vanishes."""
-    exact = dmt_load(lam) - truncation(lam)
+    exact = rigid_load(lam) - truncation(lam)
     errors = [abs(load(n, lam) - exact) for n in (101, 201, 401)]
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     # (at order 4 the h^6 rest still shows at these N: measured 4.10, 4.37)
@@ -52,9 +50,9 @@ def test_truncation_error_of_paper_domain():
     """At lambda = 0 the attraction beyond r_m = 10 is -5.1e-4 (NOTES: some 5e-4)."""
     assert truncation(0.0) == pytest.approx(-5.13e-4, rel=2e-3)
     # on the paper grid the discrete load sits off eq. (28) by the truncation and an O(h^2) rest
-    pb, snes = make_problem(mu=0.0, r=grid.paper(RMAX))
+    pb, newton = make_problem(mu=0.0, r=grid.paper(RMAX))
     H = pb.rigid(0.0, pb.create_vec())
-    assert solve(snes, pb, 0.0, H)
-    off = pb.load(H) - dmt_load(0.0)
+    assert newton.solve(0.0, H)
+    off = pb.load(H) - rigid_load(0.0)
     # measured: 4.91e-4 = 5.13e-4 (truncation) - 2.1e-5 (grid): the truncation dominates
     assert abs(off + truncation(0.0)) < 0.05 * abs(truncation(0.0))

@@ -1,0 +1,66 @@
+"""PETSc C functions that petsc4py 3.18 does not bind, called through ctypes.
+
+The symbols come from the PETSc library that petsc4py's extension module
+already links, so they are the same PETSc the rest of the program uses.
+Newer petsc4py binds some of these; one path for all versions is simpler.
+"""
+from __future__ import annotations
+
+import ctypes
+from functools import lru_cache
+
+import numpy as np
+from petsc4py import PETSc
+
+__all__ = ["options_left", "error_message", "set_linesearch_type"]
+
+
+@lru_cache(maxsize=None)
+def _lib() -> ctypes.CDLL:
+    return ctypes.CDLL(PETSc.__file__)
+
+
+def _petsc_int():
+    return ctypes.c_int64 if np.dtype(PETSc.IntType).itemsize == 8 else ctypes.c_int32
+
+
+def options_left() -> list[str]:
+    """Names of the options in the database that no object has read (PetscOptionsLeftGet)."""
+    lib = _lib()
+    argtypes = [ctypes.c_void_p, ctypes.POINTER(_petsc_int()),
+                ctypes.POINTER(ctypes.POINTER(ctypes.c_char_p)),
+                ctypes.POINTER(ctypes.POINTER(ctypes.c_char_p))]
+    get, restore = lib.PetscOptionsLeftGet, lib.PetscOptionsLeftRestore
+    get.argtypes = restore.argtypes = argtypes
+    n = _petsc_int()()
+    names = ctypes.POINTER(ctypes.c_char_p)()
+    values = ctypes.POINTER(ctypes.c_char_p)()
+    if get(None, ctypes.byref(n), ctypes.byref(names), ctypes.byref(values)):
+        raise RuntimeError("PetscOptionsLeftGet failed")
+    left = [names[i].decode() for i in range(n.value)]
+    restore(None, ctypes.byref(n), ctypes.byref(names), ctypes.byref(values))
+    return left
+
+
+def error_message(ierr: int) -> str:
+    """PETSc's message for its last error of code ``ierr`` (PetscErrorMessage): the specific one if kept."""
+    get = _lib().PetscErrorMessage
+    get.argtypes = [ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(ctypes.c_char_p)]
+    text, specific = ctypes.c_char_p(), ctypes.c_char_p()
+    get(ierr, ctypes.byref(text), ctypes.byref(specific))
+    return (specific.value or text.value or b"").decode(errors="replace").strip()
+
+
+def set_linesearch_type(snes: PETSc.SNES, kind: str) -> None:
+    """Set the line search of ``snes`` (SNESGetLineSearch, SNESLineSearchSetType).
+
+    Called before ``setFromOptions()``, it is a default the user's
+    ``-snes_linesearch_type`` (with the solver's prefix) still overrides.
+    """
+    lib = _lib()
+    ls = ctypes.c_void_p()
+    lib.SNESGetLineSearch.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_void_p)]
+    lib.SNESLineSearchSetType.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
+    if lib.SNESGetLineSearch(ctypes.c_void_p(snes.handle), ctypes.byref(ls)) or \
+            lib.SNESLineSearchSetType(ls, kind.encode()):
+        raise RuntimeError(f"cannot set the line search type '{kind}'")

@@ -1,0 +1,210 @@
+"""The discrete adhesion problem: residual of eq. (12), its Jacobian, the load of eq. (26).
+
+:class:`Problem` holds the discretization (grid, influence matrix, pressure
+law) on the rows this rank owns and implements the problem protocol of the
+continuation core (:mod:`petsc_adhesion.continuation`): the unknown x is the
+nodal separation H, the parameter p the approach lambda, and the observable
+along the curve is the load F.
+
+    G_i = H_i + lambda - r_i^2/2 - c sum_j A_ij P(H_j)          (eq. 12)
+    G_H v = v - c A (P'(H) v),  G_lambda = 1                    (eq. 23)
+"""
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from .grid import l2_weights, load_weights
+from .preconditioning import Border, Dense, Layout
+from .pressure import PressureLaw
+
+__all__ = ["Problem", "TO_WALL"]
+
+#: Newton may cover at most this fraction of the way to the wall in one step.
+TO_WALL = 0.9
+
+
+class Problem:
+    """The adhesion problem on grid ``r`` with influence matrix ``A``.
+
+    Parameters
+    ----------
+    model : Model
+        mu, sigma and the roughness rule.
+    r : numpy.ndarray
+        All grid nodes (every rank holds them: N numbers).
+    A : petsc4py.PETSc.Mat
+        Influence matrix (eq. 4, 12), dense, distributed by rows.
+    pmat
+        What the preconditioner is built from: a strategy of
+        :mod:`petsc_adhesion.preconditioning` (``Dense()`` by default).
+    """
+
+    #: Name of the continuation parameter, for monitors.
+    parameter = "lambda"
+
+    def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat=None):
+        self.model, self.r, self.A = model, r, A
+        self.comm = A.getComm()
+        self._mpi = self.comm.tompi4py()
+        self.law = PressureLaw(model.sigma, model.roughness, model.hermite_points)
+        self.c = model.coupling
+        self.lo, self.hi = A.getOwnershipRange()
+        self.layout = Layout(self.lo, self.hi, r.size, self.comm.getRank() == self.comm.getSize() - 1)
+        local = r[self.lo:self.hi]
+        self.shape = 0.5 * local * local
+        self.q = (8.0 / 3.0) * load_weights(r)[self.lo:self.hi]
+        self.weights = l2_weights(r)[self.lo:self.hi]
+        self.p, self.Ap = A.createVecs()
+        self.dp = np.zeros(self.hi - self.lo)
+        self.pc = pmat if pmat is not None else Dense()
+        self.jacobian = PETSc.Mat().createPython(A.getSizes(), _Jacobian(self), comm=self.comm)
+        self.jacobian.setUp()
+        self._gather = None
+
+    # -- state ------------------------------------------------------------------
+    def create_vec(self) -> PETSc.Vec:
+        """A vector of nodal values in the layout of G."""
+        return self.A.createVecLeft()
+
+    def rigid(self, lam: float, H: PETSc.Vec) -> PETSc.Vec:
+        """H = -lambda + r^2/2 (eq. 27), lifted where it would reach the wall.
+
+        The lift keeps every gap at least 1 (zero smooth pressure), so the guess
+        is inside the domain for any lambda.
+        """
+        H.setArray(np.maximum(self.shape - lam, self.law.wall + 1.0))
+        return H
+
+    # -- eq. 12, 14, 26 ---------------------------------------------------------
+    def pressure(self, H: PETSc.Vec):
+        """Nodal P and dP/dH (eq. 14) of the local part of H."""
+        return self.law(H.getArray(readonly=True))
+
+    def residual(self, H: PETSc.Vec, lam: float, G: PETSc.Vec) -> None:
+        """G(H, lambda) of eq. (12) into G."""
+        pressure, _ = self.pressure(H)
+        self.p.setArray(pressure)
+        self.A.mult(self.p, self.Ap)
+        G.setArray(H.getArray(readonly=True) + (lam - self.shape) - self.c * self.Ap.getArray(readonly=True))
+
+    def dG_dp(self, H: PETSc.Vec, lam: float, out: np.ndarray) -> np.ndarray:
+        """G_lambda of eq. (23): ones, on the local rows."""
+        out[:] = 1.0
+        return out
+
+    def load(self, H: PETSc.Vec) -> float:
+        """F = (8/3) integral_0^{r_m} P r dr (eq. 26), exact for piecewise-linear P."""
+        pressure, _ = self.pressure(H)
+        return self._mpi.allreduce(float(self.q @ pressure))
+
+    def observe(self, h: np.ndarray, lam: float, hdot: np.ndarray, lamdot: float):
+        """The observable of the curve: the load F (eq. 26) and its rate dF/ds = (8/3) q . (P'(H) hdot).
+
+        ``h`` and ``hdot`` are local parts of H and of the tangent's H part.
+        """
+        pressure, dpressure = self.law(h)
+        F, dF = self._mpi.allreduce(np.array([self.q @ pressure, self.q @ (dpressure * hdot)]))
+        return {"F": float(F)}, {"F": float(dF)}
+
+    @staticmethod
+    def stable(point) -> bool:
+        """Stable under displacement control: lambdadot > 0.
+
+        Along the curve det G_H has the sign of lambdadot, and the far branch is stable.
+        """
+        return point.pdot > 0
+
+    # -- domain guard -------------------------------------------------------------
+    def far_approach(self) -> float:
+        """An approach with the sphere well out of reach of the surface forces: the default start.
+
+        The rigid gap at r = 0 is then 3 + 2 mu above the wall of the roughness rule.
+        """
+        return -(self.law.wall + 1.0) - 3.0 - 2.0 * self.model.mu
+
+    def gather(self, local: np.ndarray) -> np.ndarray:
+        """The whole nodal vector of local parts, on every rank."""
+        return np.concatenate(self._mpi.allgather(np.asarray(local)))
+
+    def inside(self, h: np.ndarray) -> bool:
+        """True when every gap of the local H values h is open, on all ranks."""
+        return self._mpi.allreduce(bool(np.all(h > self.law.wall)), op=MPI.LAND)
+
+    def step_fraction(self, h: np.ndarray, y: np.ndarray) -> float:
+        """Largest fraction of the Newton step h -> h - y that covers at most TO_WALL of the way to the wall.
+
+        Node by node; the same fraction on all ranks.
+        """
+        room = h - self.law.wall
+        toward = y > 0
+        alpha = float(np.min(TO_WALL * room[toward] / y[toward], initial=1.0))
+        return self._mpi.allreduce(alpha, op=MPI.MIN)
+
+    # -- linearization --------------------------------------------------------------
+    def linearize(self, H: PETSc.Vec, lam: float) -> None:
+        """Set the point of the operator G_H (the shell :attr:`jacobian`)."""
+        _, self.dp = self.pressure(H)
+
+    def dp_all(self) -> np.ndarray:
+        """P'(H) at the linearization point on all nodes, on every rank."""
+        if self._gather is None:
+            self._dpv = self.create_vec()
+            self._gather, self._dpall = PETSc.Scatter.toAll(self._dpv)
+        self._dpv.setArray(self.dp)
+        self._gather.scatter(self._dpv, self._dpall, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        return self._dpall.getArray(readonly=True)
+
+    def jacobian_rows(self, out: np.ndarray) -> np.ndarray:
+        """Local rows of G_H = I - c A diag(P'), dense, into ``out``."""
+        np.multiply(self.A.getDenseArray(), -self.c * self.dp_all(), out=out)
+        out[np.arange(self.hi - self.lo), np.arange(self.lo, self.hi)] += 1.0
+        return out
+
+    def band_values(self, ai: np.ndarray, aj: np.ndarray) -> np.ndarray:
+        """Entries of G_H on the local CSR pattern (ai, aj): exact there, the rest dropped."""
+        rows = np.repeat(np.arange(self.hi - self.lo), np.diff(ai))
+        v = -self.c * self.A.getDenseArray()[rows, aj] * self.dp_all()[aj]
+        v[rows + self.lo == aj] += 1.0
+        return v
+
+    def create_pmat(self, bordered: bool) -> PETSc.Mat | None:
+        """The preconditioning matrix of G_H, or of the bordered matrix; None: the operator itself."""
+        return self.pc.create(self.layout, self.comm, bordered)
+
+    def fill_pmat(self, P: PETSc.Mat, border: Border | None = None) -> None:
+        """Assemble P at the linearization point (with ``border``: the bordered matrix)."""
+        self.pc.fill(P, self, self.layout, border)
+
+    def setup_pc(self, pc: PETSc.PC) -> None:
+        """Default preconditioner for the kind of P."""
+        self.pc.setup_pc(pc)
+
+    def destroy(self) -> None:
+        """Free the PETSc objects held here, the influence matrix included."""
+        for obj in (self.jacobian, self.p, self.Ap, self.A):
+            obj.destroy()
+        if self._gather is not None:
+            for obj in (self._gather, self._dpv, self._dpall):
+                obj.destroy()
+
+
+class _Jacobian:
+    """MatPython context of G_H: y = x - c A (P'(H) x), diagonal 1 - c A_ii P'_i."""
+
+    def __init__(self, problem: Problem):
+        self.pb = problem
+        self._diag = None
+
+    def mult(self, mat, x, y):
+        pb = self.pb
+        pb.p.setArray(pb.dp * x.getArray(readonly=True))
+        pb.A.mult(pb.p, y)
+        y.aypx(-pb.c, x)
+
+    def getDiagonal(self, mat, d):
+        pb = self.pb
+        if self._diag is None:
+            self._diag = pb.A.getDiagonal().getArray(readonly=True).copy()
+        d.setArray(1.0 - pb.c * self._diag * pb.dp)

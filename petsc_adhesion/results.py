@@ -1,0 +1,156 @@
+"""What a traced load-approach curve means for adhesion: its events by name, the pull-off, warnings, the report.
+
+The continuation core finds folds, extrema and zeros; here they get their
+physical names:
+
+=============  ======================  =============================================
+kind           core event              meaning
+=============  ======================  =============================================
+snap_on        fold, lambda largest    jump-in on approach (displacement control)
+snap_off       fold, lambda smallest   jump-out on retraction
+F_min, F_max   extremum of F           the most tensile F_min is the load-controlled pull-off
+equilibrium    F = 0                   zero load
+lambda         lambda = target         state asked for by -cont_at_lambda
+=============  ======================  =============================================
+
+Under displacement control a point is stable when lambdadot > 0; a fold's
+landing is the state on the other stable branch at the same lambda after the
+jump (Figs. 6, 7).
+"""
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from .events import Extremum, Fold, ParameterValue, Zero
+
+__all__ = ["curve_events", "curve", "stop_reason", "curve_warnings", "report_curve", "report_solve", "WALL_GAP"]
+
+#: Closer than this to the wall of the roughness rule, a state is set by its smallest weights.
+WALL_GAP = 1e-3
+
+
+def curve_events(at_lambda=()) -> list:
+    """The events of a load-approach curve, in the order they are tested at every step."""
+    return [Fold(("snap_on", "snap_off")), Extremum("F", ("F_min", "F_max")), Zero("F", "equilibrium"),
+            *(ParameterValue(t, "lambda") for t in at_lambda)]
+
+
+def _H0(problem, pt) -> float:
+    """H at r = 0, on every rank (collective)."""
+    return problem.comm.tompi4py().bcast(float(pt.x[0]) if problem.lo == 0 else None, root=0)
+
+
+def _whole(problem, local: np.ndarray):
+    """The whole nodal vector on rank 0 (None elsewhere); collective."""
+    parts = problem.comm.tompi4py().gather(local, root=0)
+    return np.concatenate(parts) if parts is not None else None
+
+
+def _state(problem, pt, profiles: bool) -> dict:
+    out = {"lambda": pt.p, "F": pt.values["F"], "H0": _H0(problem, pt)}
+    if profiles:
+        H = _whole(problem, pt.x)
+        if H is not None:
+            out["H"], out["P"] = H, problem.law(H)[0]
+    return out
+
+
+def event_record(problem, found, profiles: bool) -> dict:
+    """One event as the result files hold it (collective: H0 and profiles gather)."""
+    ev = {"kind": found.label, **_state(problem, found.point, profiles), "segment": found.segment}
+    if not isinstance(found.event, Fold):          # at a fold lambdadot = 0: marginal
+        ev["stable"] = bool(problem.stable(found.point))
+    if found.landing is not None:
+        ev["landing"] = _state(problem, found.landing, profiles)
+    return ev
+
+
+def stop_reason(stop, settings) -> str:
+    """Why the continuation stopped, in the options' words."""
+    reason, value = stop
+    if reason == "ds_min":
+        where = "a turning point (natural continuation cannot pass it)" \
+            if settings.corrector == "natural" else "a point it cannot pass"
+        return f"step below -cont_ds_min at lambda = {value:.6g}: {where}"
+    return {"observable_max": f"load F = {value:.4g} >= -cont_F_max {settings.observable_max:g}",
+            "p_max": f"approach lambda = {value:.4g} >= -cont_lambda_max {settings.p_max:g}",
+            "max_steps": f"-cont_max_steps {value} reached",
+            "max_folds": f"more than -cont_max_folds {value} turning points"}[reason]
+
+
+def curve(problem, cont, finder, profiles: bool = False) -> dict:
+    """The traced curve with its events as dicts, the pull-off and the pressures along it (rank 0).
+
+    Collective.  ``pressures`` (rank 0, else empty) feed the resolution check.
+    """
+    events = [event_record(problem, f, profiles) for f in finder.found]
+    pts = cont.points
+    pressures = [problem.law(H)[0] for H in (_whole(problem, p.x) for p in pts) if H is not None]
+    mins = [e for e in events if e["kind"] == "F_min"]
+    return {"points": pts, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
+            "steps": len(pts) - 1, "rejected_steps": cont.rejected, "folds": cont.folds,
+            "stop_reason": stop_reason(cont.stop, cont.set), "pressures": pressures}
+
+
+def curve_warnings(problem, pts, pull_off) -> list[str]:
+    """What makes a traced curve untrustworthy, one line each.
+
+    ``pull_off`` None skips the check of the pull-off against the curve (when
+    the grid warning already explains a curve of spurious folds).
+    """
+    out = []
+    law = problem.law
+    gap = problem.comm.tompi4py().allreduce(min(float(p.x.min()) for p in pts) - law.wall, op=MPI.MIN)
+    if not law.smooth and gap < WALL_GAP:
+        out.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
+                   f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
+                   f"the loads there are properties of the rule and ill-conditioned; use fewer points")
+    lowest = min(p.values["F"] for p in pts)
+    if pull_off is not None and lowest < pull_off["F"] - 1e-9:
+        out.append(f"a computed point (F = {lowest:.6g}) is more tensile than the located pull-off "
+                   f"({pull_off['F']:.6g}): the load varies faster than the steps resolve; "
+                   f"lower -cont_dF_max or -cont_ds_max")
+    return out
+
+
+def _err(e: dict) -> str:
+    if "lambda_err" not in e:
+        return ""
+    f = f", F +- {e['F_err']:.1e} (+ truncation {e['F_truncation']:.1e})" if "F" in e else ""
+    lam = f"lambda +- {e['lambda_err']:.1e}" if e["kind"] != "lambda" else "lambda exact"
+    return f"   [error: {lam}{f}]"
+
+
+def report_curve(s: dict) -> None:
+    """The console lines of a curve's summary (rank 0)."""
+    out = []
+    po = s["pull_off"]
+    extra = f" + {s['error_estimate']['coarse_wall_time_s']:.3g} s for the error estimate" \
+        if "error_estimate" in s else ""
+    out.append(f"mu = {s['mu']:g}  sigma = {s['sigma']:g}  N = {s['n_nodes']}  steps {s['steps']} "
+               f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s{extra}; stopped: {s['stop_reason']}")
+    if po:
+        out.append(f"  pull-off (load control)  lambda = {po['lambda']:.8f}  F = {po['F']:.8f}{_err(po)}")
+        if "F_N" in po:
+            out.append(f"                           = {po['F_N']:.6g} N at an approach of {po['lambda_m']:.6g} m "
+                       f"(mu = {s['mu']:.4g} from -adh_physical)")
+    for f in s["folds"]:
+        land = f.get("landing")
+        to = f"  -> lands at F = {land['F']:.8f}" if land else ""
+        out.append(f"  {f['kind']:<23}  lambda = {f['lambda']:.8f}  F = {f['F']:.8f}{to}{_err(f)}")
+    for e in s["equilibria"]:
+        out.append(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}{_err(e)}")
+    for e in s["at_lambda"]:
+        out.append(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}{_err(e)}")
+    for w in ([s["grid_warning"]] if s["grid_warning"] else []) + s["warnings"]:
+        out.append(f"  WARNING: {w}")
+    PETSc.Sys.Print("\n".join(out), comm=PETSc.COMM_SELF)
+
+
+def report_solve(res: dict) -> None:
+    """The console line of a fixed-approach solve (rank 0)."""
+    PETSc.Sys.Print(f"lambda = {res['lambda']:.10g}  F = {res['F']:.10g}  H0 = {res['H0']:.10g}  "
+                    f"Newton {res['snes_iterations']}  KSP {res['ksp_iterations']}  {res['wall_time_s']:.3g} s",
+                    comm=PETSc.COMM_SELF)
