@@ -160,6 +160,7 @@ def _t(s: float | None) -> str:
 
 
 def report(info: dict, results: dict, profile: dict | None) -> None:
+    """The benchmark table on stdout."""
     print(f"petsc-adhesion {info['version']} bench: PETSc {info['petsc_version']}, 1 rank, "
           f"OPENBLAS_NUM_THREADS={info['openblas_num_threads']}, "
           f"load average {info['load_average']:.2f} on {info['cpu_count']} cores before the runs")
@@ -187,6 +188,7 @@ def report(info: dict, results: dict, profile: dict | None) -> None:
 
 
 def main() -> int:
+    """The benchmark program (options -bench_*); 0 on success."""
     opts = PETSc.Options("bench_")
     repeats = opts.getInt("repeats", 0)         # 0: each quantity's own number
     only = opts.getString("only", "")

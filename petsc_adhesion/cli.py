@@ -1,6 +1,6 @@
 """Command line entry: ``petsc-adhesion [PETSc and application options]``.
 
-    mpiexec -n 2 petsc-adhesion -options_file options/fig5_mu1.opts -snes_monitor
+    mpiexec -n 2 petsc-adhesion -options_file options/fig5_mu1.opts -arc_snes_monitor
 
 Bad input ends in one line on stderr, exit status 2, and no output file.
 """

@@ -152,6 +152,7 @@ class Bordered:
         return a[:self.nloc], self._mpi.bcast(p, root=self.comm.getSize() - 1)
 
     def join(self, x: np.ndarray, p: float, X: PETSc.Vec | None = None) -> PETSc.Vec:
+        """X (default: the solution Vec) set to (x, p)."""
         X = X or self.X
         X.setArray(np.append(x, p) if self.last else x)
         return X
@@ -180,6 +181,7 @@ class Bordered:
         self.join(self.G.getArray(readonly=True), q, R)
 
     def form_jacobian(self, snes, X, K, P):
+        """SNES Jacobian callback: the bordered operator at X, its PC matrix when stale."""
         x, self.p = self.split(X)
         self.x.setArray(x)
         self.linearize(self.reuse(snes.getKSP()))
@@ -198,6 +200,7 @@ class Bordered:
         self.K.assemble()
 
     def precheck(self, X, Y, *args) -> bool:
+        """Line-search pre-check: the domain guard on the x part of the step."""
         x, _ = self.split(X)
         return guard(self.pb, x, Y, Y.getArray(readonly=True)[:self.nloc])
 
@@ -264,6 +267,7 @@ class Continuation:
         self.stop: tuple[str, float] | None = None
 
     def inner(self, u: np.ndarray, v: np.ndarray) -> float:
+        """<u, v> of local parts, summed over ranks."""
         return self.bordered.inner(u, v)
 
     # -- tangents -----------------------------------------------------------

@@ -40,9 +40,11 @@ class Fold:
     needs_tangent = True
 
     def test(self, pt) -> float:
+        """The test function at a point: pdot."""
         return pt.pdot
 
     def label(self, before: float) -> str:
+        """The name of the fold, by the sign of pdot before it."""
         return self.labels[0] if before > 0 else self.labels[1]
 
 
@@ -58,9 +60,11 @@ class Extremum:
     needs_tangent = True
 
     def test(self, pt) -> float:
+        """The test function at a point: the observable's rate d/ds."""
         return pt.rates[self.name]
 
     def label(self, before: float) -> str:
+        """The name of the extremum, by the sign of the rate before it."""
         return self.labels[0] if before < 0 else self.labels[1]
 
 
@@ -74,9 +78,11 @@ class Zero:
     needs_tangent = False
 
     def test(self, pt) -> float:
+        """The test function at a point: observable - level."""
         return pt.values[self.name] - self.level
 
     def label(self, before: float) -> str:
+        """The event's one name."""
         return self.tag
 
 
@@ -89,9 +95,11 @@ class ParameterValue:
     needs_tangent = False
 
     def test(self, pt) -> float:
+        """The test function at a point: p - target."""
         return pt.p - self.target
 
     def label(self, before: float) -> str:
+        """The event's one name."""
         return self.tag
 
 

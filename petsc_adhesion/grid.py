@@ -44,6 +44,12 @@ def load_weights(r: np.ndarray) -> np.ndarray:
 
     Exact for the interpolant of eq. (11); the load of eq. (26) is
     F = (8/3) q . P.
+
+    >>> r = uniform(3, 2.0)                 # nodes 0, 1, 2
+    >>> load_weights(r)                     # P = 1 gives integral_0^2 r dr = 2
+    array([0.16666667, 1.        , 0.83333333])
+    >>> abs(load_weights(r) @ r - 8 / 3) < 1e-15   # P = r: integral_0^2 r^2 dr = 8/3, exact
+    True
     """
     a, b = r[:-1], r[1:]
     h = b - a
@@ -60,6 +66,9 @@ def l2_weights(r: np.ndarray) -> np.ndarray:
     The continuation measures the unknown H in this grid-independent norm: with
     the Euclidean norm of the paper, |lambdadot| would be about N^-1/2 on the
     whole curve and the paper's switch at |lambdadot| = 0.5 would never act.
+
+    >>> l2_weights(uniform(5, 1.0))         # trapezoid rule, weights summing to 1
+    array([0.125, 0.25 , 0.25 , 0.25 , 0.125])
     """
     h = np.diff(r)
     w = np.zeros_like(r)

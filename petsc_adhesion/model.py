@@ -13,7 +13,17 @@ __all__ = ["Model", "tabor", "scales"]
 
 
 def tabor(R: float, gamma: float, E: float, epsilon: float) -> float:
-    """Tabor parameter mu = (R gamma^2 / (E^2 epsilon^3))^(1/3), eq. (9)."""
+    """Tabor parameter mu = (R gamma^2 / (E^2 epsilon^3))^(1/3), eq. (9).
+
+    R radius (m), gamma work of adhesion (J/m^2), E combined modulus of eq. (2)
+    (Pa), epsilon equilibrium spacing (m).  A 1 um particle, gamma = 0.05 J/m^2,
+    E = 1 GPa, epsilon = 0.4 nm:
+
+    >>> round(tabor(1e-6, 0.05, 1e9, 4e-10), 4)
+    3.393
+    >>> round(tabor(1e-6, 0.05, 1e12, 4e-10), 5)   # 1000 times stiffer: mu / 1000^(2/3)
+    0.03393
+    """
     return (R * gamma**2 / (E**2 * epsilon**3)) ** (1.0 / 3.0)
 
 
@@ -39,7 +49,11 @@ class Model:
 
     @property
     def coupling(self) -> float:
-        """c = 32 mu^(3/2) / (3 pi), the elastic coupling of eq. (12)."""
+        """c = 32 mu^(3/2) / (3 pi), the elastic coupling of eq. (12).
+
+        >>> round(Model(mu=1.0).coupling, 6)
+        3.395305
+        """
         return 32.0 * self.mu**1.5 / (3.0 * math.pi)
 
     @property

@@ -153,20 +153,24 @@ class AppOptions:
         return x
 
     def real(self, name: str):
+        """The value of a real option, checked against its range, or its default."""
         o, raw = TABLE[name], self._raw(name)
         return o.default if raw is None else self._number(o, raw, float)
 
     def int(self, name: str):
+        """The value of an integer option, checked against its range, or its default."""
         o, raw = TABLE[name], self._raw(name)
         return o.default if raw is None else int(self._number(o, raw, _strict_int))
 
     def reals(self, name: str) -> tuple:
+        """The values of a comma-separated list of reals, each checked, or the default."""
         o, raw = TABLE[name], self._raw(name)
         if raw is None:
             return o.default
         return tuple(self._number(o, s.strip(), float) for s in raw.split(",") if s.strip())
 
     def choice(self, name: str) -> str:
+        """The value of a choice option, one of its choices, or its default."""
         o, raw = TABLE[name], self._raw(name)
         if raw is None:
             return o.default
@@ -175,6 +179,7 @@ class AppOptions:
         return raw
 
     def string(self, name: str):
+        """The value of a string option (non-empty), or its default."""
         o, raw = TABLE[name], self._raw(name)
         if raw is None:
             return o.default
@@ -183,6 +188,7 @@ class AppOptions:
         return raw
 
     def flag(self, name: str) -> bool:
+        """The value of a flag (bare, or true/false, yes/no, on/off, 1/0), or its default."""
         o, raw = TABLE[name], self._raw(name)
         if raw is None:
             return o.default

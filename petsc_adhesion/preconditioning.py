@@ -55,6 +55,7 @@ class Layout:
 
     @property
     def nloc(self) -> int:
+        """Rows of G_x on this rank."""
         return self.hi - self.lo
 
     def sizes(self, bordered: bool):
@@ -82,11 +83,13 @@ class Dense:
     kind = "dense"
 
     def create(self, layout: Layout, comm: PETSc.Comm, bordered: bool) -> PETSc.Mat:
+        """A dense Mat of the square or bordered size."""
         P = PETSc.Mat().createDense(layout.sizes(bordered), comm=comm)
         P.setUp()
         return P
 
     def fill(self, P: PETSc.Mat, problem, layout: Layout, border: Border | None = None) -> None:
+        """P = G_x (``problem.jacobian_rows``), with the border appended when given."""
         a = P.getDenseArray()
         problem.jacobian_rows(a[:layout.nloc, :layout.N])
         if border is not None:
@@ -138,6 +141,7 @@ class Band:
         return ai2.astype(PETSc.IntType), j.astype(PETSc.IntType), vals
 
     def create(self, layout: Layout, comm: PETSc.Comm, bordered: bool) -> PETSc.Mat:
+        """An AIJ Mat preallocated for the band (and the border)."""
         ai, aj = self.pattern(layout)
         if bordered:
             ai, aj, _ = self._csr(layout, ai, aj, None, Border(np.zeros(0), None, 0.0))
@@ -148,6 +152,7 @@ class Band:
         return P
 
     def fill(self, P: PETSc.Mat, problem, layout: Layout, border: Border | None = None) -> None:
+        """P = the band of G_x (``problem.band_values``), with the border appended when given."""
         ai, aj = self.pattern(layout)
         v = problem.band_values(ai, aj)
         P.setValuesCSR(*self._csr(layout, ai, aj, v, border))
@@ -162,13 +167,15 @@ class Shell:
     kind = "shell"
 
     def create(self, layout: Layout, comm: PETSc.Comm, bordered: bool) -> None:
+        """None: the solvers hand the operator itself to the PC."""
         return None
 
     def fill(self, P, problem, layout: Layout, border: Border | None = None) -> None:
-        pass
+        """Nothing to fill."""
 
     @staticmethod
     def setup_pc(pc: PETSc.PC) -> None:
+        """No preconditioner (-pc_type jacobi reads the shell's diagonal)."""
         pc.setType("none")
 
 

@@ -198,12 +198,14 @@ class _Jacobian:
         self._diag = None
 
     def mult(self, mat, x, y):
+        """y = G_H x (eq. 23)."""
         pb = self.pb
         pb.p.setArray(pb.dp * x.getArray(readonly=True))
         pb.A.mult(pb.p, y)
         y.aypx(-pb.c, x)
 
     def getDiagonal(self, mat, d):
+        """d = diag G_H, for -pc_type jacobi on the shell."""
         pb = self.pb
         if self._diag is None:
             self._diag = pb.A.getDiagonal().getArray(readonly=True).copy()

@@ -183,22 +183,9 @@ def jkr_load(A: ArrayLike, mu: float) -> float | np.ndarray:
     """JKR load at contact radius A (Johnson, Kendall & Roberts 1971).
 
     P = 4 E a^3/(3R) - sqrt(8 pi gamma E a^3) becomes
-    F = (2/(3 pi)) A^3 mu^(-3/2) - sqrt(2 A^3 / (pi mu^(3/2))).
+    F = (2/(3 pi)) A^3 mu^(-3/2) - sqrt(2 A^3 / (pi mu^(3/2))): the load F (units
+    2 pi R gamma) at contact radius A (units sqrt(epsilon R)), Tabor parameter mu > 0.
 
-    Parameters
-    ----------
-    A : array_like
-        Contact radius in units of sqrt(epsilon R).
-    mu : float
-        Tabor parameter > 0.
-
-    Returns
-    -------
-    float or ndarray
-        F in units of 2 pi R gamma.
-
-    Examples
-    --------
     >>> round(jkr_load((9 * np.pi / 8) ** (1 / 3), 1.0), 12)  # at the pull-off radius
     -0.75
     """
@@ -210,21 +197,10 @@ def jkr_load(A: ArrayLike, mu: float) -> float | np.ndarray:
 def jkr_approach(A: ArrayLike, mu: float) -> float | np.ndarray:
     """JKR approach at contact radius A (Johnson, Kendall & Roberts 1971).
 
-    delta = a^2/R - sqrt(2 pi gamma a / E) becomes lambda = A^2 - sqrt(2 pi mu^(3/2) A).
-    JKR's delta is measured from first touch; lambda = delta/epsilon holds to
-    leading order at large mu (lambda ~ mu), an O(1) shift being beyond the model.
-
-    Parameters
-    ----------
-    A : array_like
-        Contact radius in units of sqrt(epsilon R).
-    mu : float
-        Tabor parameter > 0.
-
-    Returns
-    -------
-    float or ndarray
-        lambda.
+    delta = a^2/R - sqrt(2 pi gamma a / E) becomes lambda = A^2 - sqrt(2 pi mu^(3/2) A),
+    A and mu as in :func:`jkr_load`.  JKR's delta is measured from first touch;
+    lambda = delta/epsilon holds to leading order at large mu (lambda ~ mu), an
+    O(1) shift being beyond the model.
     """
     A = np.asarray(A, dtype=float)
     return _out(A**2 - np.sqrt(2.0 * math.pi * mu**1.5 * A))
@@ -233,17 +209,8 @@ def jkr_approach(A: ArrayLike, mu: float) -> float | np.ndarray:
 def jkr_zero_load(mu: float) -> tuple[float, float]:
     """JKR contact radius and approach at zero load (Johnson, Kendall & Roberts 1971).
 
-    A0 = (9 pi/2)^(1/3) mu^(1/2) and lambda0 = [(9 pi/2)^(2/3) - (2 pi (9 pi/2)^(1/3))^(1/2)] mu.
-
-    Parameters
-    ----------
-    mu : float
-        Tabor parameter > 0.
-
-    Returns
-    -------
-    (float, float)
-        (A0, lambda0).
+    Returns (A0, lambda0): A0 = (9 pi/2)^(1/3) mu^(1/2) and
+    lambda0 = [(9 pi/2)^(2/3) - (2 pi (9 pi/2)^(1/3))^(1/2)] mu, for mu > 0.
 
     Examples
     --------
@@ -257,20 +224,9 @@ def jkr_zero_load(mu: float) -> tuple[float, float]:
 def jkr_fixed_grip_pull_off(mu: float) -> tuple[float, float]:
     """JKR pull-off under displacement control, d lambda / dA = 0 (Johnson, Kendall & Roberts 1971).
 
-    At A = (pi/8)^(1/3) mu^(1/2): lambda = -3 (pi/8)^(2/3) mu and F = -5/12 for every mu.
+    Returns (lambda, F) at A = (pi/8)^(1/3) mu^(1/2): lambda = -3 (pi/8)^(2/3) mu and
+    F = -5/12 for every mu > 0.
 
-    Parameters
-    ----------
-    mu : float
-        Tabor parameter > 0.
-
-    Returns
-    -------
-    (float, float)
-        (lambda, F).
-
-    Examples
-    --------
     >>> lam, F = jkr_fixed_grip_pull_off(2.0)
     >>> round(F * 12, 12), round(lam / 2.0, 4)
     (-5.0, -1.6088)

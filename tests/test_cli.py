@@ -321,6 +321,7 @@ PCS = {
     "band_ilu": ("-adh_pmat", "band", "-pc_type", "ilu"),
     "shell": ("-adh_pmat", "shell"),
     "dense_bjacobi": ("-adh_pmat", "dense", "-pc_type", "bjacobi"),
+    "shell_jacobi": ("-adh_pmat", "shell", "-pc_type", "jacobi"),
     "lag2": ("-snes_lag_preconditioner", "2"),
 }
 

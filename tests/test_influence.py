@@ -14,10 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.integrate import IntegrationWarning, quad
-from scipy.special import ellipe, ellipkm1
+from scipy.special import ellipkm1
 
 from petsc_adhesion import grid, influence
 from petsc_adhesion.influence import influence_rows
+from petsc_adhesion.reference import disk_deflection, hertz_deflection
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -46,21 +47,6 @@ GRIDS = {
     "graded": lambda: graded(201),
     "jump_at_zero": jump_at_zero,
 }
-
-
-def disk(r: np.ndarray, a: float) -> np.ndarray:
-    """W for unit pressure on t <= a, at r <= a: a E(r/a)."""
-    return a * ellipe((r / a) ** 2)
-
-
-def hertz(r: np.ndarray, a: float) -> np.ndarray:
-    """W for p = sqrt(1 - t^2 / a^2) on t <= a."""
-    w = np.pi ** 2 / (16 * a) * (2 * a ** 2 - r ** 2)
-    out = r > a
-    ro = r[out]
-    w[out] = np.pi / (8 * a) * ((2 * a ** 2 - ro ** 2) * np.arcsin(a / ro)
-                                + a * np.sqrt(ro ** 2 - a ** 2))
-    return w
 
 
 def quad_entry(r: np.ndarray, i: int, j: int) -> tuple[float, float]:
@@ -110,7 +96,7 @@ def test_row_sums_match_disk_closed_form(name):
     # the hats sum to one on [0, r_m]: A @ 1 is the unit disk of radius r_m
     r = GRIDS[name]()
     w = influence_rows(r, 0, r.size).sum(axis=1)
-    exact = disk(r, r[-1])
+    exact = disk_deflection(r, r[-1])
     assert np.max(np.abs(w - exact) / exact) < 1e-13
 
 
@@ -130,7 +116,7 @@ def observed_order(make, ns=(101, 201, 401, 801), a=1.0):
         r = make(n)
         p = np.sqrt(np.clip(1 - (r / a) ** 2, 0.0, None))
         w = influence_rows(r, 0, n) @ p
-        exact = hertz(r, a)
+        exact = hertz_deflection(r, a)
         errors.append(np.max(np.abs(w - exact)) / np.max(exact))
     return -np.polyfit(np.log(ns), np.log(errors), 1)[0]
 
@@ -175,7 +161,7 @@ def test_petsc_matrix_gives_disk_closed_form(PETSc):
     x, y = A.createVecs()
     x.set(1.0)
     A.mult(x, y)
-    exact = disk(r, r[-1])
+    exact = disk_deflection(r, r[-1])
     assert np.max(np.abs(y.getArray() - exact) / exact) < 1e-13
 
 

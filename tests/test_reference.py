@@ -4,7 +4,6 @@ Every check goes another way than the module: adaptive quadrature of the
 integral the closed form evaluates, a numerical extremum or root of a curve,
 the published formula in physical units, or numbers from another package.
 """
-import doctest
 import math
 import warnings
 
@@ -20,12 +19,6 @@ from petsc_adhesion.reference import (
     DMT_PULL_OFF, JKR_PULL_OFF, RIGID_EQUILIBRIUM, disk_deflection, hertz_deflection,
     jkr_approach, jkr_fixed_grip_pull_off, jkr_load, jkr_zero_load, load_beyond,
     maugis_dugdale_curve, maugis_dugdale_pull_off, maugis_parameter, rigid_load)
-
-
-def test_doctests():
-    result = doctest.testmod(reference, optionflags=doctest.NORMALIZE_WHITESPACE)
-    assert result.attempted > 10
-    assert result.failed == 0
 
 
 # --- rigid sphere, eqs. (26)-(28) --------------------------------------------
