@@ -44,7 +44,8 @@ from . import __version__, grid
 from .influence import create_influence
 from .model import Model
 from .options import AppOptions, InputError, check_unused, read_settings
-from .output import check_writable, write_json
+from .files import ResultSet, check_targets
+from .output import write_json
 from .problem import Problem
 from .solver import Newton
 from .study import discretize, trace
@@ -201,7 +202,8 @@ def main() -> int:
         raise InputError(f"-bench_only: expected one of {', '.join(PARTS)}, got '{only}'")
     if PETSc.COMM_WORLD.getSize() > 1:
         raise InputError("the benchmark runs on one rank")
-    check_writable("bench_json", path or None)
+    if path:
+        check_targets({"bench_json": path})
     load = os.getloadavg()[0]
 
     parts = (only,) if only else PARTS
@@ -218,7 +220,9 @@ def main() -> int:
             "load_average": load, "cpu_count": os.cpu_count()}
     report(info, results, top)
     if path:
-        write_json(path, {**info, "results": results, **({"curve_profile": top} if top else {})})
+        files = ResultSet({"bench_json": path})
+        write_json(files.temp("bench_json"), {**info, "results": results, **({"curve_profile": top} if top else {})})
+        files.commit()
     return 0
 
 

@@ -2,75 +2,111 @@
 
     mpiexec -n 2 petsc-adhesion -options_file options/fig5_mu1.opts -arc_snes_monitor
 
-Bad input ends in one line on stderr, exit status 2, and no output file.
+Exit status: 0 done; 1 failed (no result); 2 bad input (one line naming the
+option, nothing written); 3 result written but not what was asked for
+(a stalled curve, an event not reached: its warnings say why); 130 and 143
+interrupted by SIGINT or SIGTERM (nothing written).  Every error is one line
+on stderr from rank 0; no traceback reaches the user.
 """
 from __future__ import annotations
 
-import os
+import signal
 import sys
 
-__all__ = ["main"]
+from .files import printable
+from .optionsfile import environment_error, file_error, options_files
+
+__all__ = ["main", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
+
+EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INCOMPLETE = 0, 1, 2, 3
 
 
-def _options_files(argv: list[str]) -> list[str]:
-    """The files named by -options_file on the command line."""
-    return [argv[i + 1] if i + 1 < len(argv) else "" for i, a in enumerate(argv) if a == "-options_file"]
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM: end cleanly, with the signal's exit status."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
 
 
-def _options_file_error(path: str) -> str | None:
-    """What PETSc would abort on in an options file, said in one line (None: fine).
-
-    Its syntax: a line is '-name [value]' or 'alias -name -other', '#' and '!'
-    start comments; a nested -options_file is checked too.
-    """
-    if not path or not os.path.isfile(path) or not os.access(path, os.R_OK):
-        return f"-options_file: cannot read '{path}'"
-    with open(path, errors="replace") as f:
-        for n, line in enumerate(f, 1):
-            tokens = line.split("#")[0].split("!")[0].split()
-            ok = not tokens or (tokens[0] == "alias" and len(tokens) == 3) or \
-                (tokens[0].startswith("-") and len(tokens) <= 2)
-            if not ok:
-                return f"-options_file {path}: line {n}: expected '-name [value]', got '{line.strip()}'"
-            if tokens and tokens[0] == "-options_file":
-                inner = _options_file_error(tokens[1] if len(tokens) > 1 else "")
-                if inner:
-                    return inner
-    return None
+def _on_signal(signum, frame):
+    raise Interrupted(signum)
 
 
-def _error(msg: str, status: int) -> int:
-    """Say ``msg`` once, on rank 0's stderr; return the exit status."""
+def _say(msg: str) -> None:
+    """One line on rank 0's stderr."""
     from mpi4py import MPI
 
     if MPI.COMM_WORLD.Get_rank() == 0:
-        print(f"petsc-adhesion: error: {msg}", file=sys.stderr, flush=True)
-    return status
+        print(f"petsc-adhesion: error: {printable(msg)}", file=sys.stderr, flush=True)
+
+
+def _first_line(e: BaseException) -> str:
+    text = str(e).strip()
+    return text.splitlines()[0] if text else type(e).__name__
+
+
+def _version() -> str:
+    from petsc4py import PETSc
+
+    from . import __version__
+
+    return f"petsc-adhesion {__version__} (PETSc {'%d.%d.%d' % PETSc.Sys.getVersion()})"
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the program on ``argv`` (default: sys.argv); the exit status: 0, 1 (failed), 2 (bad input)."""
+    """Run the program on ``argv`` (default: sys.argv) and return its exit status (see the module)."""
     argv = list(sys.argv if argv is None else argv)
+    old = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        return _main(argv)
+    except Interrupted as e:
+        _say(f"interrupted by {signal.Signals(e.signum).name}; nothing written")
+        return 128 + e.signum
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+
+
+def _main(argv: list[str]) -> int:
     # PETSc aborts with a page of text on a bad options file: say it in one line first
-    for path in _options_files(argv):
-        bad = _options_file_error(path)
+    for path in options_files(argv):
+        bad = file_error(path)
         if bad:
-            return _error(bad, 2)
+            _say(bad)
+            return EXIT_INPUT
+    bad = environment_error(argv)
+    if bad:
+        _say(bad)
+        return EXIT_INPUT
     import petsc4py
     petsc4py.init(argv)
+    from mpi4py import MPI
     from petsc4py import PETSc
 
     from .options import InputError, petsc_error
     from .study import main as study
 
+    if "-version" in argv:
+        PETSc.Sys.Print(_version())
+        return EXIT_OK
     try:
-        return study()
+        return study(argv)
     except InputError as e:
-        return _error(str(e), 2)
+        _say(str(e))
+        return EXIT_INPUT
     except PETSc.Error as e:
         bad = petsc_error(e)
-        return _error(str(bad), 2) if bad else _error(f"PETSc error {e.ierr}", 1)
-    except OSError as e:
-        return _error(f"cannot write '{e.filename}': {e.strerror}", 1)
-    except (RuntimeError, FloatingPointError) as e:
-        return _error(str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__, 1)
+        _say(str(bad) if isinstance(bad, InputError) else bad)
+        return EXIT_INPUT if isinstance(bad, InputError) else EXIT_FAILED
+    except (RuntimeError, FloatingPointError, OSError) as e:
+        what = f"cannot write '{e.filename}': {e.strerror}" if isinstance(e, OSError) and e.filename \
+            else _first_line(e)
+        _say(what)
+        return EXIT_FAILED
+    except Exception as e:                                  # a defect: still one line, no hang
+        print(f"petsc-adhesion: internal error on rank {MPI.COMM_WORLD.Get_rank()}: "
+              f"{type(e).__name__}: {printable(_first_line(e))}", file=sys.stderr, flush=True)
+        if MPI.COMM_WORLD.Get_size() > 1:
+            MPI.COMM_WORLD.Abort(EXIT_FAILED)
+        return EXIT_FAILED

@@ -8,21 +8,23 @@ pacopy's ``f``, ``df_dlmbda``, ``jacobian_solver``, ``inner``):
 ``parameter``                      name of p, for monitors
 ``create_vec()``                   a Vec in the layout of x and of G
 ``residual(x, p, G)``              G(x, p) into the Vec G, at the p passed in
-``dG_dp(x, p, out)``               dG/dp on the local rows, into the array ``out``
+``dG_dp(x, p, out)``               dG/dp on the local rows into the array ``out``; returns ``out``
 ``linearize(x, p)``                set the point of ``jacobian``
 ``jacobian``                       the Mat G_x at that point (may be a shell)
 ``create_pmat(bordered)``          the Mat the PC is built from, for G_x or for the bordered
                                    matrix [[G_x, G_p], [w xdot^T, pdot]]; None: the operator
 ``fill_pmat(P, border=None)``      assemble it at the linearization point (border: a
                                    :class:`~petsc_adhesion.preconditioning.Border`)
-``setup_pc(pc)``                   the default PC for that matrix
+``setup_pc(pc, bordered)``         the default PC for the square or the bordered matrix
 ``weights``                        local weights w of the inner product <u, v> = sum w u v
 ``inside(x)``                      domain guard: is the local part x admissible (collective)
 ``step_fraction(x, y)``            domain guard: largest fraction of the step x -> x - y allowed
 ``observe(x, p, xdot, pdot)``      named observables and their rates d/ds: two dicts
 =================================  ============================================================
 
-x arrays are the rank's local parts (numpy); the parameter is a float.
+``residual``, ``dG_dp`` and ``linearize`` get x as a PETSc Vec; ``inside``,
+``step_fraction``, ``observe`` and ``weights`` deal in the rank's local parts
+(numpy arrays); the parameter is a float.
 
 The curve is followed in X = (x, p) with the inner product <x, y> + p q.
 
@@ -102,8 +104,9 @@ class Settings:
     observable_step: float = 0.2    # its largest change in one step, relative above magnitude 1
     observable_max: float = math.inf  # stop when the observable reaches this
     p_max: float = math.inf         # stop when the parameter reaches this
+    p_min: float = -math.inf        # or falls to this
     max_steps: int = 2000
-    max_folds: int = 12             # stop after this many turning points
+    max_folds: int = 12             # stop after more than this many turning points
     pc_reuse_its: int = PC_REUSE_ITS
     monitor: bool = False           # one line a step
 
@@ -124,7 +127,7 @@ class Bordered:
         self.last = comm.getRank() == comm.getSize() - 1
         n1 = 1 if self.last else 0
         self.X = PETSc.Vec().createMPI((self.nloc + n1, N + 1), comm=comm)
-        self.rhs, self.z, self.start, self.R = (self.X.duplicate() for _ in range(4))
+        self.rhs, self.z, self.start, self.R, self.r = (self.X.duplicate() for _ in range(5))
 
         def dense(rows, cols):
             M = PETSc.Mat().createDense((rows, cols), comm=comm)
@@ -139,7 +142,8 @@ class Bordered:
         self.pmat = pb.create_pmat(bordered=True)
         self.reuse = PCReuse(pc_reuse_its)
         self.snes = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R, self.form_jacobian,
-                                self.K, self.pmat or self.K, pb.setup_pc, self.precheck, full_steps=True)
+                                self.K, self.pmat or self.K, pb.setup_pc, self.precheck, full_steps=True,
+                                bordered=True)
         # the hyperplane Q of eq. (24): through (x0, p0), normal (xdot, pdot), at distance ds
         self.x0, self.p0, self.xdot, self.pdot, self.ds = None, 0.0, None, 1.0, 0.0
         self.p = 0.0
@@ -234,7 +238,8 @@ class Bordered:
             self.rhs.setValue(self.rhs.getSize() - 1, 1.0)
         self.rhs.assemble()
         ksp = self.snes.getKSP()
-        if not krylov_retry(ksp, self.K, self.pmat or self.K, self.rhs, self.z, self.reuse, self.linearize):
+        if not krylov_retry(ksp, self.K, self.pmat or self.K, self.rhs, self.z, self.reuse, self.linearize,
+                            self.r):
             return None
         zx, zp = self.split(self.z)
         norm = math.sqrt(self.inner(zx, zx) + zp * zp)
@@ -243,7 +248,7 @@ class Bordered:
     def destroy(self) -> None:
         """Free the PETSc objects made here."""
         for obj in (self.snes, self.K, self.pmat, self.column, self.row, self.corner,
-                    self.X, self.rhs, self.z, self.start, self.R, self.x, self.G):
+                    self.X, self.rhs, self.z, self.start, self.R, self.r, self.x, self.G):
             if obj is not None:
                 obj.destroy()
 
@@ -252,14 +257,14 @@ class Continuation:
     """Trace a curve of G(x, p) = 0 from a start point; collect the points and step statistics.
 
     ``stop`` after :meth:`run`: (reason, value) with reason one of
-    "observable_max", "p_max", "max_steps", "max_folds", "ds_min".
+    "observable_max", "p_max", "p_min", "max_steps", "max_folds", "ds_min".
     """
 
     def __init__(self, problem, settings: Settings | None = None):
         self.pb, self.set = problem, settings or Settings()
         self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its)
         self.bordered = Bordered(problem, self.set.pc_reuse_its)
-        self._x, self._xt, self._rhs, self._phi = (problem.create_vec() for _ in range(4))
+        self._x, self._xt, self._rhs, self._phi, self._r = (problem.create_vec() for _ in range(5))
         self._gp = np.zeros(self._x.getLocalSize())
         self.points: list[Point] = []
         self.rejected = 0
@@ -278,7 +283,7 @@ class Continuation:
         self._rhs.setArray(-pb.dG_dp(self._xt, p, self._gp))
         ksp = newton.snes.getKSP()
         if not krylov_retry(ksp, pb.jacobian, newton.pmat or pb.jacobian, self._rhs, self._phi, newton.reuse,
-                            lambda refill: newton.linearize(self._xt, refill)):
+                            lambda refill: newton.linearize(self._xt, refill), self._r):
             return None
         phi = self._phi.getArray(readonly=True).copy()
         a = 1.0 / math.sqrt(1.0 + self.inner(phi, phi))
@@ -291,8 +296,9 @@ class Continuation:
         values, rates = self.pb.observe(x, p, xdot, pdot)
         return Point(x=x, p=p, xdot=xdot, pdot=pdot, values=values, rates=rates, **kw)
 
-    def start(self, guess: PETSc.Vec, p0: float) -> Point:
-        """Solve at p0 from ``guess`` (natural corrector's SNES); tangent pointing to larger p.
+    def start(self, guess: PETSc.Vec, p0: float, direction: int = 1) -> Point:
+        """Solve at p0 from ``guess`` (natural corrector's SNES); tangent towards larger p (``direction`` 1)
+        or smaller (-1).
 
         RuntimeError when Newton or the tangent fails there.
         """
@@ -302,7 +308,7 @@ class Continuation:
             raise RuntimeError(f"no solution at the start {self.pb.parameter} = {p0:g}")
         a = x.getArray(readonly=True).copy()
         x.destroy()
-        tan = self.bordered.tangent(a, p0, np.zeros_like(a), 1.0)
+        tan = self.bordered.tangent(a, p0, np.zeros_like(a), float(direction))
         if tan is None:
             raise RuntimeError(f"no tangent at the start {self.pb.parameter} = {p0:g}")
         xdot, pdot, kits = tan
@@ -384,6 +390,8 @@ class Continuation:
             return "observable_max", b.values[s.observable]
         if b.p >= s.p_max:
             return "p_max", b.p
+        if b.p <= s.p_min:
+            return "p_min", b.p
         if len(self.points) > s.max_steps:
             return "max_steps", s.max_steps
         if self.folds > s.max_folds:
@@ -437,5 +445,5 @@ class Continuation:
         """Free the PETSc objects made here."""
         self.newton.destroy()
         self.bordered.destroy()
-        for v in (self._x, self._xt, self._rhs, self._phi):
+        for v in (self._x, self._xt, self._rhs, self._phi, self._r):
             v.destroy()

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
 from petsc4py import PETSc
 
 from . import capi, grid, preconditioning
+from .errors import InputError
 from .continuation import ARCLENGTH_PREFIX, CORRECTORS, NATURAL_PREFIX, Settings
 from .events import EVENT_TOL
 from .model import Model, tabor
@@ -24,11 +26,8 @@ from .solver import PC_REUSE_ITS
 
 __all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "petsc_error", "print_help",
            "read_model", "read_grid", "read_settings", "read_physical", "read_guess", "check_memory",
-           "F_MAX", "SOLVER_PREFIXES"]
-
-
-class InputError(Exception):
-    """Bad user input: reported as one line, with a non-zero exit status."""
+           "check_consistency", "check_petsc_values", "collective", "smallest_domain", "petsc_names",
+           "F_MAX", "SOLVER_PREFIXES", "PETSC_GLOBAL"]
 
 
 @dataclass(frozen=True)
@@ -43,18 +42,19 @@ class Option:
     hi: float = math.inf
     lo_open: bool = False
     choices: tuple = ()
+    hi_open: bool = False
 
     def allowed(self) -> str:
         """What the option accepts, in words."""
         if self.kind == "choice":
             return "one of " + ", ".join(self.choices)
         if self.kind in ("real", "int", "reals"):
-            left = "(" if self.lo_open else "["
+            left, right = "(" if self.lo_open else "[", ")" if self.hi_open else "]"
             what = {"real": "a finite real", "int": "an integer",
                     "reals": "comma-separated finite reals"}[self.kind]
             if self.lo == -math.inf and self.hi == math.inf:
                 return what
-            return f"{what} in {left}{_fmt(self.lo)}, {_fmt(self.hi)}]"
+            return f"{what} in {left}{_fmt(self.lo)}, {_fmt(self.hi)}{right}"
         return {"string": "a file name", "flag": "true or false"}[self.kind]
 
 
@@ -105,8 +105,8 @@ TABLE = {o.name: o for o in [
     Option("cont_max_steps", "int", _S.max_steps, "stop after this many accepted steps", 1, 10**7),
     Option("cont_dF_max", "real", _S.observable_step, "largest change of the load in one step, relative above "
            "|F| = 1", 0.0, 1e6, lo_open=True),
-    Option("cont_max_folds", "int", _S.max_folds, "stop after this many turning points (a grid that traps the "
-           "contact edge makes dozens)", 0, 10**6),
+    Option("cont_max_folds", "int", _S.max_folds, "stop after more than this many turning points (a grid that "
+           "traps the contact edge makes dozens)", 0, 10**6),
     Option("cont_ds", "real", _S.ds, "first arclength step", 0.0, 1e3, lo_open=True),
     Option("cont_ds_min", "real", _S.ds_min, "smallest step before giving up", 0.0, 1e3, lo_open=True),
     Option("cont_ds_max", "real", _S.ds_max, "largest step", 0.0, 1e3, lo_open=True),
@@ -148,7 +148,7 @@ class AppOptions:
             x = cast(raw)
         except ValueError:
             raise self._bad(o, raw) from None
-        if not math.isfinite(x) or x > o.hi or x < o.lo or (o.lo_open and x == o.lo):
+        if not math.isfinite(x) or x > o.hi or x < o.lo or (o.lo_open and x == o.lo) or (o.hi_open and x == o.hi):
             raise self._bad(o, raw)
         return x
 
@@ -260,6 +260,81 @@ def read_settings(opts: AppOptions) -> Settings:
                     pc_reuse_its=opts.int("adh_pc_reuse_its"), monitor=opts.flag("cont_monitor"))
 
 
+#: The attraction beyond r_m may carry at most this share of the DMT pull-off at contact.
+DOMAIN_SHARE = 0.05
+
+
+def smallest_domain(mu: float) -> float:
+    """The smallest r_m that holds the contact: the JKR contact radius at zero load, and the
+    radius beyond which the rigid sphere's attraction carries at most DOMAIN_SHARE of F = -1."""
+    from scipy.optimize import brentq
+
+    from .reference import jkr_zero_load, load_beyond
+
+    reach = brentq(lambda r: abs(load_beyond(r, 0.0)) - DOMAIN_SHARE, 0.1, 100.0)
+    return max(reach, jkr_zero_load(mu)[0] if mu > 0 else 0.0)
+
+
+def _given(opts: AppOptions, names) -> list[str]:
+    return [n for n in names if opts.db.hasName(n)]
+
+
+def check_consistency(opts: AppOptions, model: Model) -> None:
+    """Refuse contradictions and options the chosen run ignores, before any work."""
+    fixed = opts.real("adh_lambda") is not None
+    ignored = []
+    if fixed:
+        ignored += [(n, "applies to a curve, not with -adh_lambda") for n in
+                    _given(opts, [n for n in TABLE if n.startswith("cont_")] + ["profiles", "plot"])]
+    kind = opts.choice("grid_type")
+    if kind == "paper":
+        ignored += [(n, "is a -grid_type uniform option") for n in _given(opts, ["grid_n"])]
+    else:
+        ignored += [(n, "is a -grid_type paper option") for n in _given(opts, [n for n in TABLE
+                                                                                if n.startswith("grid_paper_")])]
+    if model.sigma == 0 or model.roughness == "none":
+        ignored += [(n, "sets the roughness average, not used at -adh_sigma 0") for n in
+                    _given(opts, ["adh_hermite_points"])]
+    if opts.choice("adh_pmat") != "band":
+        ignored += [(n, "applies to -adh_pmat band") for n in _given(opts, ["adh_pmat_band"])]
+    if ignored:
+        name, why = ignored[0]
+        raise InputError(f"-{name}: {why}; remove it")
+    start, stop = opts.real("cont_lambda_start"), opts.real("cont_lambda_max")
+    if start is not None and stop is not None and start >= stop:
+        raise InputError(f"-cont_lambda_start: {start:g} is not below -cont_lambda_max {stop:g}")
+    ds, lo, hi = opts.real("cont_ds"), opts.real("cont_ds_min"), opts.real("cont_ds_max")
+    if lo > hi:
+        raise InputError(f"-cont_ds_min: {lo:g} is above -cont_ds_max {hi:g}")
+    if not lo <= ds <= hi:
+        raise InputError(f"-cont_ds: {ds:g} is outside [-cont_ds_min, -cont_ds_max] = [{lo:g}, {hi:g}]")
+    for t in opts.reals("cont_at_lambda"):
+        if (start is not None and t < start) or (stop is not None and t > stop):
+            raise InputError(f"-cont_at_lambda: {t:g} is outside the traced range "
+                             f"[{'-inf' if start is None else f'{start:g}'}, {'inf' if stop is None else f'{stop:g}'}]")
+    if opts.db.hasName("adh_rmax") and model.rmax < smallest_domain(model.mu):
+        raise InputError(f"-adh_rmax: {model.rmax:g} leaves out part of the contact at mu = {model.mu:g}: "
+                         f"expected at least {smallest_domain(model.mu):.3g} (the JKR contact radius, or the "
+                         f"reach of {DOMAIN_SHARE:.0%} of the attraction)")
+
+
+def collective(comm, check, *args):
+    """Run ``check(*args)`` on every rank; an InputError on any rank is raised on all (rank order).
+
+    Keeps a check that fails on one rank only (a file part, a path) from
+    leaving the others waiting in a collective call.
+    """
+    try:
+        out, why = check(*args), None
+    except InputError as e:
+        out, why = None, str(e)
+    whys = comm.tompi4py().allgather(why)
+    first = next((w for w in whys if w), None)
+    if first:
+        raise InputError(first)
+    return out
+
+
 def check_memory(n: int, pmat: str, curve: bool, ranks: int) -> None:
     """Refuse a grid whose dense matrices cannot fit: A, and G_H and the bordered
     matrix when assembled densely, N^2 doubles each, split over the ranks."""
@@ -293,53 +368,102 @@ def read_guess(problem, lam: float, path: str | None) -> PETSc.Vec:
 
 
 # -- PETSc's errors and options ------------------------------------------------------
-#: PETSc error codes that mean a bad option value: unknown type, wrong argument, out of range.
-_INPUT_CODES = (86, 62, 63)
+#: PETSc error codes that mean a bad option value: unknown type, wrong argument, out of range, no support.
+_INPUT_CODES = (56, 62, 63, 86, 92)
+#: Words of option names too common to say which option a PETSc message is about.
+_GENERIC = {"type", "snes", "ksp", "view", "monitor", "options", "file", "grid", "cont", "adh"}
 
 
-def petsc_error(err: PETSc.Error) -> InputError | None:
-    """The InputError behind a PETSc error raised by a bad option value, if it is one.
+def petsc_error(err: PETSc.Error) -> InputError | str:
+    """What a PETSc error means for the user: the option behind it (an InputError), or one line.
 
     PETSc keeps the specific message of its last error (PetscErrorMessage); the
-    option is found as the one whose value the message quotes.
+    option is the one whose value the message quotes, else one whose name's
+    words it uses ("Restart must be positive": -ksp_gmres_restart).
     """
-    if err.ierr not in _INPUT_CODES:
-        return None
-    detail = capi.error_message(err.ierr)
-    words = set(detail.replace("'", " ").replace('"', " ").split())
-    named = [k for k, v in PETSc.Options().getAll().items() if v and v in words]
-    where = f"-{named[0]} {PETSc.Options().getString(named[0])}: " if named else ""
-    return InputError(f"{where}{detail}")
+    detail = capi.error_message(err.ierr) or f"PETSc error {err.ierr}"
+    given = PETSc.Options().getAll()
+    words = set(detail.lower().replace("'", " ").replace('"', " ").replace(",", " ").replace(":", " ").split())
+    by_value = [k for k, v in given.items() if v and v.lower() in words]
+    by_name = [k for k in given if any(len(w) >= 3 and w not in _GENERIC and w in words for w in k.lower().split("_"))]
+    named = by_value or by_name
+    if named:
+        value = f" {given[named[0]]}" if given[named[0]] else ""
+        return InputError(f"-{named[0]}{value}: {detail}")
+    if err.ierr in _INPUT_CODES:
+        return InputError(detail)
+    return f"PETSc error {err.ierr}: {detail}"
 
 
-# A few PETSc options users type, for the did-you-mean hint only.
-_PETSC_COMMON = ["snes_monitor", "ksp_monitor", "snes_view", "ksp_view", "log_view",
-                 "snes_rtol", "snes_atol", "snes_max_it", "ksp_rtol", "ksp_type", "pc_type",
-                 "snes_lag_preconditioner", "options_file", "help", "snes_converged_reason",
-                 "ksp_converged_reason", "pc_factor_mat_solver_type", "sub_pc_type"]
+#: Options PETSc itself reads at start-up or at the end of every program: never unknown.
+PETSC_GLOBAL = ("options_left", "options_view", "get_total_flops", "checkstack", "nox", "viewer_binary_skip_info",
+                "options_suppress_deprecated_warnings", "options_monitor", "memory_view", "malloc_view",
+                "malloc_dump", "objects_dump", "log_view", "log_view_memory", "help", "version", "skip_petscrc",
+                "options_file", "info", "malloc_debug", "malloc_test", "fp_trap", "on_error_abort",
+                "no_signal_handler", "history", "log_trace", "log_all", "log_exclude", "log_sync")
 _SOLVER_OPTIONS = ("snes_", "ksp_", "pc_", "sub_", "mat_")
+#: PETSc option names from PETSc's own -help (see :func:`petsc_names`), for the did-you-mean hint.
+_NAMES_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "petsc_options.txt")
+
+
+def petsc_names() -> list[str]:
+    """PETSc's option names (without prefix) that this program's solvers can read.
+
+    The list is PETSc's own -help output over the solver configurations the
+    program offers, made by ``python -m petsc_adhesion.options``.
+    """
+    with open(_NAMES_FILE) as f:
+        return [ln.strip() for ln in f if ln.strip() and not ln.startswith("#")]
+
+
+def _prefixes() -> tuple:
+    return tuple(p for p, _ in SOLVER_PREFIXES)
 
 
 def check_unused(judged=lambda name: True) -> None:
     """Raise :class:`InputError` for an option that nobody read.
 
     ``judged`` picks the options to judge: the application's own, which are
-    all read up front, before any work; or all of them at the end of a run,
-    when PETSc has read its own.
+    all read up front, before any work; or all of them once the solvers are
+    set up, when PETSc has read its own.
     """
-    left = [n for n in capi.options_left() if judged(n)]
+    left = [n for n in capi.options_left() if judged(n) and n not in PETSC_GLOBAL]
     if not left:
         return
     name = left[0]
-    bare = next((name[len(p):] for p, _ in SOLVER_PREFIXES if p and name.startswith(p)), name)
-    if bare in _PETSC_COMMON and bare.startswith(_SOLVER_OPTIONS):
+    bare = next((name[len(p):] for p in _prefixes() if p and name.startswith(p)), name)
+    names = petsc_names()
+    if bare in names and bare.startswith(_SOLVER_OPTIONS):
         where = ", ".join(f"-{p}{bare} for {what}" for p, what in SOLVER_PREFIXES)
         block = " (and a sub-PC option needs a block PC)" if bare.startswith("sub_") else ""
         raise InputError(f"-{name}: not used by the solvers this run configures{block}; use {where}")
-    near = difflib.get_close_matches(name, list(TABLE) + _PETSC_COMMON
-                                     + [p + n for p, _ in SOLVER_PREFIXES if p for n in _PETSC_COMMON], n=1)
+    candidates = list(TABLE) + [p + n for p in _prefixes() for n in names]
+    near = difflib.get_close_matches(name, candidates, n=1, cutoff=0.75)
     hint = f" (did you mean -{near[0]}?)" if near else ""
     raise InputError(f"-{name}: unknown option{hint}; -help lists the options")
+
+
+#: PETSc's solver options whose values PETSc accepts out of range or takes as "default"
+#: without a word: name -> (kind, lowest, highest, lowest open, highest open).
+_PETSC_RANGES = {
+    "snes_rtol": ("real", 0.0, 1.0, False, True), "snes_atol": ("real", 0.0, math.inf, False, False),
+    "snes_stol": ("real", 0.0, 1.0, False, True), "snes_max_it": ("int", 1, 10**9, False, False),
+    "snes_max_funcs": ("int", 1, 10**12, False, False), "ksp_rtol": ("real", 0.0, 1.0, False, True),
+    "ksp_atol": ("real", 0.0, math.inf, False, False), "ksp_max_it": ("int", 1, 10**9, False, False),
+    "ksp_divtol": ("real", 1.0, math.inf, True, False), "snes_linesearch_damping": ("real", 0.0, 1.0, True, False),
+    "snes_linesearch_max_it": ("int", 1, 10**6, False, False), "ksp_gmres_restart": ("int", 1, 10**6, False, False),
+}
+
+
+def check_petsc_values(db: PETSc.Options | None = None) -> None:
+    """Raise :class:`InputError` for a solver tolerance or count out of its range, under any prefix."""
+    db = db or PETSc.Options()
+    for prefix in _prefixes():
+        for name, (kind, lo, hi, lo_open, hi_open) in _PETSC_RANGES.items():
+            if not db.hasName(prefix + name):
+                continue
+            o = Option(prefix + name, kind, None, "", lo, hi, lo_open, hi_open=hi_open)
+            AppOptions(db)._number(o, db.getString(prefix + name, ""), float if kind == "real" else _strict_int)
 
 
 def print_help(out) -> None:
@@ -352,3 +476,32 @@ def print_help(out) -> None:
               "-{prefix}pc_*):\n")
     for prefix, what in SOLVER_PREFIXES:
         out.write(f"  -{prefix}snes_...: {what}\n")
+
+
+def _write_petsc_names() -> None:
+    """Collect PETSc's option names from its -help over the solver configurations offered here."""
+    import re
+    import subprocess
+    import sys
+
+    names = set()
+    base = [sys.executable, "-m", "petsc_adhesion", "-help", "-adh_lambda", "-2", "-grid_type", "uniform",
+            "-grid_n", "21"]
+    variants = [("-adh_pmat", kind, "-pc_type", pc) for kind in ("dense", "band")
+                for pc in ("lu", "ilu", "bjacobi", "asm", "jacobi", "none", "hypre", "gamg", "cholesky", "icc")]
+    variants += [("-ksp_type", k) for k in ("fgmres", "bcgs", "cg", "lgmres", "gcr")]
+    variants += [("-snes_linesearch_type", k) for k in ("basic", "l2", "cp")]
+    variants += [("-adh_pmat", "band", "-pc_type", "lu", "-pc_factor_mat_solver_type", "mumps")]
+    for extra in variants:
+        proc = subprocess.run(base + list(extra), capture_output=True, text=True)
+        names |= set(re.findall(r"^\s+-([a-z][a-z0-9_]*)", proc.stdout, re.M))
+    names -= set(TABLE)
+    names |= {"sub_" + n for n in names if n.startswith(("ksp_", "pc_"))}
+    with open(_NAMES_FILE, "w") as f:
+        f.write(f"# PETSc {'%d.%d.%d' % PETSc.Sys.getVersion()} option names from its -help over the solver "
+                "configurations petsc-adhesion offers;\n# made by: python -m petsc_adhesion.options\n")
+        f.write("\n".join(sorted(names)) + "\n")
+
+
+if __name__ == "__main__":
+    _write_petsc_names()

@@ -1,54 +1,20 @@
-"""Result files: their layout (docs/output.md) and their writing, by rank 0, atomically.
+"""Result files: their layout (docs/output.md) and their writing, by rank 0.
 
-A file is written under a temporary name in its target directory and renamed
-into place, so a reader never sees a partial file and a failed run leaves none.
 The layout of a curve or a solve is built here from the result dicts of
-:mod:`petsc_adhesion.results`, once for the JSON summary and the HDF5 tree.
+:mod:`petsc_adhesion.results`, once for the JSON summary and the HDF5 tree;
+the files of one run are written into the temporaries of a
+:class:`~petsc_adhesion.files.ResultSet` and committed together.
 """
 from __future__ import annotations
 
 import json
 import os
-import tempfile
-from contextlib import contextmanager
 
 import numpy as np
 
-from .options import InputError
+from .files import PLOT_FORMATS, ResultSet
 
-__all__ = ["check_writable", "atomic", "write_h5", "write_json", "curve_summary", "curve_tree",
-           "write_curve", "write_solve"]
-
-
-def check_writable(option: str, path: str | None) -> None:
-    """Fail early, before any work, when ``path`` cannot be created (by trying)."""
-    if path is None:
-        return
-    folder = os.path.dirname(os.path.abspath(path))
-    if os.path.isdir(path):
-        raise InputError(f"-{option}: '{path}' is a directory")
-    if not os.path.isdir(folder):
-        raise InputError(f"-{option}: cannot write '{path}' (no directory '{folder}')")
-    try:
-        with atomic(path, keep=False):
-            pass
-    except OSError as e:
-        raise InputError(f"-{option}: cannot write '{path}' ({e.strerror})") from None
-
-
-@contextmanager
-def atomic(path: str, keep: bool = True):
-    """Yield a temporary path next to ``path``; rename it to ``path`` on success (``keep``)."""
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=folder)
-    os.close(fd)
-    try:
-        yield tmp
-        if keep:
-            os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+__all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve", "write_solve"]
 
 
 def _write(group, tree: dict) -> None:
@@ -67,12 +33,11 @@ def _write(group, tree: dict) -> None:
 
 
 def write_h5(path: str, tree: dict) -> None:
-    """The tree as an HDF5 file (see :func:`_write`), atomically."""
+    """The tree as an HDF5 file (see :func:`_write`)."""
     import h5py
 
-    with atomic(path) as tmp:
-        with h5py.File(tmp, "w") as f:
-            _write(f, tree)
+    with h5py.File(path, "w") as f:
+        _write(f, tree)
 
 
 def _plain(x):
@@ -86,11 +51,10 @@ def _plain(x):
 
 
 def write_json(path: str, summary: dict) -> None:
-    """The summary as JSON (no NaN allowed), atomically."""
-    with atomic(path) as tmp:
-        with open(tmp, "w") as f:
-            json.dump(_plain(summary), f, indent=1, allow_nan=False)
-            f.write("\n")
+    """The summary as JSON (no NaN allowed)."""
+    with open(path, "w") as f:
+        json.dump(_plain(summary), f, indent=1, allow_nan=False)
+        f.write("\n")
 
 
 # -- layout ---------------------------------------------------------------------
@@ -120,7 +84,8 @@ def curve_summary(res: dict, head: dict) -> dict:
          "load_extrema": [_brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
          "at_lambda": [_brief(e) for e in ev if e["kind"] == "lambda"],
          "steps": res["steps"], "rejected_steps": res["rejected_steps"], "stop_reason": res["stop_reason"],
-         "grid_warning": res["grid_warning"], "warnings": res["warnings"], "wall_time_s": res["wall_time_s"]}
+         "grid_warning": res["grid_warning"], "warnings": res["warnings"], "complete": not res["incomplete"],
+         "lambda_start": res["lambda_start"], "wall_time_s": res["wall_time_s"]}
     if "error_estimate" in res:
         s["error_estimate"] = res["error_estimate"]
     if "scales" in head and s["pull_off"]:
@@ -142,35 +107,28 @@ def curve_tree(res: dict, head: dict, summary: dict) -> dict:
             "summary": {k: v for k, v in summary.items() if not isinstance(v, (list, dict)) and v is not None}}
 
 
-def write_curve(res: dict, head: dict, out, summary, plot) -> dict:
-    """Files of a traced curve; returns the summary."""
+def write_curve(res: dict, head: dict, files: ResultSet) -> dict:
+    """The files of a traced curve, committed together; returns the summary."""
     summ = curve_summary(res, head)
     tree = curve_tree(res, head, summ)
-    if out:
-        write_h5(out, tree)
-    if plot:
-        _draw(plot, tree, out)
-    if summary:
-        write_json(summary, summ)
+    if "out" in files.targets:
+        write_h5(files.temp("out"), tree)
+    if "plot" in files.targets:
+        from .plot import curve_figure
+
+        fmt = PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()]
+        curve_figure(tree, files.temp("plot"), fmt)
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), summ)
+    files.commit()
     return summ
 
 
-def write_solve(res: dict, head: dict, out, summary) -> None:
-    """Files of a fixed-approach solve."""
+def write_solve(res: dict, head: dict, files: ResultSet) -> None:
+    """The files of a fixed-approach solve, committed together."""
     brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
-    if out:
-        write_h5(out, {**head, "kind": "solve", "solution": {"H": res["H"], "P": res["P"], **brief}})
-    if summary:
-        write_json(summary, {**_common(head), **brief})
-
-
-def _draw(png: str, tree: dict, h5: str | None) -> None:
-    """The curve figure; plotting is imported only here."""
-    from .plot import curve_figure
-
-    with tempfile.TemporaryDirectory() as tmp:
-        if h5 is None:
-            h5 = f"{tmp}/curve.h5"
-            write_h5(h5, tree)
-        with atomic(png) as target:
-            curve_figure(h5, target)
+    if "out" in files.targets:
+        write_h5(files.temp("out"), {**head, "kind": "solve", "solution": {"H": res["H"], "P": res["P"], **brief}})
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), {**_common(head), **brief})
+    files.commit()

@@ -10,10 +10,16 @@ import sys
 import h5py
 import numpy as np
 
-__all__ = ["read", "load_approach", "profiles", "curve_figure"]
+__all__ = ["read", "from_tree", "load_approach", "profiles", "curve_figure"]
 
 MARK = {"snap_on": ("v", "snap-on"), "snap_off": ("^", "snap-off"), "F_min": ("o", "load extremum"),
         "equilibrium": ("s", "equilibrium"), "lambda": ("x", "at lambda")}
+
+
+def from_tree(tree: dict) -> dict:
+    """The layout of :func:`read` from a result tree of :mod:`petsc_adhesion.output` (before it is a file)."""
+    return {"mu": tree["model"]["mu"], "sigma": tree["model"]["sigma"], "r": tree["grid"]["r"],
+            "curve": tree["curve"], "events": tree["events"]}
 
 
 def read(path: str) -> dict:
@@ -60,13 +66,13 @@ def profiles(ax_h, ax_p, r: np.ndarray, H: np.ndarray, P: np.ndarray, label: str
     ax_p.set_xlabel("r")
 
 
-def curve_figure(path: str, out: str) -> None:
-    """The load-approach curve of one result file, with its event profiles when stored."""
+def curve_figure(source, out: str, fmt: str = "png") -> None:
+    """The load-approach curve of a result file or tree, with its event profiles when stored."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    res = read(path)
+    res = read(source) if isinstance(source, str) else from_tree(source)
     with_profiles = [e for e in res["events"] if "H" in e]
     if with_profiles:
         fig, (ax, ax_h, ax_p) = plt.subplots(3, 1, figsize=(6.4, 9.6))
@@ -79,7 +85,7 @@ def curve_figure(path: str, out: str) -> None:
     load_approach(ax, res)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out, dpi=120, format="png")
+    fig.savefig(out, dpi=120, format=fmt)
     plt.close(fig)
 
 

@@ -73,7 +73,7 @@ def _preallocation(ai: np.ndarray, aj: np.ndarray, lo: int, hi: int):
     return d, (np.diff(ai) - d).astype(PETSc.IntType)
 
 
-def _lu_or_block_jacobi(pc: PETSc.PC) -> None:
+def _lu_or_block_jacobi(pc: PETSc.PC, bordered: bool = False) -> None:
     pc.setType("lu" if pc.getComm().getSize() == 1 else "bjacobi")
 
 
@@ -174,7 +174,7 @@ class Shell:
         """Nothing to fill."""
 
     @staticmethod
-    def setup_pc(pc: PETSc.PC) -> None:
+    def setup_pc(pc: PETSc.PC, bordered: bool = False) -> None:
         """No preconditioner (-pc_type jacobi reads the shell's diagonal)."""
         pc.setType("none")
 

@@ -177,9 +177,9 @@ class Problem:
         """Assemble P at the linearization point (with ``border``: the bordered matrix)."""
         self.pc.fill(P, self, self.layout, border)
 
-    def setup_pc(self, pc: PETSc.PC) -> None:
+    def setup_pc(self, pc: PETSc.PC, bordered: bool = False) -> None:
         """Default preconditioner for the kind of P."""
-        self.pc.setup_pc(pc)
+        self.pc.setup_pc(pc, bordered)
 
     def destroy(self) -> None:
         """Free the PETSc objects held here, the influence matrix included."""

@@ -25,7 +25,7 @@ from petsc4py import PETSc
 
 from .events import Extremum, Fold, ParameterValue, Zero
 
-__all__ = ["curve_events", "curve", "stop_reason", "curve_warnings", "report_curve", "report_solve", "WALL_GAP"]
+__all__ = ["curve_events", "curve", "stop_reason", "assess", "report_curve", "report_solve", "WALL_GAP"]
 
 #: Closer than this to the wall of the roughness rule, a state is set by its smallest weights.
 WALL_GAP = 1e-3
@@ -76,6 +76,7 @@ def stop_reason(stop, settings) -> str:
         return f"step below -cont_ds_min at lambda = {value:.6g}: {where}"
     return {"observable_max": f"load F = {value:.4g} >= -cont_F_max {settings.observable_max:g}",
             "p_max": f"approach lambda = {value:.4g} >= -cont_lambda_max {settings.p_max:g}",
+            "p_min": f"approach lambda = {value:.4g} <= {settings.p_min:g}",
             "max_steps": f"-cont_max_steps {value} reached",
             "max_folds": f"more than -cont_max_folds {value} turning points"}[reason]
 
@@ -91,28 +92,49 @@ def curve(problem, cont, finder, profiles: bool = False) -> dict:
     mins = [e for e in events if e["kind"] == "F_min"]
     return {"points": pts, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
             "steps": len(pts) - 1, "rejected_steps": cont.rejected, "folds": cont.folds,
-            "stop_reason": stop_reason(cont.stop, cont.set), "pressures": pressures}
+            "stop": cont.stop, "stop_reason": stop_reason(cont.stop, cont.set), "pressures": pressures}
 
 
-def curve_warnings(problem, pts, pull_off) -> list[str]:
-    """What makes a traced curve untrustworthy, one line each.
+#: The contact reaches the end of the domain when |P(r_m)| exceeds this share of the peak attraction.
+EDGE_SHARE = 1e-3
+#: The peak of the Lennard-Jones attraction, |P| at H + 1 = 3^(1/6) (units 8 gamma / (3 epsilon)).
+PEAK_ATTRACTION = 2.0 / (3.0 * 3.0 ** 0.5)
 
-    ``pull_off`` None skips the check of the pull-off against the curve (when
-    the grid warning already explains a curve of spurious folds).
-    """
-    out = []
-    law = problem.law
-    gap = problem.comm.tompi4py().allreduce(min(float(p.x.min()) for p in pts) - law.wall, op=MPI.MIN)
+
+def assess(problem, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
+    """What makes a traced curve untrustworthy, one line each: (warnings, the subset that makes it
+    not what was asked for: exit status 3).  Collective."""
+    warn, short = [], []
+    law, pts, mpi = problem.law, res["points"], problem.comm.tompi4py()
+    gap = mpi.allreduce(min(float(p.x.min()) for p in pts) - law.wall, op=MPI.MIN)
     if not law.smooth and gap < WALL_GAP:
-        out.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
-                   f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
-                   f"the loads there are properties of the rule and ill-conditioned; use fewer points")
+        warn.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
+                    f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
+                    f"the loads there are properties of the rule and ill-conditioned; use fewer points")
+    if res["stop"][0] in ("ds_min", "max_steps", "max_folds"):
+        short.append(f"the curve ended early: {res['stop_reason']}")
+    if res["grid_warning"]:
+        short.append(res["grid_warning"])
+    pull_off = res["pull_off"]
     lowest = min(p.values["F"] for p in pts)
-    if pull_off is not None and lowest < pull_off["F"] - 1e-9:
-        out.append(f"a computed point (F = {lowest:.6g}) is more tensile than the located pull-off "
-                   f"({pull_off['F']:.6g}): the load varies faster than the steps resolve; "
-                   f"lower -cont_dF_max or -cont_ds_max")
-    return out
+    if pull_off is not None and not res["grid_warning"] and lowest < pull_off["F"] - 1e-9:
+        short.append(f"a computed point (F = {lowest:.6g}) is more tensile than the located pull-off "
+                     f"({pull_off['F']:.6g}): the load varies faster than the steps resolve; "
+                     f"lower -cont_dF_max or -cont_ds_max")
+    if pts[0].values["F"] > 0:
+        short.append(f"the curve starts in contact (F = {pts[0].values['F']:.3g} > 0 at lambda = {pts[0].p:g}): "
+                     f"the approach and its events lie before it; give -cont_lambda_start further apart")
+    found = [e["lambda"] for e in res["events"] if e["kind"] == "lambda"]
+    for t in at_lambda:
+        if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):
+            short.append(f"-cont_at_lambda {t:g} not reached: the curve spans lambda in "
+                         f"[{min(p.p for p in pts):.4g}, {max(p.p for p in pts):.4g}]")
+    last = problem.hi == problem.r.size
+    edge = mpi.allreduce(max(abs(float(problem.law(p.x[-1:])[0][0])) for p in pts) if last else 0.0, op=MPI.MAX)
+    if edge > EDGE_SHARE * PEAK_ATTRACTION:
+        short.append(f"the contact reaches the end of the domain r_m = {problem.r[-1]:g} (|P(r_m)| up to "
+                     f"{edge:.2g}): give a larger -adh_rmax")
+    return warn + short, short
 
 
 def _err(e: dict) -> str:

@@ -41,7 +41,7 @@ class Tolerances:
 
 def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, jacobian,
                 J: PETSc.Mat, P: PETSc.Mat, setup_pc, precheck, full_steps: bool = False,
-                tol: Tolerances = Tolerances()) -> PETSc.SNES:
+                bordered: bool = False, tol: Tolerances = Tolerances()) -> PETSc.SNES:
     """A Newton-Krylov SNES with prefix ``prefix``, configured, then ``setFromOptions()``.
 
     Parameters
@@ -51,13 +51,15 @@ def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, ja
     J, P
         The linearization (operator) and the matrix the preconditioner is built from.
     setup_pc
-        ``setup_pc(pc)`` sets the default preconditioner for the kind of P.
+        ``setup_pc(pc, bordered)`` sets the default preconditioner for the kind of P.
     precheck
         Line-search pre-check ``(x, y, ...) -> bool`` that shortens the step y (domain guard).
     full_steps
         Newton starts from a continuation predictor, close to the solution, where full
         steps (still shortened by the guard) need no backtracking: the ``basic`` line
         search, which halves the residual evaluations of the default ``bt``.
+    bordered
+        Whether J is the bordered matrix of the arclength corrector (for ``setup_pc``).
     """
     snes = PETSc.SNES().create(comm)
     snes.setOptionsPrefix(prefix)
@@ -70,7 +72,7 @@ def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, ja
     ksp = snes.getKSP()
     ksp.setType("gmres")
     ksp.setTolerances(rtol=tol.ksp_rtol, atol=tol.ksp_atol, max_it=tol.ksp_max_it)
-    setup_pc(ksp.getPC())
+    setup_pc(ksp.getPC(), bordered)
     snes.setLineSearchPreCheck(precheck)
     snes.setFromOptions()
     return snes
@@ -115,15 +117,28 @@ def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse, work: PETSc.Vec)
     return False
 
 
+#: A Krylov solution is accepted when its true residual is below this many times KSP's rtol.
+TRUE_RESIDUAL = 1e3
+
+
 def krylov_retry(ksp: PETSc.KSP, A: PETSc.Mat, P: PETSc.Mat, b: PETSc.Vec, x: PETSc.Vec,
-                 reuse: PCReuse, linearize) -> bool:
-    """Solve A x = b at the point set by ``linearize(refill)``; retry once with a fresh PC."""
+                 reuse: PCReuse, linearize, work: PETSc.Vec) -> bool:
+    """Solve A x = b at the point set by ``linearize(refill)``; retry once with a fresh PC.
+
+    GMRES with a left preconditioner stops on the preconditioned residual; with
+    a preconditioner kept from a distant point that can pass while A x = b is
+    far from solved (the first iterate is then the old tangent).  So the true
+    residual (in ``work``) must be below TRUE_RESIDUAL times KSP's rtol, too.
+    """
     for _ in range(2):
         linearize(reuse(ksp))
         ksp.setOperators(A, P)
         ksp.solve(b, x)
         if ksp.getConvergedReason() > 0:
-            return True
+            A.mult(x, work)
+            work.aypx(-1.0, b)
+            if work.norm() <= TRUE_RESIDUAL * ksp.getTolerances()[0] * b.norm():
+                return True
         reuse.expire()
     return False
 

@@ -3,35 +3,74 @@
 
 A study is either one solve at a fixed approach (``-adh_lambda``) or the whole
 load-approach curve by continuation (the default).  This module only reads
-the options into objects and calls the modules named for each step, in that
-order.
+the options into objects, checks them (on every rank, agreed before any
+work), and calls the modules named for each step, in that order.
 """
 from __future__ import annotations
 
 import sys
 import time
+from dataclasses import dataclass
 
 import petsc4py
 from petsc4py import PETSc
 
 from . import __version__, error_estimate, preconditioning, resolution, results
-from .continuation import Continuation
+from .continuation import Continuation, Settings
 from .events import EventFinder
+from .files import PLOT_FORMATS, ResultSet, check_targets
 from .influence import create_influence
-from .model import scales
-from .options import (TABLE, AppOptions, InputError, check_memory, check_unused, print_help, read_guess,
-                      read_grid, read_model, read_physical, read_settings)
-from .output import check_writable, write_curve, write_solve
+from .model import Model, scales
+from .optionsfile import options_files
+from .options import (TABLE, AppOptions, InputError, check_consistency, check_memory, check_petsc_values,
+                      check_unused, collective, print_help, read_grid, read_guess, read_model, read_physical,
+                      read_settings)
+from .output import write_curve, write_solve
 from .problem import Problem
 from .solver import Newton
 
-__all__ = ["discretize", "trace", "fixed_solve", "main"]
+__all__ = ["Plan", "discretize", "trace", "fixed_solve", "main"]
 
 _APP = ("adh_", "grid_", "cont_")
+_OUTPUTS = ("out", "summary", "plot")
 
 
 def _is_app(name: str) -> bool:
     return name.startswith(_APP) or name in TABLE
+
+
+@dataclass
+class Plan:
+    """Everything a run needs from its options, checked."""
+
+    model: Model
+    r: object
+    lam: float | None                 # fixed approach, or None for a curve
+    settings: Settings
+    targets: dict                     # option -> output path
+    inputs: dict                      # option -> paths read
+
+
+def plan(opts: AppOptions, comm, argv: list[str]) -> Plan:
+    """Read and check every option before any work (PETSc's solver options too, as far as
+    they can be judged before the solvers exist)."""
+    model = read_model(opts)
+    r = read_grid(opts, model)
+    lam = opts.real("adh_lambda")
+    check_memory(r.size, opts.choice("adh_pmat"), lam is None, comm.getSize())
+    if opts.string("adh_guess") is not None and lam is None:
+        raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
+    opts.read_all()
+    check_unused(_is_app)
+    check_consistency(opts, model)
+    check_petsc_values(opts.db)
+    targets = {k: opts.string(k) for k in _OUTPUTS if opts.string(k)}
+    if "plot" in targets and not targets["plot"].lower().endswith(tuple(PLOT_FORMATS)):
+        raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
+    inputs = {"options_file": options_files(argv), "adh_guess": [opts.string("adh_guess") or ""]}
+    if comm.getRank() == 0:                  # only rank 0 writes
+        check_targets(targets, inputs)
+    return Plan(model, r, lam, read_settings(opts), targets, inputs)
 
 
 def discretize(model, r, pmat=None) -> Problem:
@@ -40,8 +79,12 @@ def discretize(model, r, pmat=None) -> Problem:
 
 
 def trace(problem: Problem, settings, lam0: float, at_lambda=(), tol: float | None = None,
-          profiles: bool = False) -> dict:
-    """The load-approach curve from lam0 with its events, landings, pull-off, resolution check and warnings."""
+          profiles: bool = False, started=None) -> dict:
+    """The load-approach curve from lam0 with its events, landings, pull-off, resolution check and warnings.
+
+    ``started()`` is called once the first point and its tangent are computed (the
+    solvers then have read all their options).
+    """
     t0 = time.perf_counter()
     cont = Continuation(problem, settings)
     finder = EventFinder(cont, results.curve_events(at_lambda), *([tol] if tol else []))
@@ -52,14 +95,17 @@ def trace(problem: Problem, settings, lam0: float, at_lambda=(), tol: float | No
         raise RuntimeError(f"{e}; give -cont_lambda_start further apart") from None
     finally:
         guess.destroy()
+    if started:
+        started()
     cont.run(start, on_step=finder)
     finder.jumps(problem.stable)
     wall = time.perf_counter() - t0
     res = results.curve(problem, cont, finder, profiles)
     edges = resolution.contact_edges(problem.r, res.pop("pressures"))
-    res["grid_warning"] = resolution.check(problem.model, problem.r, edges, cont.folds)
-    res["warnings"] = results.curve_warnings(problem, cont.points,
-                                             None if res["grid_warning"] else res["pull_off"])
+    mpi = problem.comm.tompi4py()
+    res["grid_warning"] = mpi.bcast(resolution.check(problem.model, problem.r, edges, cont.folds)
+                                    if mpi.Get_rank() == 0 else None, root=0)
+    res["warnings"], res["incomplete"] = results.assess(problem, res, at_lambda)
     res |= {"wall_time_s": wall, "lambda_start": lam0}
     cont.destroy()
     return res
@@ -70,6 +116,7 @@ def fixed_solve(problem: Problem, newton: Newton, lam: float, H: PETSc.Vec) -> d
     t0 = time.perf_counter()
     ok = newton.solve(lam, H)
     wall = time.perf_counter() - t0
+    check_unused()                          # the solver has read all of its options
     if not ok:
         raise RuntimeError(f"Newton did not converge at lambda = {lam:g} "
                            f"(reason {newton.snes.getConvergedReason()}); try -adh_guess or -snes_monitor")
@@ -83,65 +130,63 @@ def fixed_solve(problem: Problem, newton: Newton, lam: float, H: PETSc.Vec) -> d
 def _head(comm, opts: AppOptions, model, r) -> dict:
     """What every result file says about its run: versions, options, model, grid, SI scales."""
     phys = read_physical(opts)
+    rough = {"roughness": model.roughness, "hermite_points": model.hermite_points} \
+        if model.sigma > 0 and model.roughness != "none" else {}
     return {"program": "petsc-adhesion", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(),
             "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize(),
             "options": opts.db.getAll(),
-            "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax,
-                      "roughness": model.roughness, "hermite_points": model.hermite_points},
+            "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **rough},
             "grid": {"r": r}, **({"scales": scales(*phys)} if phys else {})}
 
 
-def main() -> int:
-    """The program: one study from the options database; 0 on success (errors raise)."""
+def main(argv: list[str] | None = None) -> int:
+    """The program: one study from the options database (initialised from ``argv``); its exit status.
+
+    Errors raise (:mod:`petsc_adhesion.cli` turns them into one line).
+    """
     comm = PETSc.COMM_WORLD
     opts = AppOptions()
     helping = opts.db.hasName("help")
     if helping and comm.getRank() == 0:
         print_help(sys.stdout)
-    model = read_model(opts)
-    r = read_grid(opts, model)
-    lam = opts.real("adh_lambda")
-    out, summary, plot = opts.string("out"), opts.string("summary"), opts.string("plot")
-    check_memory(r.size, opts.choice("adh_pmat"), lam is None, comm.getSize())
-    if opts.string("adh_guess") is not None and lam is None:
-        raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
-    opts.read_all()
-    check_unused(_is_app)
-    for name, path in (("out", out), ("summary", summary), ("plot", plot)):
-        check_writable(name, path)
-    if plot and lam is not None:
-        raise InputError("-plot: draws a curve; not with -adh_lambda")
-
+    p = collective(comm, plan, opts, comm, sys.argv if argv is None else argv)
     pmat = preconditioning.create(opts.choice("adh_pmat"), opts.int("adh_pmat_band"))
-    problem = discretize(model, r, pmat)
-    if lam is None:
-        settings = read_settings(opts)
+    problem = discretize(p.model, p.r, pmat)
+    if p.lam is None:
         lam0 = opts.real("cont_lambda_start")
         lam0 = problem.far_approach() if lam0 is None else lam0
         if helping:
-            Continuation(problem, settings).destroy()       # its solvers print their options
+            Continuation(problem, p.settings).destroy()       # its solvers print their options
             return 0
         at, tol, profiles = opts.reals("cont_at_lambda"), opts.real("cont_event_tol"), opts.flag("profiles")
-        res = trace(problem, settings, lam0, at, tol, profiles)
+        res = trace(problem, p.settings, lam0, at, tol, profiles, started=check_unused)
         if opts.flag("cont_error_estimate"):
-            coarse = discretize(model, error_estimate.coarsen(r), pmat)
-            error_estimate.attach(res, trace(coarse, settings, lam0, at, tol), model.rmax)
+            coarse = discretize(p.model, error_estimate.coarsen(p.r), pmat)
+            error_estimate.attach(res, trace(coarse, p.settings, lam0, at, tol), p.model.rmax)
             coarse.destroy()
     else:
         newton = Newton(problem, "", pc_reuse_its=opts.int("adh_pc_reuse_its"))
         if helping:
             return 0
-        res = fixed_solve(problem, newton, lam, read_guess(problem, lam, opts.string("adh_guess")))
+        H = collective(comm, read_guess, problem, p.lam, opts.string("adh_guess"))
+        res = fixed_solve(problem, newton, p.lam, H)
         newton.destroy()
-    check_unused()                          # PETSc has read all of its options by now
+    check_unused()
+    status = 0
     if comm.getRank() == 0:
-        head = _head(comm, opts, model, r)
-        if lam is None:
-            results.report_curve(write_curve(res, head, out, summary, plot))
-        else:
-            write_solve(res, head, out, summary)
-            results.report_solve(res)
+        files = ResultSet(p.targets)
+        head = _head(comm, opts, p.model, p.r)
+        try:
+            if p.lam is None:
+                results.report_curve(write_curve(res, head, files))
+            else:
+                write_solve(res, head, files)
+                results.report_solve(res)
+        finally:
+            files.discard()
+    if p.lam is None and res["incomplete"]:
+        status = 3
     problem.destroy()
     PETSc.garbage_cleanup()
-    return 0
+    return status

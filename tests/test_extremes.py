@@ -8,10 +8,10 @@ from petsc_adhesion.reference import RIGID_EQUILIBRIUM
 from conftest import run_cli
 
 
-def trace(tmp_path, *args):
+def trace(tmp_path, *args, status=0):
     js, h5 = tmp_path / "s.json", tmp_path / "c.h5"
     proc = run_cli(*args, "-summary", js, "-out", h5)
-    assert proc.returncode == 0, proc.stderr
+    assert proc.returncode == status, proc.stderr
     return json.loads(js.read_text()), h5
 
 
@@ -55,7 +55,8 @@ def test_strong_compression(tmp_path):
 def test_huge_mu_on_coarse_grid_is_caught(tmp_path):
     """mu = 20 on the paper grid (h = 0.02): the cohesive zone 0.0084 is far below the
     spacing; the run stops early on the staircase and names the spacing it needs."""
-    s, _ = trace(tmp_path, "-adh_mu", 20)
+    s, _ = trace(tmp_path, "-adh_mu", 20, status=3)        # written, but not a curve: exit 3
+    assert not s["complete"] and s["grid_warning"] in s["warnings"]
     assert "turning points" in s["stop_reason"]
     assert "needs spacing <= 0.00168" in s["grid_warning"]
 
