@@ -7,12 +7,13 @@ Newer petsc4py binds some of these; one path for all versions is simpler.
 from __future__ import annotations
 
 import ctypes
+from contextlib import contextmanager
 from functools import lru_cache
 
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["options_left", "error_message", "set_linesearch_type"]
+__all__ = ["options_left", "error_message", "set_linesearch_type", "options_from"]
 
 
 @lru_cache(maxsize=None)
@@ -64,3 +65,30 @@ def set_linesearch_type(snes: PETSc.SNES, kind: str) -> None:
     if lib.SNESGetLineSearch(ctypes.c_void_p(snes.handle), ctypes.byref(ls)) or \
             lib.SNESLineSearchSetType(ls, kind.encode()):
         raise RuntimeError(f"cannot set the line search type '{kind}'")
+
+
+@contextmanager
+def options_from(argv: list[str]):
+    """A fresh options database holding ``argv``'s options, as PETSc's start-up reads them
+    (arguments, -options_file, PETSC_OPTIONS, .petscrc), made the global one for the block
+    (PetscOptionsCreate, PetscOptionsPush, PetscOptionsInsert); the caller's comes back after
+    (PetscOptionsPop, PetscOptionsDestroy)."""
+    lib = _lib()
+    ptr = ctypes.POINTER
+    lib.PetscOptionsCreate.argtypes = [ptr(ctypes.c_void_p)]
+    lib.PetscOptionsPush.argtypes = [ctypes.c_void_p]
+    lib.PetscOptionsDestroy.argtypes = [ptr(ctypes.c_void_p)]
+    lib.PetscOptionsInsert.argtypes = [ctypes.c_void_p, ptr(ctypes.c_int), ptr(ptr(ctypes.c_char_p)), ctypes.c_char_p]
+    db = ctypes.c_void_p()
+    if lib.PetscOptionsCreate(ctypes.byref(db)) or lib.PetscOptionsPush(db):
+        raise RuntimeError("cannot make an options database")
+    try:
+        args = [a.encode("utf-8", errors="surrogateescape") for a in argv]
+        argc = ctypes.c_int(len(args))
+        array = ctypes.cast((ctypes.c_char_p * len(args))(*args), ptr(ctypes.c_char_p))
+        if lib.PetscOptionsInsert(None, ctypes.byref(argc), ctypes.byref(array), None):
+            raise RuntimeError("PETSc could not read the options")
+        yield
+    finally:
+        lib.PetscOptionsPop()
+        lib.PetscOptionsDestroy(ctypes.byref(db))

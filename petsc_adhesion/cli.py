@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import signal
 import sys
+from contextlib import nullcontext
 
 from .files import printable
 from .optionsfile import environment_error, file_error, options_files
@@ -55,7 +56,12 @@ def _version() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the program on ``argv`` (default: sys.argv) and return its exit status (see the module)."""
+    """Run the program on ``argv`` (default: sys.argv) and return its exit status (see the module).
+
+    Repeatable in one process: after the first run (or where PETSc is already
+    initialised) each run reads its options into a database of its own, as
+    PETSc's start-up would, and the caller's options come back afterwards.
+    """
     argv = list(sys.argv if argv is None else argv)
     old = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
@@ -68,7 +74,22 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(s, handler)
 
 
+def _undecodable(argv: list[str]) -> str | None:
+    """The first argument that is not UTF-8 (PETSc cannot take it), said with its option."""
+    for i, a in enumerate(argv[1:], 1):
+        try:
+            a.encode("utf-8")
+        except UnicodeEncodeError:
+            option = argv[i - 1] if argv[i - 1].startswith("-") else "argument"
+            return f"{option}: the file name '{printable(a)}' is not valid UTF-8"
+    return None
+
+
 def _main(argv: list[str]) -> int:
+    bad = _undecodable(argv)
+    if bad:
+        _say(bad)
+        return EXIT_INPUT
     # PETSc aborts with a page of text on a bad options file: say it in one line first
     for path in options_files(argv):
         bad = file_error(path)
@@ -80,10 +101,13 @@ def _main(argv: list[str]) -> int:
         _say(bad)
         return EXIT_INPUT
     import petsc4py
-    petsc4py.init(argv)
+    fresh = "petsc4py.PETSc" not in sys.modules
+    if fresh:
+        petsc4py.init(argv)
     from mpi4py import MPI
     from petsc4py import PETSc
 
+    from . import capi
     from .options import InputError, petsc_error
     from .study import main as study
 
@@ -91,7 +115,9 @@ def _main(argv: list[str]) -> int:
         PETSc.Sys.Print(_version())
         return EXIT_OK
     try:
-        return study(argv)
+        # PETSc runs already in this process (a notebook, a test): the run's own options database
+        with nullcontext() if fresh else capi.options_from(argv):
+            return study(argv)
     except InputError as e:
         _say(str(e))
         return EXIT_INPUT

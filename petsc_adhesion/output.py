@@ -17,8 +17,59 @@ from .files import PLOT_FORMATS, ResultSet
 __all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve", "write_solve"]
 
 
+# Units of the dimensionless results (docs/model.md)
+_EPS, _LOAD, _RAD, _PRES = "epsilon", "2 pi R gamma", "sqrt(epsilon R)", "8 gamma / (3 epsilon)"
+_STATE = f"lambda, H0: {_EPS}; F: {_LOAD}"
+_ERRORS = f"lambda_err: {_EPS}; F_err, F_truncation: {_LOAD}"
+#: path pattern (numbered groups as *) -> (units, one-line description), for every group and dataset
+DESCRIBE = {
+    "": ("", "petsc-adhesion result: adhesive contact of an elastic sphere with a flat (Cheng, Dunn and Brach "
+             "2002); kind: curve (continuation) or solve (one approach)"),
+    "options": ("", "every option of the run as given (name without the dash: value)"),
+    "model": (f"mu: 1; sigma: {_EPS}; rmax: {_RAD}", "the model: Tabor parameter mu (eq. 9), roughness sigma "
+              "(with its averaging rule when sigma > 0), end r_m of the domain"),
+    "scales": ("force_N: N; approach_m: m; radius_m: m; pressure_Pa: Pa",
+               "the SI values of the units, from -adh_physical R,gamma,E,epsilon"),
+    "grid": ("", "the collocation grid"),
+    "grid/r": (_RAD, "the nodes r_i on [0, r_m]"),
+    "solution": (f"{_STATE}; wall_time_s: s", "the state at one approach (-adh_lambda) and the solver's effort"),
+    "solution/H": (_EPS, "separation H = h / epsilon - 1 at the nodes"),
+    "solution/P": (_PRES, "pressure at the nodes (eq. 14), positive when repulsive"),
+    "curve": ("", "the load-approach curve, one entry per computed point, start first"),
+    "curve/lambda": (_EPS, "approach lambda = alpha / epsilon"),
+    "curve/F": (_LOAD, "load (eq. 26), negative when tensile"),
+    "curve/H0": (_EPS, "separation at r = 0"),
+    "curve/lambdadot": ("1", "d lambda / ds of the unit tangent (s: pseudo-arclength)"),
+    "curve/stable": ("", "stable under displacement control (lambdadot > 0)"),
+    "curve/ds": ("1", "the step that reached the point (0 at the start)"),
+    "curve/newton_its": ("", "Newton iterations of the corrector"),
+    "curve/ksp_its": ("", "Krylov iterations of the corrector and the tangent"),
+    "curve/corrector": ("", "start, natural (eq. 21-22) or arclength (eq. 24-25)"),
+    "events": ("", "events located on the curve, in the order found"),
+    "events/*": (f"{_STATE}; {_ERRORS}", "one event: kind (snap_on, snap_off, F_min, F_max, equilibrium, "
+                 "lambda), its state, stability, error estimates"),
+    "events/*/H": (_EPS, "separation at the nodes at the event (-profiles)"),
+    "events/*/P": (_PRES, "pressure at the nodes at the event (-profiles)"),
+    "events/*/landing": (_STATE, "where the jump from this fold lands: the other stable branch at its lambda"),
+    "events/*/landing/H": (_EPS, "separation at the nodes after the jump (-profiles)"),
+    "events/*/landing/P": (_PRES, "pressure at the nodes after the jump (-profiles)"),
+    "summary": (f"{_STATE}; {_ERRORS}; *_s: s", "the JSON summary (docs/output.md)"),
+}
+
+
+def _describe(name: str, obj) -> None:
+    key = "/".join("*" if part.isdigit() else part for part in name.split("/"))
+    if key.startswith("summary/"):
+        key = "summary"
+    units, text = DESCRIBE[key]
+    obj.attrs["units"], obj.attrs["description"] = units, text
+
+
 def _write(group, tree: dict) -> None:
-    """Dicts become groups; arrays datasets; scalars and strings attributes."""
+    """Dicts become groups, lists of dicts numbered groups; arrays datasets; scalars, strings and lists of
+    strings attributes."""
+    import h5py
+
     for key, val in tree.items():
         if isinstance(val, dict):
             _write(group.require_group(key), val)
@@ -26,6 +77,8 @@ def _write(group, tree: dict) -> None:
             sub = group.require_group(key)
             for i, item in enumerate(val):
                 _write(sub.require_group(f"{i:04d}"), item)
+        elif isinstance(val, (list, tuple)):
+            group.attrs[key] = np.array([str(v) for v in val], dtype=h5py.string_dtype())
         elif isinstance(val, np.ndarray):
             group.create_dataset(key, data=val)
         else:
@@ -33,11 +86,13 @@ def _write(group, tree: dict) -> None:
 
 
 def write_h5(path: str, tree: dict) -> None:
-    """The tree as an HDF5 file (see :func:`_write`)."""
+    """The tree as an HDF5 file (see :func:`_write`), every group and dataset with units and a description."""
     import h5py
 
     with h5py.File(path, "w") as f:
         _write(f, tree)
+        _describe("", f)
+        f.visititems(_describe)
 
 
 def _plain(x):
@@ -95,7 +150,7 @@ def curve_summary(res: dict, head: dict) -> dict:
 
 
 def curve_tree(res: dict, head: dict, summary: dict) -> dict:
-    """The HDF5 tree of a traced curve: the points, the events, and the summary's scalars."""
+    """The HDF5 tree of a traced curve: the points, the events, and the summary."""
     pts = res["points"]
     curve = {"lambda": np.array([p.p for p in pts]), "F": np.array([p.values["F"] for p in pts]),
              "stable": np.array([p.pdot > 0 for p in pts]), "ds": np.array([p.ds for p in pts]),
@@ -103,8 +158,7 @@ def curve_tree(res: dict, head: dict, summary: dict) -> dict:
              "H0": np.array([p.x[0] for p in pts]), "lambdadot": np.array([p.pdot for p in pts]),
              "corrector": np.array([p.corrector for p in pts], dtype="S9")}
     events = [{k: v for k, v in e.items() if k != "segment"} for e in res["events"]]
-    return {**head, "kind": "curve", "curve": curve, "events": events,
-            "summary": {k: v for k, v in summary.items() if not isinstance(v, (list, dict)) and v is not None}}
+    return {**head, "kind": "curve", "curve": curve, "events": events, "summary": summary}
 
 
 def write_curve(res: dict, head: dict, files: ResultSet) -> dict:
