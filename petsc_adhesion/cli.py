@@ -15,7 +15,7 @@ import sys
 from contextlib import nullcontext
 
 from .files import printable
-from .optionsfile import environment_error, file_error, options_files
+from .optionsfile import environment_error, file_error, options_files, stray_word
 
 __all__ = ["main", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
 
@@ -87,6 +87,9 @@ def _undecodable(argv: list[str]) -> str | None:
 
 def _main(argv: list[str]) -> int:
     bad = _undecodable(argv)
+    word = stray_word(argv[1:])
+    if word is not None and not bad:
+        bad = f"'{printable(word)}' is neither an option (they start with '-') nor an option's value"
     if bad:
         _say(bad)
         return EXIT_INPUT

@@ -12,6 +12,7 @@ from __future__ import annotations
 import difflib
 import math
 import os
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +20,7 @@ from petsc4py import PETSc
 
 from . import capi, grid, preconditioning
 from .errors import InputError
+from .files import printable
 from .continuation import ARCLENGTH_PREFIX, CORRECTORS, NATURAL_PREFIX, Settings
 from .events import EVENT_TOL
 from .model import Model, tabor
@@ -155,7 +157,7 @@ class AppOptions:
     def real(self, name: str):
         """The value of a real option, checked against its range, or its default."""
         o, raw = TABLE[name], self._raw(name)
-        return o.default if raw is None else self._number(o, raw, float)
+        return o.default if raw is None else self._number(o, raw, _strict_float)
 
     def int(self, name: str):
         """The value of an integer option, checked against its range, or its default."""
@@ -167,7 +169,7 @@ class AppOptions:
         o, raw = TABLE[name], self._raw(name)
         if raw is None:
             return o.default
-        return tuple(self._number(o, s.strip(), float) for s in raw.split(",") if s.strip())
+        return tuple(self._number(o, s.strip(), _strict_float) for s in raw.split(",") if s.strip())
 
     def choice(self, name: str) -> str:
         """The value of a choice option, one of its choices, or its default."""
@@ -198,14 +200,31 @@ class AppOptions:
             return False
         raise self._bad(o, raw)
 
+    def given(self) -> dict:
+        """Every option in the database as given: name -> value string (None for a bare flag).
+
+        petsc4py's getAll splits values at blanks; each value is read again whole.
+        """
+        return {k: (None if v is None else self.db.getString(k, "")) for k, v in self.db.getAll().items()}
+
     def read_all(self) -> None:
         """Read (and so check) every application option now, before any work."""
         for name, o in TABLE.items():
             getattr(self, o.kind)(name)
 
 
+#: A number as users write it: no Python extras (1_0, 0x10, whitespace), inf and nan named to be refused.
+_NUMBER = re.compile(r"[+-]?((\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|inf|infinity|nan)", re.I)
+
+
+def _strict_float(s: str) -> float:
+    if not _NUMBER.fullmatch(s.strip()):
+        raise ValueError(s)
+    return float(s)
+
+
 def _strict_int(s: str) -> int:
-    x = float(s)
+    x = _strict_float(s)
     if x != int(x):
         raise ValueError(s)
     return int(x)
@@ -349,20 +368,32 @@ def check_memory(n: int, pmat: str, curve: bool, ranks: int) -> None:
                          f"or -adh_pmat band")
 
 
+def _first_line(e: BaseException) -> str:
+    text = str(e).strip()
+    return text.splitlines()[0] if text else type(e).__name__
+
+
 def read_guess(problem, lam: float, path: str | None) -> PETSc.Vec:
     """The initial H of a fixed-approach solve: the rigid state, or H(r) of -adh_guess interpolated."""
     H = problem.rigid(lam, problem.create_vec())
     if path is None:
         return H
+    shown = printable(path)
     try:
         import h5py
         with h5py.File(path, "r") as f:
             r0, h0 = f["grid/r"][()], f["solution/H"][()]
-    except (OSError, KeyError) as e:
-        raise InputError(f"-adh_guess: cannot read grid/r and solution/H from '{path}' ({e})") from None
+    except (OSError, KeyError, TypeError) as e:
+        raise InputError(f"-adh_guess: cannot read grid/r and solution/H from '{shown}' "
+                         f"({printable(_first_line(e))}); give the -out file of a fixed-approach solve") from None
+    if not (np.issubdtype(r0.dtype, np.floating) and np.issubdtype(h0.dtype, np.floating)
+            and r0.ndim == h0.ndim == 1 and r0.size == h0.size >= 2):
+        raise InputError(f"-adh_guess: grid/r and solution/H in '{shown}' are not two real vectors of one length")
+    if not (np.all(np.isfinite(r0)) and np.all(np.diff(r0) > 0)):
+        raise InputError(f"-adh_guess: grid/r in '{shown}' is not finite and increasing")
     h = np.interp(problem.r[problem.lo:problem.hi], r0, h0)
     if not np.all(np.isfinite(h)) or np.any(h <= problem.law.wall):
-        raise InputError(f"-adh_guess: H in '{path}' is not finite and above the wall {problem.law.wall:g}")
+        raise InputError(f"-adh_guess: H in '{shown}' is not finite and above the wall {problem.law.wall:g}")
     H.setArray(h)
     return H
 
@@ -382,7 +413,7 @@ def petsc_error(err: PETSc.Error) -> InputError | str:
     words it uses ("Restart must be positive": -ksp_gmres_restart).
     """
     detail = capi.error_message(err.ierr) or f"PETSc error {err.ierr}"
-    given = PETSc.Options().getAll()
+    given = AppOptions().given()
     words = set(detail.lower().replace("'", " ").replace('"', " ").replace(",", " ").replace(":", " ").split())
     by_value = [k for k, v in given.items() if v and v.lower() in words]
     by_name = [k for k in given if any(len(w) >= 3 and w not in _GENERIC and w in words for w in k.lower().split("_"))]
@@ -463,7 +494,7 @@ def check_petsc_values(db: PETSc.Options | None = None) -> None:
             if not db.hasName(prefix + name):
                 continue
             o = Option(prefix + name, kind, None, "", lo, hi, lo_open, hi_open=hi_open)
-            AppOptions(db)._number(o, db.getString(prefix + name, ""), float if kind == "real" else _strict_int)
+            AppOptions(db)._number(o, db.getString(prefix + name, ""), _strict_float if kind == "real" else _strict_int)
 
 
 def print_help(out) -> None:

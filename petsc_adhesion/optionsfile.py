@@ -11,7 +11,20 @@ import os
 
 from .files import printable
 
-__all__ = ["options_files", "file_error", "environment_error"]
+__all__ = ["options_files", "file_error", "environment_error", "stray_word"]
+
+
+def _is_value(token: str) -> bool:
+    """A token PETSc takes as a value, not as an option name: no leading dash, or a negative number."""
+    return not token.startswith("-") or token[1:2].isdigit() or token[1:2] == "."
+
+
+def stray_word(tokens: list[str]) -> str | None:
+    """The first word that is neither an option nor the value of the option before it (PETSc ignores it)."""
+    for i, t in enumerate(tokens):
+        if _is_value(t) and (i == 0 or _is_value(tokens[i - 1])):
+            return t
+    return None
 
 
 def _lines(path: str):
@@ -63,9 +76,9 @@ def file_error(path: str, opened: tuple = ()) -> str | None:
 def environment_error(argv: list[str]) -> str | None:
     """What PETSc would abort on, or silently skip, in PETSC_OPTIONS and the .petscrc files."""
     env = os.environ.get("PETSC_OPTIONS", "").split()
-    for i, t in enumerate(env):
-        if not t.startswith("-") and (i == 0 or not env[i - 1].startswith("-")):
-            return f"PETSC_OPTIONS: '{printable(t)}' is not an option (options start with '-')"
+    word = stray_word(env)
+    if word is not None:
+        return f"PETSC_OPTIONS: '{printable(word)}' is neither an option (they start with '-') nor an option's value"
     if "-skip_petscrc" in argv + env:
         return None
     for rc in (os.path.join(os.path.expanduser("~"), ".petscrc"), ".petscrc", "petscrc"):

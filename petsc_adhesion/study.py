@@ -135,7 +135,7 @@ def _head(comm, opts: AppOptions, model, r) -> dict:
     return {"program": "petsc-adhesion", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(),
             "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize(),
-            "options": opts.db.getAll(),
+            "options": opts.given(),
             "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **rough},
             "grid": {"r": r}, **({"scales": scales(*phys)} if phys else {})}
 

@@ -286,3 +286,46 @@ def test_every_group_and_dataset_has_units_and_a_description(tmp_path):
     with h5py.File(tmp_path / "s.h5") as f:
         assert "roughness" not in f["model"].attrs                    # no roughness average at sigma = 0
         assert f["solution/H"].attrs["units"] == "epsilon"
+
+
+# -- 8. what PETSc or Python would take silently ------------------------------------------------------
+@pytest.mark.parametrize("args, phrase", [
+    (("adh_mu", "2"), "'adh_mu' is neither an option"),
+    (("-adh_mu", "1", "2"), "'2' is neither an option"),
+    (("-adh_mu", "1_0"), "-adh_mu: expected a finite real"),
+    (("-adh_mu", "0x1"), "-adh_mu: expected a finite real"),
+], ids=["no_dash", "stray_value", "underscore", "hex"])
+def test_words_python_or_petsc_would_take(tmp_path, args, phrase):
+    proc = run_cli("-adh_lambda", "-2", "-grid_type", "uniform", *args, "-out", tmp_path / "x.h5")
+    assert phrase in one_line(proc)
+    assert not os.listdir(tmp_path)
+
+
+def _guess(path, r, H):
+    with h5py.File(path, "w") as f:
+        f["grid/r"], f["solution/H"] = r, H
+
+
+@pytest.mark.parametrize("kind, phrase", [
+    ("two_columns", "two real vectors"), ("strings", "two real vectors"), ("lengths", "two real vectors"),
+    ("decreasing", "increasing"), ("nan", "not finite"), ("curve_file", "cannot read"), ("text", "cannot read"),
+])
+def test_bad_guess_files(tmp_path, kind, phrase):
+    path, r = tmp_path / "g.h5", np.linspace(0, 10, 21)
+    if kind == "two_columns":
+        _guess(path, r, np.ones((21, 2)))
+    elif kind == "strings":
+        _guess(path, r, np.array([b"a"] * 21))
+    elif kind == "lengths":
+        _guess(path, r[:5], np.ones(7))
+    elif kind == "decreasing":
+        _guess(path, r[::-1], 3 + r)
+    elif kind == "nan":
+        _guess(path, r, np.where(r > 5, np.nan, 3 + r))
+    elif kind == "curve_file":
+        assert run_cli(*CURVE, "-cont_F_max", "0", "-out", path).returncode == 0
+    else:
+        path.write_text("not HDF5\n")
+    line = one_line(run_cli(*SOLVE, "-adh_guess", path, "-out", tmp_path / "x.h5"))
+    assert line.startswith("-adh_guess") and phrase in line, line
+    assert sorted(os.listdir(tmp_path)) == ["g.h5"]
