@@ -48,6 +48,9 @@ from .files import ResultSet, check_targets
 from .output import write_json
 from .problem import Problem
 from .solver import Newton
+from .adaptive import RMAX
+from .preconditioning import Dense
+from .problem import far_approach
 from .study import discretize, trace
 
 __all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main"]
@@ -120,20 +123,22 @@ def check_curve(res: dict) -> dict:
             "equilibrium_lambda": first["equilibrium"]["lambda"]}
 
 
-def _trace(problem: Problem) -> dict:
-    """The program's default curve on ``problem``, step control from the options (-cont_*)."""
-    return trace(problem, read_settings(AppOptions()), problem.far_approach())
+def _trace() -> dict:
+    """The program's default curve: mu = 1 on grids that follow the contact edge, step control from
+    the options (-cont_*)."""
+    model = Model(mu=1.0, rmax=RMAX)
+    return trace(model, None, Dense(), read_settings(AppOptions()), far_approach(model))
 
 
-def bench_curve(problem: Problem, repeats: int | None = None) -> dict:
-    """The whole default curve (target 1 s), each repeat with fresh solvers (as the program makes them)."""
+def bench_curve(repeats: int | None = None) -> dict:
+    """The whole default curve (target 1 s), each repeat with fresh grids and solvers (as the program makes them)."""
     times = []
     for _ in range(repeats or 5):
         t0 = time.perf_counter()
-        res = _trace(problem)
+        res = _trace()
         times.append(time.perf_counter() - t0)
         marks = check_curve(res)
-    return {"curve": row(f"curve, mu = {problem.model.mu:g}, N = {problem.r.size}", times, 1.0, **marks)}
+    return {"curve": row("curve, mu = 1, edge grid", times, 1.0, **marks)}
 
 
 def _where(key: tuple) -> str:
@@ -143,10 +148,10 @@ def _where(key: tuple) -> str:
     return f"{os.path.join(*path.split(os.sep)[-2:])}:{line}({name})"
 
 
-def profile_curve(problem: Problem, top: int = 10) -> dict:
+def profile_curve(top: int = 10) -> dict:
     """Profiled time of one traced curve and its ``top`` functions by own time (cProfile's tottime)."""
     prof = cProfile.Profile()
-    check_curve(prof.runcall(_trace, problem))
+    check_curve(prof.runcall(_trace))
     st = pstats.Stats(prof)
     best = sorted(st.stats.items(), key=lambda kv: kv[1][2], reverse=True)[:top]
     return {"total_s": st.total_tt,
@@ -208,12 +213,11 @@ def main() -> int:
 
     parts = (only,) if only else PARTS
     results = bench_influence(repeats) if "influence" in parts else {}
-    problem = mu1_problem() if parts != ("influence",) or profile else None
     if "solve" in parts:
-        results |= bench_solve(problem, repeats)
+        results |= bench_solve(mu1_problem(), repeats)
     if "curve" in parts:
-        results |= bench_curve(problem, repeats)
-    top = profile_curve(problem) if profile else None
+        results |= bench_curve(repeats)
+    top = profile_curve() if profile else None
     info = {"program": "petsc-adhesion bench", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(), "mpi_ranks": 1,
             "openblas_num_threads": os.environ.get("OPENBLAS_NUM_THREADS", "unset"),

@@ -257,11 +257,13 @@ class Continuation:
     """Trace a curve of G(x, p) = 0 from a start point; collect the points and step statistics.
 
     ``stop`` after :meth:`run`: (reason, value) with reason one of
-    "observable_max", "p_max", "p_min", "max_steps", "max_folds", "ds_min".
+    "observable_max", "p_max", "p_min", "max_steps", "max_folds", "ds_min",
+    or "until" (the caller's criterion).  ``ds`` is the step it would take next.
+    ``index0`` numbers the monitor's lines after those of earlier segments.
     """
 
-    def __init__(self, problem, settings: Settings | None = None):
-        self.pb, self.set = problem, settings or Settings()
+    def __init__(self, problem, settings: Settings | None = None, index0: int = 0):
+        self.pb, self.set, self.index0 = problem, settings or Settings(), index0
         self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its)
         self.bordered = Bordered(problem, self.set.pc_reuse_its)
         self._x, self._xt, self._rhs, self._phi, self._r = (problem.create_vec() for _ in range(5))
@@ -270,6 +272,7 @@ class Continuation:
         self.rejected = 0
         self.folds = 0
         self.stop: tuple[str, float] | None = None
+        self.ds = self.set.ds
 
     def inner(self, u: np.ndarray, v: np.ndarray) -> float:
         """<u, v> of local parts, summed over ranks."""
@@ -314,6 +317,20 @@ class Continuation:
         xdot, pdot, kits = tan
         its, lits = self.newton.iterations
         return self.make_point(a, p0, xdot, pdot, newton_its=its, ksp_its=lits + kits)
+
+    def project(self, x: PETSc.Vec, p: float, xdot: np.ndarray, pdot: float) -> Point | None:
+        """The point of the curve nearest (x, p) along (xdot, pdot), with its tangent oriented alike.
+
+        A zero-length arclength correction (eq. 24-25, regular at folds): how a
+        point carried over from another discretization is put back on this one's
+        curve.  None when it fails.
+        """
+        guess = Point(x=x.getArray(readonly=True).copy(), p=p, xdot=xdot, pdot=pdot)
+        sol = self.arclength(guess, 0.0)
+        if sol is None:
+            return None
+        x1, p1, (xdot1, pdot1, kits), its, lits, _ = sol
+        return self.make_point(x1, p1, xdot1, pdot1, newton_its=its, ksp_its=lits + kits, corrector="regrid")
 
     # -- one step -------------------------------------------------------------
     def natural_ok(self, a: Point) -> bool:
@@ -398,8 +415,9 @@ class Continuation:
             return "max_folds", s.max_folds
         return None
 
-    def run(self, start: Point, on_step=None) -> list[Point]:
-        """Trace from ``start`` until a stop criterion; ``on_step(a, b)`` sees every accepted step."""
+    def run(self, start: Point, on_step=None, until=None) -> list[Point]:
+        """Trace from ``start`` until a stop criterion; ``on_step(a, b)`` sees every accepted step,
+        and ``until(a, b)`` True ends the run there (after on_step)."""
         s = self.set
         a = start
         self.points.append(a)
@@ -412,6 +430,7 @@ class Continuation:
                 self.bordered.reuse.expire()
                 self.rejected += 1
                 ds *= s.cut
+                self.ds = ds
                 if ds < s.ds_min:
                     self.stop = ("ds_min", a.p)
                     break
@@ -424,21 +443,33 @@ class Continuation:
             self.stop = self.done(b)
             if self.stop:
                 break
-            easy = b.deviation < s.grow_margin * s.max_deviation and (
-                s.observable is None or abs(b.values[s.observable] - a.values[s.observable])
-                < s.grow_margin * self._observable_bound(a))
-            if b.newton_its < s.newton_target and easy:
-                ds = min(s.grow * ds, s.ds_max)
-            elif b.newton_its > s.newton_target:
-                ds = max(s.shrink * ds, s.ds_min)
+            self.ds = self._next_step(a, b, ds)
+            if until and until(a, b):
+                self.stop = ("until", b.p)
+            if self.stop:
+                break
+            ds = self.ds
             a = b
         return self.points
+
+    def _next_step(self, a: Point, b: Point, ds: float) -> float:
+        """The step after an accepted one of length ds: grow on fast Newton and a nearly straight
+        curve, shrink on slow Newton."""
+        s = self.set
+        easy = b.deviation < s.grow_margin * s.max_deviation and (
+            s.observable is None or abs(b.values[s.observable] - a.values[s.observable])
+            < s.grow_margin * self._observable_bound(a))
+        if b.newton_its < s.newton_target and easy:
+            return min(s.grow * ds, s.ds_max)
+        if b.newton_its > s.newton_target:
+            return max(s.shrink * ds, s.ds_min)
+        return ds
 
     def monitor(self, pt: Point) -> None:
         """One line a point with -cont_monitor (rank 0)."""
         if self.set.monitor:
             obs = "".join(f" {k} {v: .10e}" for k, v in pt.values.items())
-            PETSc.Sys.Print(f"{len(self.points) - 1:4d} CONT {self.pb.parameter} {pt.p: .10e}{obs} ds {pt.ds:.3e} "
+            PETSc.Sys.Print(f"{self.index0 + len(self.points) - 1:4d} CONT {self.pb.parameter} {pt.p: .10e}{obs} ds {pt.ds:.3e} "
                             f"{pt.corrector[:3]} Newton {pt.newton_its} KSP {pt.ksp_its}", comm=self.pb.comm)
 
     def destroy(self) -> None:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-__all__ = ["Fold", "Extremum", "Zero", "ParameterValue", "Found", "EventFinder", "EVENT_TOL"]
+__all__ = ["Fold", "Extremum", "Zero", "ParameterValue", "Found", "EventFinder", "jumps", "EVENT_TOL"]
 
 #: Default location tolerance in the parameter.
 EVENT_TOL = 1e-10
@@ -112,7 +112,8 @@ class Found:
     point: object
     segment: int
     before: float                 # the test function's value at the segment's start
-    landing: object = None        # for a fold: the point it jumps to (see EventFinder.jumps)
+    landing: object = None        # for a fold: the point it jumps to (see jumps)
+    landing_by: object = None     # the EventFinder (segment) that located it
 
 
 class EventFinder:
@@ -170,21 +171,31 @@ class EventFinder:
         return cache[s]
 
     def jumps(self, stable) -> None:
-        """For each fold, the state on another stable branch at the same p (``Found.landing``).
+        """For each fold, the state it jumps to (``Found.landing``): :func:`jumps` on this one curve."""
+        jumps([self], stable)
 
-        Under control of p the state jumps forward along the curve from a fold
-        where p is largest, backward from one where it is smallest: the first
-        crossing of the fold's p on a segment whose ends are ``stable(point)``
-        in that direction is where it lands.
-        """
-        pts = self.cont.points
-        for ev in self.found:
+
+def jumps(finders, stable) -> None:
+    """For each fold found by ``finders`` (the segments of one curve, in order), the state on another
+    stable branch at the same p (``Found.landing``).
+
+    Under control of p the state jumps forward along the curve from a fold
+    where p is largest, backward from one where it is smallest: the first
+    crossing of the fold's p on a step whose ends are ``stable(point)`` in that
+    direction is where it lands, located on that step's own segment.  Steps
+    between segments (a change of discretization) are not crossings.
+    """
+    steps = [(f, j) for f in finders for j in range(len(f.cont.points) - 1)]
+    for k, finder in enumerate(finders):
+        for ev in finder.found:
             if not isinstance(ev.event, Fold):
                 continue
-            k, pf = ev.segment, ev.point.p
-            order = range(k + 1, len(pts) - 1) if ev.before > 0 else range(k - 1, -1, -1)
-            for j in order:
-                a, b = pts[j], pts[j + 1]
+            at = steps.index((finder, ev.segment))
+            pf = ev.point.p
+            order = steps[at + 1:] if ev.before > 0 else steps[at - 1::-1] if at else []
+            for owner, j in order:
+                a, b = owner.cont.points[j], owner.cont.points[j + 1]
                 if stable(a) and stable(b) and (a.p - pf) * (b.p - pf) <= 0:
-                    ev.landing = self.locate(a, b, lambda pt: pt.p, level=pf, tangent=False)
+                    ev.landing = owner.locate(a, b, lambda pt: pt.p, level=pf, tangent=False)
+                    ev.landing_by = owner
                     break

@@ -6,9 +6,12 @@ exact integration weights that the piecewise-linear interpolant implies.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-__all__ = ["uniform", "paper", "load_weights", "l2_weights", "PAPER_UNIFORM", "PAPER_EXTRA", "PAPER_SPLIT"]
+__all__ = ["uniform", "paper", "load_weights", "l2_weights", "EdgeGrid", "PAPER_UNIFORM", "PAPER_EXTRA",
+           "PAPER_SPLIT"]
 
 #: The paper's grid: 501 uniform nodes plus about 30 (N = 531): 30 elements halved.
 PAPER_UNIFORM, PAPER_EXTRA, PAPER_SPLIT = 501, 30, 2
@@ -60,18 +63,81 @@ def load_weights(r: np.ndarray) -> np.ndarray:
     return q
 
 
-def l2_weights(r: np.ndarray) -> np.ndarray:
-    """Trapezoidal weights of (1/r_m) integral_0^{r_m} u v dr.
+def l2_weights(r: np.ndarray, upto: float | None = None) -> np.ndarray:
+    """Trapezoidal weights of (1/R) integral_0^R u v dr, R = min(upto, r_m).
 
     The continuation measures the unknown H in this grid-independent norm: with
     the Euclidean norm of the paper, |lambdadot| would be about N^-1/2 on the
     whole curve and the paper's switch at |lambdadot| = 0.5 would never act.
+    Beyond the reach of the contact H only shifts with lambda: ``upto`` keeps a
+    large domain's far field from drowning the contact region in the norm
+    (the elements cut by R count in part).
 
     >>> l2_weights(uniform(5, 1.0))         # trapezoid rule, weights summing to 1
     array([0.125, 0.25 , 0.25 , 0.25 , 0.125])
+    >>> l2_weights(uniform(5, 1.0), 0.5)    # [0, 0.5] only
+    array([0.25, 0.5 , 0.25, 0.  , 0.  ])
     """
-    h = np.diff(r)
+    R = r[-1] if upto is None else min(upto, r[-1])
+    h = np.clip(np.minimum(r[1:], R) - r[:-1], 0.0, None)
     w = np.zeros_like(r)
     w[:-1] += h / 2
     w[1:] += h / 2
-    return w / (r[-1] - r[0])
+    return w / R
+
+
+@dataclass(frozen=True)
+class EdgeGrid:
+    """Nodes graded around the contact edge ``edge``, fine enough for the cohesive zone there.
+
+    The spacing h(r) is ``fine`` within ``band`` of the edge, grows by ``grading``
+    times the distance beyond, and is capped by ``contact`` within ``reach`` of
+    the forces (by ``interior`` times r inside the contact), growing by ``far``
+    times the distance beyond that, out to ``rmax``.  The nodes are the mapping
+    xi = integral_0^r dr / h at equal steps of xi, so refinement levels are nested:
+    every other node of ``level`` + 1 is a node of ``level`` (spacing / 2^level).
+    """
+
+    edge: float
+    fine: float
+    rmax: float
+    band: float = 0.0
+    grading: float = 0.1
+    contact: float = 0.025
+    interior: float = 0.01
+    reach: float = 3.0
+    far: float = 0.1
+    level: int = 0
+
+    def spacing(self, r: np.ndarray) -> np.ndarray:
+        """h(r) at level 0."""
+        d = np.abs(r - self.edge)
+        cap = np.where(r < self.edge, np.maximum(self.contact, self.interior * r),
+                       self.contact + self.far * np.maximum(0.0, r - self.edge - self.reach))
+        return np.minimum(np.maximum(self.fine, self.grading * (d - self.band)), np.maximum(cap, self.fine))
+
+    def _mapping(self) -> tuple[np.ndarray, np.ndarray]:
+        """(r, xi(r)), xi = integral dr / h by the trapezoid rule on samples at most h/8 apart.
+
+        Samples: geometric about the edge (ratio 1 + grading/8), uniform over the band
+        and over the reach of the forces.
+        """
+        q = 1.0 + self.grading / 8
+        steps = (self.fine / 8) * (q ** np.arange(int(np.log(8 * self.rmax / self.fine) / np.log(q)) + 2) - 1) / (q - 1)
+        near = min(self.rmax, self.edge + self.reach + 1.0)
+        r = np.concatenate([self.edge - self.band - steps, self.edge + self.band + steps,
+                            np.arange(max(0.0, self.edge - self.band), min(self.rmax, self.edge + self.band),
+                                      self.fine / 8),
+                            np.arange(0.0, near, min(self.contact, self.fine * 4) / 8), [0.0, self.rmax]])
+        r = np.unique(r[(r >= 0.0) & (r <= self.rmax)])
+        inv = 1.0 / self.spacing(r)
+        return r, np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(r))])
+
+    def nodes(self) -> np.ndarray:
+        """The nodes of this level: 4 k elements at level 0 (so two coarser levels nest), times 2^level."""
+        r, xi = self._mapping()
+        elements = 4 * int(np.ceil(xi[-1] / 4)) * 2 ** self.level if self.level >= 0 else \
+            4 * int(np.ceil(xi[-1] / 4)) // 2 ** -self.level
+        out = np.interp(np.linspace(0.0, xi[-1], elements + 1), xi, r)
+        out[0], out[-1] = 0.0, self.rmax
+        return out

@@ -21,6 +21,7 @@ from petsc4py import PETSc
 from . import capi, grid, preconditioning
 from .errors import InputError
 from .files import printable
+from .adaptive import RMAX
 from .continuation import ARCLENGTH_PREFIX, CORRECTORS, NATURAL_PREFIX, Settings
 from .events import EVENT_TOL
 from .model import Model, tabor
@@ -82,7 +83,8 @@ TABLE = {o.name: o for o in [
     Option("adh_roughness", "choice", Model.roughness, "roughness average of the pressure (eq. 14)",
            choices=("none", "hermite")),
     Option("adh_hermite_points", "int", Model.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
-    Option("adh_rmax", "real", Model.rmax, "end r_m of the computational domain", 0.0, 1e3, lo_open=True),
+    Option("adh_rmax", "real", None, f"end r_m of the computational domain (default: {RMAX:g} on grids that "
+           f"follow the contact edge, {Model.rmax:g} as in the paper otherwise)", 0.0, 1e3, lo_open=True),
     Option("adh_lambda", "real", None, "solve at this one approach lambda only (no continuation)", -1e3, 1e3),
     Option("adh_guess", "string", None, "HDF5 result whose H(r) is the initial guess of -adh_lambda"),
     Option("adh_pmat", "choice", "dense", "matrix handed to the preconditioner: the assembled Jacobian, "
@@ -91,7 +93,8 @@ TABLE = {o.name: o for o in [
     Option("adh_pc_reuse_its", "int", PC_REUSE_ITS, "keep the preconditioner while Krylov needs at most this many "
            "iterations (0: rebuild at every Newton iteration)", 0, 10**6),
     # grid
-    Option("grid_type", "choice", "paper", "node set", choices=("paper", "uniform")),
+    Option("grid_type", "choice", "edge", "node set: graded about the contact edge and following it along "
+           "the curve; the paper's; uniform", choices=("edge", "paper", "uniform")),
     Option("grid_n", "int", grid.PAPER_UNIFORM + grid.PAPER_EXTRA, "number of nodes of -grid_type uniform",
            3, 200000),
     Option("grid_paper_uniform", "int", grid.PAPER_UNIFORM, "uniform nodes of -grid_type paper", 3, 200000),
@@ -247,16 +250,21 @@ def read_model(opts: AppOptions) -> Model:
     mu = tabor(*phys) if phys else opts.real("adh_mu")
     if phys and not 0 <= mu <= TABLE["adh_mu"].hi:
         raise InputError(f"-adh_physical: gives mu = {mu:.3g}, outside [0, {TABLE['adh_mu'].hi:g}]")
-    model = Model(mu=mu, sigma=opts.real("adh_sigma"), rmax=opts.real("adh_rmax"),
+    rmax = opts.real("adh_rmax")
+    if rmax is None:
+        rmax = RMAX if opts.choice("grid_type") == "edge" else Model.rmax
+    model = Model(mu=mu, sigma=opts.real("adh_sigma"), rmax=rmax,
                   roughness=opts.choice("adh_roughness"), hermite_points=opts.int("adh_hermite_points"))
     if model.roughness == "none" and model.sigma > 0:
         raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
     return model
 
 
-def read_grid(opts: AppOptions, model: Model) -> np.ndarray:
-    """The nodes of -grid_type on [0, r_m]."""
+def read_grid(opts: AppOptions, model: Model) -> np.ndarray | None:
+    """The nodes of -grid_type on [0, r_m]; None for grids that follow the contact edge."""
     kind = opts.choice("grid_type")
+    if kind == "edge":
+        return None
     nu, extra = opts.int("grid_paper_uniform"), opts.int("grid_paper_extra")
     start, split = opts.real("grid_paper_refine_from"), opts.int("grid_paper_split")
     if kind == "uniform":

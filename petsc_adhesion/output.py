@@ -30,8 +30,11 @@ DESCRIBE = {
               "(with its averaging rule when sigma > 0), end r_m of the domain"),
     "scales": ("force_N: N; approach_m: m; radius_m: m; pressure_Pa: Pa",
                "the SI values of the units, from -adh_physical R,gamma,E,epsilon"),
-    "grid": ("", "the collocation grid"),
+    "grid": ("", "the collocation grid (of the last segment when the grid followed the contact edge)"),
     "grid/r": (_RAD, "the nodes r_i on [0, r_m]"),
+    "grid/lambda": (_EPS, "approach where each segment of the curve, on its own grid, starts"),
+    "grid/edge": (_RAD, "contact edge each segment's grid is centred on (NaN: a fixed grid)"),
+    "grid/n_nodes": ("", "nodes of each segment's grid"),
     "solution": (f"{_STATE}; wall_time_s: s", "the state at one approach (-adh_lambda) and the solver's effort"),
     "solution/H": (_EPS, "separation H = h / epsilon - 1 at the nodes"),
     "solution/P": (_PRES, "pressure at the nodes (eq. 14), positive when repulsive"),
@@ -48,9 +51,11 @@ DESCRIBE = {
     "events": ("", "events located on the curve, in the order found"),
     "events/*": (f"{_STATE}; {_ERRORS}", "one event: kind (snap_on, snap_off, F_min, F_max, equilibrium, "
                  "lambda), its state, stability, error estimates"),
+    "events/*/r": (_RAD, "the nodes of the grid the event was located on (-profiles)"),
     "events/*/H": (_EPS, "separation at the nodes at the event (-profiles)"),
     "events/*/P": (_PRES, "pressure at the nodes at the event (-profiles)"),
     "events/*/landing": (_STATE, "where the jump from this fold lands: the other stable branch at its lambda"),
+    "events/*/landing/r": (_RAD, "the nodes of the grid the landing was located on (-profiles)"),
     "events/*/landing/H": (_EPS, "separation at the nodes after the jump (-profiles)"),
     "events/*/landing/P": (_PRES, "pressure at the nodes after the jump (-profiles)"),
     "summary": (f"{_STATE}; {_ERRORS}; *_s: s", "the JSON summary (docs/output.md)"),
@@ -124,9 +129,10 @@ def _brief(e: dict) -> dict:
 
 
 def _common(head: dict) -> dict:
-    """The keys every summary has: versions, the model and the grid size."""
+    """The keys every summary has: versions, the model and the grid size (the largest grid's)."""
     flat = {k: v for k, v in head.items() if k not in ("options", "model", "grid")}
-    return {**flat, **head["model"], "n_nodes": int(head["grid"]["r"].size)}
+    sizes = head["grid"].get("n_nodes", [head["grid"]["r"].size])
+    return {**flat, **head["model"], "n_nodes": int(max(sizes))}
 
 
 def curve_summary(res: dict, head: dict) -> dict:
@@ -138,7 +144,8 @@ def curve_summary(res: dict, head: dict) -> dict:
          "equilibria": [{k: v for k, v in _brief(e).items() if k != "F"} for e in ev if e["kind"] == "equilibrium"],
          "load_extrema": [_brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
          "at_lambda": [_brief(e) for e in ev if e["kind"] == "lambda"],
-         "steps": res["steps"], "rejected_steps": res["rejected_steps"], "stop_reason": res["stop_reason"],
+         "steps": res["steps"], "rejected_steps": res["rejected_steps"], "regrids": res["regrids"],
+         "stop_reason": res["stop_reason"],
          "grid_warning": res["grid_warning"], "warnings": res["warnings"], "complete": not res["incomplete"],
          "lambda_start": res["lambda_start"], "wall_time_s": res["wall_time_s"]}
     if "error_estimate" in res:

@@ -30,9 +30,9 @@ def read(path: str) -> dict:
         for name in sorted(f["events"]) if "events" in f else []:
             g = f["events"][name]
             ev = dict(g.attrs)
-            ev.update({k: g[k][()] for k in ("H", "P") if k in g})
+            ev.update({k: g[k][()] for k in ("r", "H", "P") if k in g})
             if "landing" in g:
-                ev["landing"] = dict(g["landing"].attrs) | {k: g["landing"][k][()] for k in ("H", "P")
+                ev["landing"] = dict(g["landing"].attrs) | {k: g["landing"][k][()] for k in ("r", "H", "P")
                                                             if k in g["landing"]}
             out["events"].append(ev)
     return out
@@ -78,7 +78,7 @@ def curve_figure(source, out: str, fmt: str = "png") -> None:
         fig, (ax, ax_h, ax_p) = plt.subplots(3, 1, figsize=(6.4, 9.6))
         for ev in with_profiles:
             kind = ev["kind"].decode() if isinstance(ev["kind"], bytes) else ev["kind"]
-            profiles(ax_h, ax_p, res["r"], ev["H"], ev["P"], f"{kind} lambda = {ev['lambda']:.4f}")
+            profiles(ax_h, ax_p, ev.get("r", res["r"]), ev["H"], ev["P"], f"{kind} lambda = {ev['lambda']:.4f}")
         ax_h.legend(fontsize=7)
     else:
         fig, ax = plt.subplots(figsize=(6.4, 4.8))

@@ -37,16 +37,21 @@ BAND = 64
 
 @dataclass
 class Border:
-    """The extra column, row and corner of the bordered matrix."""
+    """One extra column, row and corner around a matrix (the last rank holds the row).
 
-    column: np.ndarray          # local rows of dG/dp
-    row: np.ndarray | None      # the whole weighted tangent w xdot, on the last rank only
-    corner: float               # pdot
+    ``column``: its local rows of everything before it (G_x's rows, then the rows
+    of earlier borders on the last rank); ``row``: the whole row over everything
+    before it (on the last rank only; None elsewhere); ``corner``: the diagonal entry.
+    """
+
+    column: np.ndarray
+    row: np.ndarray | None
+    corner: float
 
 
 @dataclass(frozen=True)
 class Layout:
-    """Row layout of G_x on this rank: rows [lo, hi) of N; the border row lives on the last rank."""
+    """Row layout of G_x on this rank: rows [lo, hi) of N; border rows live on the last rank."""
 
     lo: int
     hi: int
@@ -58,12 +63,10 @@ class Layout:
         """Rows of G_x on this rank."""
         return self.hi - self.lo
 
-    def sizes(self, bordered: bool):
-        """PETSc (local, global) sizes of the square or bordered matrix."""
-        if not bordered:
-            return ((self.nloc, self.N), (self.nloc, self.N))
-        n1 = int(self.last)
-        return ((self.nloc + n1, self.N + 1), (self.nloc + n1, self.N + 1))
+    def sizes(self, extra: int = 0):
+        """PETSc (local, global) sizes of G_x with ``extra`` borders."""
+        n = self.nloc + extra * int(self.last)
+        return ((n, self.N + extra), (n, self.N + extra))
 
 
 def _preallocation(ai: np.ndarray, aj: np.ndarray, lo: int, hi: int):
@@ -82,28 +85,30 @@ class Dense:
 
     kind = "dense"
 
-    def create(self, layout: Layout, comm: PETSc.Comm, bordered: bool) -> PETSc.Mat:
-        """A dense Mat of the square or bordered size."""
-        P = PETSc.Mat().createDense(layout.sizes(bordered), comm=comm)
+    def create(self, layout: Layout, comm: PETSc.Comm, extra: int = 0) -> PETSc.Mat:
+        """A dense Mat of G_x's size with ``extra`` borders."""
+        P = PETSc.Mat().createDense(layout.sizes(extra), comm=comm)
         P.setUp()
         return P
 
-    def fill(self, P: PETSc.Mat, problem, layout: Layout, border: Border | None = None) -> None:
-        """P = G_x (``problem.jacobian_rows``), with the border appended when given."""
+    def fill(self, P: PETSc.Mat, problem, layout: Layout, borders=()) -> None:
+        """P = G_x (``problem.jacobian_rows``), with the borders appended in order."""
         a = P.getDenseArray()
         problem.jacobian_rows(a[:layout.nloc, :layout.N])
-        if border is not None:
-            a[:layout.nloc, -1] = border.column
+        for j, b in enumerate(borders):
+            n = layout.N + j
+            a[:layout.nloc + j * layout.last, n] = b.column
             if layout.last:
-                a[-1, :-1] = border.row
-                a[-1, -1] = border.corner
+                a[layout.nloc + j, :n] = b.row
+                a[layout.nloc + j, n] = b.corner
         P.assemble()
 
     setup_pc = staticmethod(_lu_or_block_jacobi)
 
 
 class Band:
-    """The near field |i - j| <= ``band`` of G_x as AIJ (the far field dropped): any PETSc PC."""
+    """The near field |i - j| <= ``band`` of G_x as AIJ (the far field dropped), with its borders
+    in full: any PETSc PC."""
 
     kind = "band"
 
@@ -114,48 +119,47 @@ class Band:
     def pattern(self, layout: Layout):
         """Local CSR row pointers and global columns of the band of G_x (made once per layout)."""
         if layout not in self._patterns:
-            self._patterns[layout] = self._pattern(layout)
+            rows = np.arange(layout.lo, layout.hi)
+            first = np.maximum(rows - self.band, 0)
+            last = np.minimum(rows + self.band, layout.N - 1)
+            counts = (last - first + 1).astype(PETSc.IntType)
+            ai = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
+            aj = (first.repeat(counts) + np.arange(counts.sum()) - np.repeat(ai[:-1], counts)).astype(PETSc.IntType)
+            self._patterns[layout] = ai, aj
         return self._patterns[layout]
 
-    def _pattern(self, layout: Layout):
-        rows = np.arange(layout.lo, layout.hi)
-        first = np.maximum(rows - self.band, 0)
-        last = np.minimum(rows + self.band, layout.N - 1)
-        counts = (last - first + 1).astype(PETSc.IntType)
-        ai = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
-        aj = (first.repeat(counts) + np.arange(counts.sum()) - np.repeat(ai[:-1], counts)).astype(PETSc.IntType)
-        return ai, aj
-
-    def _csr(self, layout: Layout, ai, aj, v, border: Border | None):
-        """The band's CSR with, when bordered, the dG/dp column and (last rank) the border row."""
-        if border is None and v is not None:
-            return ai, aj, v
-        j = np.insert(aj, ai[1:], layout.N)
-        vals = None if v is None else np.insert(v, ai[1:], border.column)
-        ai2 = ai + np.arange(ai.size)
-        if layout.last:
-            j = np.concatenate([j, np.arange(layout.N + 1)])
-            if v is not None:
-                vals = np.concatenate([vals, border.row, [border.corner]])
-            ai2 = np.append(ai2, ai2[-1] + layout.N + 1)
-        return ai2.astype(PETSc.IntType), j.astype(PETSc.IntType), vals
-
-    def create(self, layout: Layout, comm: PETSc.Comm, bordered: bool) -> PETSc.Mat:
-        """An AIJ Mat preallocated for the band (and the border)."""
+    def _csr(self, layout: Layout, extra: int, v, borders):
+        """CSR of the band with ``extra`` border columns on G_x's rows and, on the last rank, the border
+        rows in full (row k: everything before it, its corner, then later borders' columns).
+        Values only when ``v``, the band's own, is given."""
         ai, aj = self.pattern(layout)
-        if bordered:
-            ai, aj, _ = self._csr(layout, ai, aj, None, Border(np.zeros(0), None, 0.0))
-        lo = layout.lo
-        hi = layout.hi + int(bordered and layout.last)
-        P = PETSc.Mat().createAIJ(layout.sizes(bordered), nnz=_preallocation(ai, aj, lo, hi), comm=comm)
+        at = np.repeat(ai[1:], extra)                       # each row's end, once per border column
+        tail = layout.N + np.arange(extra)
+        cols = [np.insert(aj, at, np.tile(tail, layout.nloc))]
+        vals = [np.insert(v, at, np.stack([b.column[:layout.nloc] for b in borders], axis=1).ravel()
+                          if extra else [])] if v is not None else None
+        counts = [np.diff(ai) + extra]
+        for k in range(extra if layout.last else 0):
+            cols.append(np.concatenate([np.arange(layout.N + k + 1), tail[k + 1:]]))
+            counts.append([cols[-1].size])
+            if v is not None:
+                b = borders[k]
+                vals.append(np.concatenate([b.row, [b.corner], [c.column[layout.nloc + k] for c in borders[k + 1:]]]))
+        ai2 = np.concatenate([[0], np.cumsum(np.concatenate(counts))]).astype(PETSc.IntType)
+        return ai2, np.concatenate(cols).astype(PETSc.IntType), None if v is None else np.concatenate(vals)
+
+    def create(self, layout: Layout, comm: PETSc.Comm, extra: int = 0) -> PETSc.Mat:
+        """An AIJ Mat preallocated for the band and the borders."""
+        ai, aj, _ = self._csr(layout, extra, None, ())
+        lo, hi = layout.lo, layout.hi + extra * int(layout.last)
+        P = PETSc.Mat().createAIJ(layout.sizes(extra), nnz=_preallocation(ai, aj, lo, hi), comm=comm)
         P.setUp()
         return P
 
-    def fill(self, P: PETSc.Mat, problem, layout: Layout, border: Border | None = None) -> None:
-        """P = the band of G_x (``problem.band_values``), with the border appended when given."""
+    def fill(self, P: PETSc.Mat, problem, layout: Layout, borders=()) -> None:
+        """P = the band of G_x (``problem.band_values``), with the borders appended in order."""
         ai, aj = self.pattern(layout)
-        v = problem.band_values(ai, aj)
-        P.setValuesCSR(*self._csr(layout, ai, aj, v, border))
+        P.setValuesCSR(*self._csr(layout, len(borders), problem.band_values(ai, aj), borders))
         P.assemble()
 
     setup_pc = staticmethod(_lu_or_block_jacobi)
@@ -166,11 +170,11 @@ class Shell:
 
     kind = "shell"
 
-    def create(self, layout: Layout, comm: PETSc.Comm, bordered: bool) -> None:
+    def create(self, layout: Layout, comm: PETSc.Comm, extra: int = 0) -> None:
         """None: the solvers hand the operator itself to the PC."""
         return None
 
-    def fill(self, P, problem, layout: Layout, border: Border | None = None) -> None:
+    def fill(self, P, problem, layout: Layout, borders=()) -> None:
         """Nothing to fill."""
 
     @staticmethod

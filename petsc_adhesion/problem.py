@@ -18,11 +18,27 @@ from petsc4py import PETSc
 from .grid import l2_weights, load_weights
 from .preconditioning import Border, Dense, Layout
 from .pressure import PressureLaw
+from .reference import jkr_zero_load
 
-__all__ = ["Problem", "TO_WALL"]
+__all__ = ["Problem", "far_approach", "norm_radius", "TO_WALL"]
 
 #: Newton may cover at most this fraction of the way to the wall in one step.
 TO_WALL = 0.9
+
+
+def norm_radius(model) -> float:
+    """Where the continuation's norm of H ends: the paper's domain, or three JKR contact radii at zero
+    load when larger (mu > 1.9), beyond which H only shifts with lambda."""
+    return max(10.0, 3.0 * jkr_zero_load(model.mu)[0]) if model.mu > 0 else 10.0
+
+
+def far_approach(model) -> float:
+    """An approach with the sphere well out of reach of the surface forces: the default start.
+
+    The rigid gap at r = 0 is then 3 + 2 mu above the wall of the roughness rule.
+    """
+    wall = PressureLaw(model.sigma, model.roughness, model.hermite_points).wall
+    return -(wall + 1.0) - 3.0 - 2.0 * model.mu
 
 
 class Problem:
@@ -55,7 +71,7 @@ class Problem:
         local = r[self.lo:self.hi]
         self.shape = 0.5 * local * local
         self.q = (8.0 / 3.0) * load_weights(r)[self.lo:self.hi]
-        self.weights = l2_weights(r)[self.lo:self.hi]
+        self.weights = l2_weights(r, norm_radius(model))[self.lo:self.hi]
         self.p, self.Ap = A.createVecs()
         self.dp = np.zeros(self.hi - self.lo)
         self.pc = pmat if pmat is not None else Dense()
@@ -117,12 +133,13 @@ class Problem:
         return point.pdot > 0
 
     # -- domain guard -------------------------------------------------------------
-    def far_approach(self) -> float:
-        """An approach with the sphere well out of reach of the surface forces: the default start.
+    def separation(self, x: np.ndarray) -> np.ndarray:
+        """The local H of a state x (here x itself)."""
+        return x
 
-        The rigid gap at r = 0 is then 3 + 2 mu above the wall of the roughness rule.
-        """
-        return -(self.law.wall + 1.0) - 3.0 - 2.0 * self.model.mu
+    def nodes(self, x: np.ndarray) -> np.ndarray:
+        """The physical nodes of a state x, all of them (here the fixed grid)."""
+        return self.r
 
     def gather(self, local: np.ndarray) -> np.ndarray:
         """The whole nodal vector of local parts, on every rank."""
@@ -171,11 +188,11 @@ class Problem:
 
     def create_pmat(self, bordered: bool) -> PETSc.Mat | None:
         """The preconditioning matrix of G_H, or of the bordered matrix; None: the operator itself."""
-        return self.pc.create(self.layout, self.comm, bordered)
+        return self.pc.create(self.layout, self.comm, int(bordered))
 
     def fill_pmat(self, P: PETSc.Mat, border: Border | None = None) -> None:
         """Assemble P at the linearization point (with ``border``: the bordered matrix)."""
-        self.pc.fill(P, self, self.layout, border)
+        self.pc.fill(P, self, self.layout, [border] if border is not None else [])
 
     def setup_pc(self, pc: PETSc.PC, bordered: bool = False) -> None:
         """Default preconditioner for the kind of P."""

@@ -51,9 +51,10 @@ def _whole(problem, local: np.ndarray):
 def _state(problem, pt, profiles: bool) -> dict:
     out = {"lambda": pt.p, "F": pt.values["F"], "H0": _H0(problem, pt)}
     if profiles:
-        H = _whole(problem, pt.x)
+        r = problem.nodes(pt.x)
+        H = _whole(problem, problem.separation(pt.x))
         if H is not None:
-            out["H"], out["P"] = H, problem.law(H)[0]
+            out["r"], out["H"], out["P"] = r, H, problem.law(H)[0]
     return out
 
 
@@ -63,7 +64,7 @@ def event_record(problem, found, profiles: bool) -> dict:
     if not isinstance(found.event, Fold):          # at a fold lambdadot = 0: marginal
         ev["stable"] = bool(problem.stable(found.point))
     if found.landing is not None:
-        ev["landing"] = _state(problem, found.landing, profiles)
+        ev["landing"] = _state(found.landing_by.cont.pb, found.landing, profiles)
     return ev
 
 
@@ -81,18 +82,32 @@ def stop_reason(stop, settings) -> str:
             "max_folds": f"more than -cont_max_folds {value} turning points"}[reason]
 
 
-def curve(problem, cont, finder, profiles: bool = False) -> dict:
-    """The traced curve with its events as dicts, the pull-off and the pressures along it (rank 0).
+def curve(segments, profiles: bool = False) -> dict:
+    """The traced curve (its segments, in order) with its events as dicts and the pull-off.
 
-    Collective.  ``pressures`` (rank 0, else empty) feed the resolution check.
+    Collective.  ``profiles`` (rank 0, else empty): the nodes and the pressure of
+    every point, for the resolution check.
     """
-    events = [event_record(problem, f, profiles) for f in finder.found]
-    pts = cont.points
-    pressures = [problem.law(H)[0] for H in (_whole(problem, p.x) for p in pts) if H is not None]
+    events = [event_record(seg.problem, f, profiles) for seg in segments for f in seg.finder.found]
+    pts = [p for seg in segments for p in seg.cont.points]
+    states = []
+    for seg in segments:
+        pb = seg.problem
+        for p in seg.cont.points:
+            r, H = pb.nodes(p.x), _whole(pb, pb.separation(p.x))
+            if H is not None:
+                states.append((r, pb.law(H)[0]))
     mins = [e for e in events if e["kind"] == "F_min"]
+    last = segments[-1].cont
     return {"points": pts, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
-            "steps": len(pts) - 1, "rejected_steps": cont.rejected, "folds": cont.folds,
-            "stop": cont.stop, "stop_reason": stop_reason(cont.stop, cont.set), "pressures": pressures}
+            "steps": sum(len(seg.cont.points) - 1 for seg in segments),
+            "rejected_steps": sum(seg.cont.rejected for seg in segments),
+            "folds": sum(seg.cont.folds for seg in segments), "regrids": len(segments) - 1,
+            "stop": last.stop, "stop_reason": stop_reason(last.stop, last.set), "states": states,
+            "grid": segments[-1].problem.nodes(segments[-1].cont.points[-1].x),
+            "grids": {"lambda": np.array([seg.cont.points[0].p for seg in segments]),
+                      "edge": np.array([np.nan if seg.grid is None else seg.grid.edge for seg in segments]),
+                      "n_nodes": np.array([seg.problem.layout.N for seg in segments])}}
 
 
 #: The contact reaches the end of the domain when |P(r_m)| exceeds this share of the peak attraction.
@@ -101,10 +116,11 @@ EDGE_SHARE = 1e-3
 PEAK_ATTRACTION = 2.0 / (3.0 * 3.0 ** 0.5)
 
 
-def assess(problem, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
+def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
     """What makes a traced curve untrustworthy, one line each: (warnings, the subset that makes it
     not what was asked for: exit status 3).  Collective."""
     warn, short = [], []
+    problem = segments[-1].problem
     law, pts, mpi = problem.law, res["points"], problem.comm.tompi4py()
     gap = mpi.allreduce(min(float(p.x.min()) for p in pts) - law.wall, op=MPI.MIN)
     if not law.smooth and gap < WALL_GAP:
@@ -129,8 +145,9 @@ def assess(problem, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
         if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):
             short.append(f"-cont_at_lambda {t:g} not reached: the curve spans lambda in "
                          f"[{min(p.p for p in pts):.4g}, {max(p.p for p in pts):.4g}]")
-    last = problem.hi == problem.r.size
-    edge = mpi.allreduce(max(abs(float(problem.law(p.x[-1:])[0][0])) for p in pts) if last else 0.0, op=MPI.MAX)
+    edge = mpi.allreduce(max((abs(float(law(seg.problem.separation(p.x)[-1:])[0][0])) for seg in segments
+                              for p in seg.cont.points if seg.problem.hi == seg.problem.layout.N), default=0.0),
+                         op=MPI.MAX)
     if edge > EDGE_SHARE * PEAK_ATTRACTION:
         short.append(f"the contact reaches the end of the domain r_m = {problem.r[-1]:g} (|P(r_m)| up to "
                      f"{edge:.2g}): give a larger -adh_rmax")
@@ -166,7 +183,7 @@ def report_curve(s: dict) -> None:
         out.append(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}{_err(e)}")
     for e in s["at_lambda"]:
         out.append(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}{_err(e)}")
-    for w in ([s["grid_warning"]] if s["grid_warning"] else []) + s["warnings"]:
+    for w in s["warnings"]:
         out.append(f"  WARNING: {w}")
     PETSc.Sys.Print("\n".join(out), comm=PETSc.COMM_SELF)
 

@@ -12,12 +12,14 @@ import sys
 import time
 from dataclasses import dataclass
 
+import numpy as np
 import petsc4py
 from petsc4py import PETSc
 
 from . import __version__, error_estimate, preconditioning, resolution, results
+from .adaptive import Tracer, grid_for
 from .continuation import Continuation, Settings
-from .events import EventFinder
+from .events import jumps
 from .files import PLOT_FORMATS, ResultSet, check_targets
 from .influence import create_influence
 from .model import Model, scales
@@ -26,7 +28,7 @@ from .options import (TABLE, AppOptions, InputError, check_consistency, check_me
                       check_unused, collective, print_help, read_grid, read_guess, read_model, read_physical,
                       read_settings)
 from .output import write_curve, write_solve
-from .problem import Problem
+from .problem import Problem, far_approach
 from .solver import Newton
 
 __all__ = ["Plan", "discretize", "trace", "fixed_solve", "main"]
@@ -57,7 +59,8 @@ def plan(opts: AppOptions, comm, argv: list[str]) -> Plan:
     model = read_model(opts)
     r = read_grid(opts, model)
     lam = opts.real("adh_lambda")
-    check_memory(r.size, opts.choice("adh_pmat"), lam is None, comm.getSize())
+    if r is not None:
+        check_memory(r.size, opts.choice("adh_pmat"), lam is None, comm.getSize())
     if opts.string("adh_guess") is not None and lam is None:
         raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
     opts.read_all()
@@ -73,41 +76,37 @@ def plan(opts: AppOptions, comm, argv: list[str]) -> Plan:
     return Plan(model, r, lam, read_settings(opts), targets, inputs)
 
 
+def rigid_edge(lam: float) -> float:
+    """The contact edge of the rigid sphere at approach lam: the peak attraction, gap 3^(1/6) epsilon."""
+    return float(np.sqrt(2.0 * max(0.0, lam + 3.0 ** (1.0 / 6.0) - 1.0)))
+
+
 def discretize(model, r, pmat=None) -> Problem:
     """The problem on grid r: influence matrix (eq. 4, 12), pressure law, preconditioning matrix kind."""
     return Problem(model, r, create_influence(r, PETSc.COMM_WORLD), pmat)
 
 
-def trace(problem: Problem, settings, lam0: float, at_lambda=(), tol: float | None = None,
-          profiles: bool = False, started=None) -> dict:
-    """The load-approach curve from lam0 with its events, landings, pull-off, resolution check and warnings.
+def trace(model, r, pmat, settings, lam0: float, at_lambda=(), tol: float | None = None,
+          profiles: bool = False, started=None, level: int = 0) -> dict:
+    """The load-approach curve from lam0 on grid ``r`` (None: grids following the contact edge, at
+    refinement ``level``), with its events, landings, pull-off, resolution check and warnings.
 
     ``started()`` is called once the first point and its tangent are computed (the
     solvers then have read all their options).
     """
     t0 = time.perf_counter()
-    cont = Continuation(problem, settings)
-    finder = EventFinder(cont, results.curve_events(at_lambda), *([tol] if tol else []))
-    guess = problem.rigid(lam0, problem.create_vec())
-    try:
-        start = cont.start(guess, lam0)
-    except RuntimeError as e:
-        raise RuntimeError(f"{e}; give -cont_lambda_start further apart") from None
-    finally:
-        guess.destroy()
-    if started:
-        started()
-    cont.run(start, on_step=finder)
-    finder.jumps(problem.stable)
+    tracer = Tracer(model, settings, results.curve_events(at_lambda), tol, nodes=r, pmat=pmat, level=level,
+                    rmax=model.rmax)
+    segments = tracer.run(lam0, started)
+    jumps([seg.finder for seg in segments], Problem.stable)
     wall = time.perf_counter() - t0
-    res = results.curve(problem, cont, finder, profiles)
-    edges = resolution.contact_edges(problem.r, res.pop("pressures"))
-    mpi = problem.comm.tompi4py()
-    res["grid_warning"] = mpi.bcast(resolution.check(problem.model, problem.r, edges, cont.folds)
-                                    if mpi.Get_rank() == 0 else None, root=0)
-    res["warnings"], res["incomplete"] = results.assess(problem, res, at_lambda)
+    res = results.curve(segments, profiles)
+    mpi = PETSc.COMM_WORLD.tompi4py()
+    states = res.pop("states")
+    res["grid_warning"] = mpi.bcast(resolution.check(model, states, res["folds"]) if mpi.Get_rank() == 0 else None)
+    res["warnings"], res["incomplete"] = results.assess(segments, res, at_lambda)
     res |= {"wall_time_s": wall, "lambda_start": lam0}
-    cont.destroy()
+    tracer.destroy()
     return res
 
 
@@ -127,7 +126,7 @@ def fixed_solve(problem: Problem, newton: Newton, lam: float, H: PETSc.Vec) -> d
             "P": problem.gather(pressure), "snes_iterations": its, "ksp_iterations": kits, "wall_time_s": wall}
 
 
-def _head(comm, opts: AppOptions, model, r) -> dict:
+def _head(comm, opts: AppOptions, model, grid: dict) -> dict:
     """What every result file says about its run: versions, options, model, grid, SI scales."""
     phys = read_physical(opts)
     rough = {"roughness": model.roughness, "hermite_points": model.hermite_points} \
@@ -137,7 +136,7 @@ def _head(comm, opts: AppOptions, model, r) -> dict:
             "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize(),
             "options": opts.given(),
             "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **rough},
-            "grid": {"r": r}, **({"scales": scales(*phys)} if phys else {})}
+            "grid": grid, **({"scales": scales(*phys)} if phys else {})}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -152,31 +151,37 @@ def main(argv: list[str] | None = None) -> int:
         print_help(sys.stdout)
     p = collective(comm, plan, opts, comm, sys.argv if argv is None else argv)
     pmat = preconditioning.create(opts.choice("adh_pmat"), opts.int("adh_pmat_band"))
-    problem = discretize(p.model, p.r, pmat)
     if p.lam is None:
         lam0 = opts.real("cont_lambda_start")
-        lam0 = problem.far_approach() if lam0 is None else lam0
-        if helping:
-            Continuation(problem, p.settings).destroy()       # its solvers print their options
+        lam0 = far_approach(p.model) if lam0 is None else lam0
+        if helping:                                  # the solvers print their options
+            problem = discretize(p.model, p.r if p.r is not None else grid_for(p.model, 0.0).nodes(), pmat)
+            Continuation(problem, p.settings).destroy()
+            problem.destroy()
             return 0
         at, tol, profiles = opts.reals("cont_at_lambda"), opts.real("cont_event_tol"), opts.flag("profiles")
-        res = trace(problem, p.settings, lam0, at, tol, profiles, started=check_unused)
+        res = trace(p.model, p.r, pmat, p.settings, lam0, at, tol, profiles, started=check_unused)
         if opts.flag("cont_error_estimate"):
-            coarse = discretize(p.model, error_estimate.coarsen(p.r), pmat)
-            error_estimate.attach(res, trace(coarse, p.settings, lam0, at, tol), p.model.rmax)
-            coarse.destroy()
+            coarse = None if p.r is None else error_estimate.coarsen(p.r)
+            error_estimate.attach(res, trace(p.model, coarse, pmat, p.settings, lam0, at, tol, level=-1),
+                                  p.model.rmax)
+        grid = {"r": res["grid"], **res["grids"]}
     else:
+        r = p.r if p.r is not None else grid_for(p.model, rigid_edge(p.lam)).nodes()
+        problem = discretize(p.model, r, pmat)
         newton = Newton(problem, "", pc_reuse_its=opts.int("adh_pc_reuse_its"))
         if helping:
             return 0
         H = collective(comm, read_guess, problem, p.lam, opts.string("adh_guess"))
         res = fixed_solve(problem, newton, p.lam, H)
         newton.destroy()
+        problem.destroy()
+        grid = {"r": r}
     check_unused()
     status = 0
     if comm.getRank() == 0:
         files = ResultSet(p.targets)
-        head = _head(comm, opts, p.model, p.r)
+        head = _head(comm, opts, p.model, grid)
         try:
             if p.lam is None:
                 results.report_curve(write_curve(res, head, files))
@@ -187,6 +192,5 @@ def main(argv: list[str] | None = None) -> int:
             files.discard()
     if p.lam is None and res["incomplete"]:
         status = 3
-    problem.destroy()
     PETSc.garbage_cleanup()
     return status

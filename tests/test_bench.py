@@ -24,8 +24,10 @@ def test_bench_json(tmp_path):
     assert q["repeats"] == 1 and math.isfinite(q["median_s"]) and q["median_s"] > 0
     assert q["target_s"] == 1.0 and isinstance(q["met"], bool)
     # the curve timed is the default study: the paper's mu = 1 landmarks (its text has
-    # -1.63, -1.74, 2.07; NOTES 4 on the swapped labels), the pull-off of docs/results.md
+    # -1.63, -1.74, 2.07; NOTES 4 on the swapped labels), and the pull-off of the half-infinite
+    # domain that ContactMechanics + Adhesion give at n = 256 (-0.83524, docs/data/peer_contactmechanics.json;
+    # its lambda_p scatters by 5e-3 between its grids)
     assert abs(q["snap_on_lambda"] + 1.63) < 0.01 and abs(q["snap_off_lambda"] + 1.74) < 0.01
     assert abs(q["equilibrium_lambda"] - 2.07) < 0.01
-    assert abs(q["pull_off_F"] + 0.8348) < 1e-4
-    assert "curve, mu = 1, N = 531" in run.stdout
+    assert abs(q["pull_off_F"] + 0.83524) < 3e-4
+    assert "curve, mu = 1, edge grid" in run.stdout

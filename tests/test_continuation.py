@@ -157,9 +157,9 @@ def folds_of(summary):
 # -- the runs -------------------------------------------------------------------------
 #: mu = 1 on the paper grid, with states recorded at lambda = -3 (far from the folds),
 #: -1.7 (between snap-off -1.74 and snap-on -1.63: three states) and 0 (Fig. 12)
-MU1 = ("-adh_mu", "1", "-cont_at_lambda", "-3,-1.7,0", "-profiles")
+MU1 = ("-adh_mu", "1", "-grid_type", "paper", "-cont_at_lambda", "-3,-1.7,0", "-profiles")
 #: mu = 0.01: a denser curve (ds_max 0.05) for the comparison with eq. (28)
-DMT = ("-cont_ds_max", "0.05", "-cont_at_lambda", "0", "-profiles")
+DMT = ("-grid_type", "paper", "-cont_ds_max", "0.05", "-cont_at_lambda", "0", "-profiles")
 
 
 def uniform(n):
@@ -189,7 +189,7 @@ def dmt(workdir):
     return run_many(workdir, {
         "mu0.01": (("-adh_mu", "0.01", *DMT), 1),
         "mu0.005": (("-adh_mu", "0.005", *DMT), 1),
-        "solve0": (("-adh_mu", "0.01", "-adh_lambda", "0"), 1),
+        "solve0": (("-adh_mu", "0.01", "-adh_lambda", "0", "-grid_type", "paper"), 1),
     })
 
 
@@ -208,7 +208,8 @@ PAPER = {
 
 @pytest.fixture(scope="module")
 def paper(workdir):
-    return run_many(workdir, {key: (("-adh_mu", f"{key[0]:g}", "-adh_sigma", f"{key[1]:g}"), 1) for key in PAPER})
+    return run_many(workdir, {key: (("-adh_mu", f"{key[0]:g}", "-adh_sigma", f"{key[1]:g}", "-grid_type", "paper"), 1)
+                              for key in PAPER})
 
 
 @pytest.fixture(scope="module")

@@ -53,17 +53,17 @@ class OwnDense:
 
     kind = "own"
 
-    def create(self, layout: Layout, comm, bordered: bool) -> PETSc.Mat:
-        m = layout.N + int(bordered)
+    def create(self, layout: Layout, comm, extra: int = 0) -> PETSc.Mat:
+        m = layout.N + extra
         P = PETSc.Mat().createDense(((m, m), (m, m)), comm=comm)
         P.setUp()
         return P
 
-    def fill(self, P: PETSc.Mat, problem, layout: Layout, border: Border | None = None) -> None:
+    def fill(self, P: PETSc.Mat, problem, layout: Layout, borders=()) -> None:
         N = layout.N
         a = np.zeros(P.getSize())
         problem.jacobian_rows(a[:N, :N])
-        if border is not None:
+        for border in borders:
             a[:N, N] = border.column
             a[N, :N] = border.row
             a[N, N] = border.corner
@@ -173,10 +173,10 @@ class Toy:
         return self.Gx(self.x_lin, self.p_lin)[rows, aj]
 
     def create_pmat(self, bordered: bool):
-        return self.pc.create(self.layout, self.comm, bordered)
+        return self.pc.create(self.layout, self.comm, int(bordered))
 
     def fill_pmat(self, P, border: Border | None = None) -> None:
-        self.pc.fill(P, self, self.layout, border)
+        self.pc.fill(P, self, self.layout, [border] if border is not None else [])
 
     def setup_pc(self, pc: PETSc.PC, bordered: bool = False) -> None:
         self.pc.setup_pc(pc, bordered)

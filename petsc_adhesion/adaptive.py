@@ -1,0 +1,245 @@
+"""The load-approach curve on grids that follow the contact edge (the default grid).
+
+At large mu the cohesive zone at the contact edge is about 0.75 mu^-1.5 wide
+and needs several nodes across it, but only where the edge is, and the edge
+travels from r = 0 outward along the curve (to about 2.4 mu^0.5 at zero
+load, further under compression).  The curve is traced in segments, each on
+one grid, of two kinds:
+
+* ``edge``: the physical frame, an :class:`~petsc_adhesion.grid.EdgeGrid`
+  centred on the edge (fine, zone / NODES_PER_ZONE and at most
+  CONTACT_SPACING, within BAND of it; graded beyond; geometric out to RMAX,
+  where the attraction left out carries |F| < 1e-8).  A new segment when the
+  edge has travelled more than ``travel`` from the grid's centre.
+* ``scaled``: once a sharp edge (zone / NODES_PER_ZONE < CONTACT_SPACING,
+  roughness below the pinned level) has formed a contact of radius A_SWITCH,
+  the frame of the edge (:mod:`petsc_adhesion.scaled`): the grid in rho = r/a
+  follows the contact radius a by itself, and a new segment is needed only
+  when a has changed by the factor GROW.
+
+A point is carried to the next segment's grid by interpolating its
+deformation H - r^2/2 and a zero-length arclength correction there (regular
+at folds).  Events are located within a segment, on one discrete problem,
+never across a change of grid: a change waits while any event's test
+function has a different sign on the two grids at the carried point (it is
+close to an event), unless the old grid no longer resolves the edge.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from mpi4py import MPI
+
+from .continuation import Continuation, Settings
+from .events import EventFinder
+from .grid import EdgeGrid
+from .influence import create_influence
+from .problem import Problem
+from .resolution import NODES_PER_ZONE
+from .scaled import LEVEL, ScaledProblem
+
+__all__ = ["grid_for", "edge_of", "contact_radius", "Segment", "Tracer", "BAND", "CONTACT_SPACING", "RMAX",
+           "REACH", "A_SWITCH", "GROW"]
+
+#: Half-width of the fine band about the edge in the physical frame.
+BAND = 0.25
+#: Largest spacing within reach of the surface forces (the paper grid's is 0.02).
+CONTACT_SPACING = 0.025
+#: How far beyond the edge the forces reach (rigid gap 4 epsilon at the equilibrium approach).
+REACH = 3.0
+#: End of the domain: the rigid sphere's attraction beyond it carries |F| < 1e-8.
+RMAX = 150.0
+#: Contact radius at which a sharp edge is pinned and the frame of the edge takes over.
+A_SWITCH = 0.3
+#: Factor by which the contact radius may change on one grid of the frame of the edge.
+GROW = 1.5
+
+
+def _fine(model) -> float:
+    return min(model.cohesive_zone / NODES_PER_ZONE, CONTACT_SPACING)
+
+
+def grid_for(model, edge: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid:
+    """The physical-frame grid centred on the contact edge ``edge`` for ``model`` at refinement ``level``."""
+    return EdgeGrid(edge=edge, fine=_fine(model), rmax=rmax, band=BAND, contact=CONTACT_SPACING, reach=REACH,
+                    level=level)
+
+
+def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid:
+    """The grid of the frame of the edge, in physical units for contact radius ``a`` (divide by a for rho).
+
+    Fine enough for the zone while a grows by GROW^2 (a change waits at most that
+    long), out to rmax GROW^2 at a, so past rmax at a / GROW^2.
+    """
+    zone = model.cohesive_zone
+    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=rmax * GROW**2, band=2 * zone,
+                    contact=CONTACT_SPACING, reach=REACH, level=level)
+
+
+def sharp(model, law) -> bool:
+    """Whether the contact edge is sharp enough to be traced in its own frame."""
+    return model.cohesive_zone / NODES_PER_ZONE < CONTACT_SPACING and law.wall < LEVEL - 0.25
+
+
+def edge_of(problem, x: np.ndarray) -> float:
+    """The contact edge of a state: the radius of peak attraction (most negative P); collective."""
+    pressure, _ = problem.law(problem.separation(x))
+    k = int(np.argmin(pressure))
+    best = (float(pressure[k]), float(problem.nodes(x)[problem.lo + k]))
+    return problem.comm.tompi4py().allreduce(best, op=MPI.MIN)[1]
+
+
+def contact_radius(problem, x: np.ndarray) -> float:
+    """Where H first rises through LEVEL from the centre (0 when H(0) >= LEVEL); collective."""
+    r, H = problem.nodes(x), problem.gather(problem.separation(x))
+    if H[0] >= LEVEL:
+        return 0.0
+    k = int(np.argmax(H >= LEVEL))
+    return float(r[k - 1] + (LEVEL - H[k - 1]) / (H[k] - H[k - 1]) * (r[k] - r[k - 1]))
+
+
+@dataclass
+class Segment:
+    """A stretch of the curve on one grid: its problem, continuation and events."""
+
+    kind: str             # "fixed", "edge" or "scaled"
+    grid: object          # the EdgeGrid (None for a fixed grid)
+    problem: object
+    cont: Continuation
+    finder: EventFinder
+
+    def destroy(self) -> None:
+        """Free the segment's PETSc objects."""
+        self.cont.destroy()
+        self.problem.destroy()
+
+
+def _carry(old, new, x: np.ndarray, xdot: np.ndarray | None = None) -> np.ndarray:
+    """The state x of ``old`` (or, with ``xdot``, its tangent's nodal part) on ``new``'s local nodes,
+    ``new`` at its design scale.
+
+    H grows like r^2/2 (eq. 27): its deformation D = H - r^2/2 is interpolated
+    instead, since the far grid's spacing h would cost the quadratic h^2/8, and
+    is what the frame of the edge takes as its unknown.  A tangent carries over
+    linearly: its nodal part (dH/ds, or dD/ds in the frame of the edge).
+    """
+    r_old = old.nodes(x)
+    scaled = isinstance(new, ScaledProblem)
+    r_new = (new.scale * new.rho if scaled else new.r)[new.lo:new.hi]
+    if xdot is not None:
+        return np.interp(r_new, r_old, old.gather(xdot[:old.hi - old.lo]))
+    field = old.gather(old.separation(x) - 0.5 * r_old[old.lo:old.hi] ** 2)
+    return np.interp(r_new, r_old, field) + (0.0 if scaled else 0.5 * r_new * r_new)
+
+
+class _Regrid:
+    """The ``until`` criterion of a segment: the edge has travelled; the next segment, ready."""
+
+    def __init__(self, tracer, seg: Segment):
+        self.tracer, self.seg, self.next = tracer, seg, None
+        zone = seg.problem.model.cohesive_zone
+        self.travel = min(BAND / 2 + zone, REACH / 3)
+        self.forced = min(BAND + 2 * zone, 2 * REACH / 3)
+
+    def target(self, b) -> tuple | None:
+        """(kind, where, forced) of the next segment, or None to stay."""
+        seg, tr = self.seg, self.tracer
+        if seg.kind == "scaled":
+            a = seg.problem.radius(b.x)
+            ratio = a / seg.grid.edge
+            return None if 1 / GROW <= ratio <= GROW else ("scaled", a, not 1 / GROW**2 <= ratio <= GROW**2)
+        if tr.sharp and contact_radius(seg.problem, b.x) >= A_SWITCH:
+            return "scaled", contact_radius(seg.problem, b.x), False
+        edge = edge_of(seg.problem, b.x)
+        moved = abs(edge - seg.grid.edge)
+        return None if moved <= self.travel else ("edge", edge, moved > self.forced)
+
+    def __call__(self, a, b) -> bool:
+        where = self.target(b)
+        if where is None:
+            return False
+        kind, at, forced = where
+        old, new = self.seg.problem, self.tracer.segment(kind, at, self.seg)
+        x = new.problem.create_vec()
+        shaped = _carry(old, new.problem, b.x)
+        slope = _carry(old, new.problem, b.x, b.xdot)
+        if kind == "scaled":
+            adot = old.radius(b.xdot) if self.seg.kind == "scaled" else 0.0
+            last = new.problem.last
+            shaped = np.append(shaped, at) if last else shaped
+            slope = np.append(slope, adot) if last else slope
+        x.setArray(shaped)
+        pt = new.cont.project(x, b.p, slope, b.pdot)
+        x.destroy()
+        same = pt is not None and all(np.sign(ev.test(b)) == np.sign(ev.test(pt)) != 0
+                                      for ev in self.tracer.events)
+        if same or (pt is not None and forced):
+            self.next = (new, pt)
+            return True
+        new.destroy()
+        if forced:
+            raise RuntimeError(f"cannot carry the curve to a new grid at lambda = {b.p:.6g}")
+        return False
+
+
+class Tracer:
+    """Trace a curve in segments: on a fixed grid (one segment), or on grids that follow the edge."""
+
+    def __init__(self, model, settings: Settings, events, tol=None, nodes=None, pmat=None, level: int = 0,
+                 rmax: float = RMAX):
+        """``nodes``: a fixed grid, or None for grids following the edge at refinement ``level`` out to
+        ``rmax``; ``pmat``: the preconditioning strategy of every segment's problem."""
+        self.model, self.set, self.events, self.tol = model, settings, list(events), tol
+        self.nodes, self.pmat, self.level, self.rmax = nodes, pmat, level, rmax
+        self.segments: list[Segment] = []
+        self.sharp = None
+
+    def segment(self, kind: str, at: float | None = None, before: Segment | None = None) -> Segment:
+        """A segment of ``kind`` (fixed, edge, scaled) centred on ``at``, continuing ``before``'s budget."""
+        if kind == "fixed":
+            grid, problem = None, Problem(self.model, self.nodes, create_influence(self.nodes), self.pmat)
+        elif kind == "edge":
+            grid = grid_for(self.model, at, self.level, self.rmax)
+            r = grid.nodes()
+            problem = Problem(self.model, r, create_influence(r), self.pmat)
+        else:
+            grid = scaled_grid_for(self.model, at, self.level, self.rmax)
+            rho = grid.nodes() / at
+            problem = ScaledProblem(self.model, rho, create_influence(rho), at, self.pmat)
+        s = self.set
+        if before is not None:
+            steps = sum(len(g.cont.points) - 1 for g in self.segments)
+            folds = sum(g.cont.folds for g in self.segments)
+            s = replace(s, ds=before.cont.ds, max_steps=max(1, s.max_steps - steps),
+                        max_folds=s.max_folds - folds)
+        cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments))
+        return Segment(kind, grid, problem, cont, EventFinder(cont, self.events, *([self.tol] if self.tol else [])))
+
+    def run(self, lam0: float, started=None) -> list[Segment]:
+        """The curve from lam0, starting from the rigid state (eq. 27); ``started()`` after the first point."""
+        seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)
+        self.sharp = self.nodes is None and sharp(self.model, seg.problem.law)
+        self.segments.append(seg)
+        x = seg.problem.rigid(lam0, seg.problem.create_vec())
+        try:
+            start = seg.cont.start(x, lam0)
+        except RuntimeError as e:
+            raise RuntimeError(f"{e}; give -cont_lambda_start further apart") from None
+        finally:
+            x.destroy()
+        if started:
+            started()
+        while True:
+            regrid = _Regrid(self, seg) if seg.kind != "fixed" else None
+            seg.cont.run(start, on_step=seg.finder, until=regrid)
+            if regrid is None or regrid.next is None:
+                return self.segments
+            seg, start = regrid.next
+            self.segments.append(seg)
+
+    def destroy(self) -> None:
+        """Free every segment's PETSc objects."""
+        for seg in self.segments:
+            seg.destroy()
+        self.segments = []
