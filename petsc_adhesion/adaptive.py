@@ -11,8 +11,8 @@ one grid, of two kinds:
   CONTACT_SPACING, within BAND of it; graded beyond; geometric out to RMAX,
   where the attraction left out carries |F| < 1e-8).  A new segment when the
   edge has travelled more than ``travel`` from the grid's centre.
-* ``scaled``: once a sharp edge (zone / NODES_PER_ZONE < CONTACT_SPACING,
-  roughness below the pinned level) has formed a contact of radius A_SWITCH,
+* ``scaled``: once a sharp edge (zone / NODES_PER_ZONE < CONTACT_SPACING)
+  has formed a contact of radius A_SWITCH,
   the frame of the edge (:mod:`petsc_adhesion.scaled`): the grid in rho = r/a
   follows the contact radius a by itself, and a new segment is needed only
   when a has changed by the factor GROW.
@@ -33,11 +33,13 @@ from mpi4py import MPI
 
 from .continuation import Continuation, Settings
 from .events import EventFinder
+from . import grid
 from .grid import EdgeGrid
 from .influence import create_influence
+from .pressure import PressureLaw
 from .problem import Problem
-from .resolution import NODES_PER_ZONE
-from .scaled import LEVEL, ScaledProblem
+from .resolution import NODES_PER_ZONE, cohesive_zone
+from .scaled import ScaledProblem, edge_level
 
 __all__ = ["grid_for", "edge_of", "contact_radius", "Segment", "Tracer", "BAND", "CONTACT_SPACING", "RMAX",
            "REACH", "A_SWITCH", "GROW"]
@@ -56,8 +58,13 @@ A_SWITCH = 0.3
 GROW = 1.5
 
 
+def _zone(model) -> float:
+    """The cohesive zone of the model, roughness included (:func:`~petsc_adhesion.resolution.cohesive_zone`)."""
+    return cohesive_zone(model, PressureLaw(model.sigma, model.roughness, model.hermite_points))
+
+
 def _fine(model) -> float:
-    return min(model.cohesive_zone / NODES_PER_ZONE, CONTACT_SPACING)
+    return min(_zone(model) / NODES_PER_ZONE, CONTACT_SPACING)
 
 
 def grid_for(model, edge: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid:
@@ -70,16 +77,16 @@ def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX) -> Edge
     """The grid of the frame of the edge, in physical units for contact radius ``a`` (divide by a for rho).
 
     Fine enough for the zone while a grows by GROW^2 (a change waits at most that
-    long), out to rmax GROW^2 at a, so past rmax at a / GROW^2.
+    long), over two zones about the pinned edge (the peak attraction lies within
+    one), out to rmax GROW^2 at a, so past rmax at a / GROW^2.
     """
-    zone = model.cohesive_zone
-    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=rmax * GROW**2, band=2 * zone,
+    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=rmax * GROW**2, band=2 * _zone(model),
                     contact=CONTACT_SPACING, reach=REACH, level=level)
 
 
-def sharp(model, law) -> bool:
+def sharp(model) -> bool:
     """Whether the contact edge is sharp enough to be traced in its own frame."""
-    return model.cohesive_zone / NODES_PER_ZONE < CONTACT_SPACING and law.wall < LEVEL - 0.25
+    return _zone(model) / NODES_PER_ZONE < CONTACT_SPACING
 
 
 def edge_of(problem, x: np.ndarray) -> float:
@@ -91,12 +98,13 @@ def edge_of(problem, x: np.ndarray) -> float:
 
 
 def contact_radius(problem, x: np.ndarray) -> float:
-    """Where H first rises through LEVEL from the centre (0 when H(0) >= LEVEL); collective."""
+    """Where H first rises through the edge level from the centre (0 when H(0) is above it); collective."""
     r, H = problem.nodes(x), problem.gather(problem.separation(x))
-    if H[0] >= LEVEL:
+    level = edge_level(problem.law)
+    if H[0] >= level:
         return 0.0
-    k = int(np.argmax(H >= LEVEL))
-    return float(r[k - 1] + (LEVEL - H[k - 1]) / (H[k] - H[k - 1]) * (r[k] - r[k - 1]))
+    k = int(np.argmax(H >= level))
+    return float(r[k - 1] + (level - H[k - 1]) / (H[k] - H[k - 1]) * (r[k] - r[k - 1]))
 
 
 @dataclass
@@ -115,9 +123,9 @@ class Segment:
         self.problem.destroy()
 
 
-def _carry(old, new, x: np.ndarray, xdot: np.ndarray | None = None) -> np.ndarray:
+def _carry(old, new, x: np.ndarray, scale: float, xdot: np.ndarray | None = None) -> np.ndarray:
     """The state x of ``old`` (or, with ``xdot``, its tangent's nodal part) on ``new``'s local nodes,
-    ``new`` at its design scale.
+    ``new``'s nodes taken at contact radius ``scale`` if it is in the frame of the edge.
 
     H grows like r^2/2 (eq. 27): its deformation D = H - r^2/2 is interpolated
     instead, since the far grid's spacing h would cost the quadratic h^2/8, and
@@ -126,11 +134,35 @@ def _carry(old, new, x: np.ndarray, xdot: np.ndarray | None = None) -> np.ndarra
     """
     r_old = old.nodes(x)
     scaled = isinstance(new, ScaledProblem)
-    r_new = (new.scale * new.rho if scaled else new.r)[new.lo:new.hi]
+    r_new = (scale * new.rho if scaled else new.r)[new.lo:new.hi]
     if xdot is not None:
         return np.interp(r_new, r_old, old.gather(xdot[:old.hi - old.lo]))
     field = old.gather(old.separation(x) - 0.5 * r_old[old.lo:old.hi] ** 2)
     return np.interp(r_new, r_old, field) + (0.0 if scaled else 0.5 * r_new * r_new)
+
+
+def carry(old: Segment, new: Segment, pt, scale: float | None = None):
+    """The point ``pt`` of ``old``'s curve put on ``new``'s: interpolated, then a zero-length arclength
+    correction there (regular at folds), its tangent oriented like pt's; None when that fails.
+
+    ``scale``: the contact radius to start from in the frame of the edge (default: pt's own,
+    or where its H rises through the edge level).
+    """
+    src, dst = old.problem, new.problem
+    scaled = isinstance(dst, ScaledProblem)
+    if scaled and scale is None:
+        scale = src.radius(pt.x) if isinstance(src, ScaledProblem) else contact_radius(src, pt.x)
+    shaped, slope = _carry(src, dst, pt.x, scale), _carry(src, dst, pt.x, scale, pt.xdot)
+    if scaled and dst.last:
+        adot = src.radius(pt.xdot) if isinstance(src, ScaledProblem) else 0.0
+        shaped, slope = np.append(shaped, scale), np.append(slope, adot)
+    elif scaled:
+        src.radius(pt.xdot) if isinstance(src, ScaledProblem) else None   # collective
+    x = dst.create_vec()
+    x.setArray(shaped)
+    out = new.cont.project(x, pt.p, slope, pt.pdot)
+    x.destroy()
+    return out
 
 
 class _Regrid:
@@ -138,7 +170,7 @@ class _Regrid:
 
     def __init__(self, tracer, seg: Segment):
         self.tracer, self.seg, self.next = tracer, seg, None
-        zone = seg.problem.model.cohesive_zone
+        zone = _zone(seg.problem.model)
         self.travel = min(BAND / 2 + zone, REACH / 3)
         self.forced = min(BAND + 2 * zone, 2 * REACH / 3)
 
@@ -160,18 +192,8 @@ class _Regrid:
         if where is None:
             return False
         kind, at, forced = where
-        old, new = self.seg.problem, self.tracer.segment(kind, at, self.seg)
-        x = new.problem.create_vec()
-        shaped = _carry(old, new.problem, b.x)
-        slope = _carry(old, new.problem, b.x, b.xdot)
-        if kind == "scaled":
-            adot = old.radius(b.xdot) if self.seg.kind == "scaled" else 0.0
-            last = new.problem.last
-            shaped = np.append(shaped, at) if last else shaped
-            slope = np.append(slope, adot) if last else slope
-        x.setArray(shaped)
-        pt = new.cont.project(x, b.p, slope, b.pdot)
-        x.destroy()
+        new = self.tracer.segment(kind, at, self.seg)
+        pt = carry(self.seg, new, b, at if kind == "scaled" else None)
         same = pt is not None and all(np.sign(ev.test(b)) == np.sign(ev.test(pt)) != 0
                                       for ev in self.tracer.events)
         if same or (pt is not None and forced):
@@ -195,31 +217,35 @@ class Tracer:
         self.segments: list[Segment] = []
         self.sharp = None
 
-    def segment(self, kind: str, at: float | None = None, before: Segment | None = None) -> Segment:
-        """A segment of ``kind`` (fixed, edge, scaled) centred on ``at``, continuing ``before``'s budget."""
+    def segment(self, kind: str, at: float | None = None, before: Segment | None = None,
+                level: int | None = None, settings: Settings | None = None) -> Segment:
+        """A segment of ``kind`` (fixed, edge, scaled) centred on ``at`` at refinement ``level`` (default:
+        the tracer's), continuing ``before``'s budget, or with ``settings`` of its own."""
+        level = self.level if level is None else level
         if kind == "fixed":
-            grid, problem = None, Problem(self.model, self.nodes, create_influence(self.nodes), self.pmat)
+            nodes = grid.nested(self.nodes, level - self.level)
+            problem, design = Problem(self.model, nodes, create_influence(nodes), self.pmat), None
         elif kind == "edge":
-            grid = grid_for(self.model, at, self.level, self.rmax)
-            r = grid.nodes()
+            design = grid_for(self.model, at, level, self.rmax)
+            r = design.nodes()
             problem = Problem(self.model, r, create_influence(r), self.pmat)
         else:
-            grid = scaled_grid_for(self.model, at, self.level, self.rmax)
-            rho = grid.nodes() / at
+            design = scaled_grid_for(self.model, at, level, self.rmax)
+            rho = design.nodes() / at
             problem = ScaledProblem(self.model, rho, create_influence(rho), at, self.pmat)
-        s = self.set
+        s = settings or self.set
         if before is not None:
             steps = sum(len(g.cont.points) - 1 for g in self.segments)
             folds = sum(g.cont.folds for g in self.segments)
             s = replace(s, ds=before.cont.ds, max_steps=max(1, s.max_steps - steps),
                         max_folds=s.max_folds - folds)
-        cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments))
-        return Segment(kind, grid, problem, cont, EventFinder(cont, self.events, *([self.tol] if self.tol else [])))
+        cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments) if before else 0)
+        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, *([self.tol] if self.tol else [])))
 
     def run(self, lam0: float, started=None) -> list[Segment]:
         """The curve from lam0, starting from the rigid state (eq. 27); ``started()`` after the first point."""
         seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)
-        self.sharp = self.nodes is None and sharp(self.model, seg.problem.law)
+        self.sharp = self.nodes is None and sharp(self.model)
         self.segments.append(seg)
         x = seg.problem.rigid(lam0, seg.problem.create_vec())
         try:

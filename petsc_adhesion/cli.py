@@ -14,20 +14,13 @@ import signal
 import sys
 from contextlib import nullcontext
 
+from .errors import Interrupted
 from .files import printable
 from .optionsfile import environment_error, file_error, options_files, stray_word
 
 __all__ = ["main", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
 
 EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INCOMPLETE = 0, 1, 2, 3
-
-
-class Interrupted(BaseException):
-    """SIGINT or SIGTERM: end cleanly, with the signal's exit status."""
-
-    def __init__(self, signum: int):
-        super().__init__(signum)
-        self.signum = signum
 
 
 def _on_signal(signum, frame):

@@ -114,6 +114,8 @@ class Found:
     before: float                 # the test function's value at the segment's start
     landing: object = None        # for a fold: the point it jumps to (see jumps)
     landing_by: object = None     # the EventFinder (segment) that located it
+    landing_step: int = -1        # and the step of that segment it lies on
+    estimate: dict | None = None  # best values and error bars, when asked for (error_estimate.event_errors)
 
 
 class EventFinder:
@@ -156,6 +158,10 @@ class EventFinder:
         def g(s, tangent=tangent):
             if s not in cache:
                 sol = cont.correct(a, s, tangent) if s else (a.x, a.p, (a.xdot, a.pdot, 0), 0, 0, "")
+                if sol is None:                       # a factorization kept from afar: once more, fresh
+                    cont.newton.reuse.expire()
+                    cont.bordered.reuse.expire()
+                    sol = cont.correct(a, s, tangent)
                 if sol is None:
                     raise RuntimeError(f"event location failed near {cont.pb.parameter} = {a.p:.6g}")
                 x, p, (xdot, pdot, _), *_ = sol
@@ -197,5 +203,5 @@ def jumps(finders, stable) -> None:
                 a, b = owner.cont.points[j], owner.cont.points[j + 1]
                 if stable(a) and stable(b) and (a.p - pf) * (b.p - pf) <= 0:
                     ev.landing = owner.locate(a, b, lambda pt: pt.p, level=pf, tangent=False)
-                    ev.landing_by = owner
+                    ev.landing_by, ev.landing_step = owner, j
                     break

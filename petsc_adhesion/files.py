@@ -26,10 +26,12 @@ from contextlib import contextmanager
 
 from .errors import InputError
 
-__all__ = ["check_targets", "ResultSet", "atomic_write", "PLOT_FORMATS", "printable"]
+__all__ = ["check_targets", "ResultSet", "atomic_write", "PLOT_FORMATS", "printable", "JOURNAL"]
 
 #: Figure formats by file extension.
 PLOT_FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
+#: What a journal of ours says it is (a file of that name that does not is left alone).
+JOURNAL = "petsc-adhesion journal"
 
 
 def printable(text) -> str:
@@ -66,6 +68,11 @@ def check_targets(targets: dict, inputs: dict | None = None) -> None:
             path.encode("utf-8")
         except UnicodeEncodeError:
             raise InputError(f"-{option}: the file name '{name}' is not valid UTF-8") from None
+        if path.endswith(os.sep):
+            raise InputError(f"-{option}: '{name}' names a directory; give a file name")
+        base = os.path.basename(path)
+        if base.startswith(".") and (base.endswith(".commit") or ".partial-" in base):
+            raise InputError(f"-{option}: '{name}' is the name of a temporary or journal of result files")
         if os.path.islink(path):
             raise InputError(f"-{option}: '{name}' is a symbolic link; give the file itself")
         if os.path.exists(path):
@@ -128,6 +135,20 @@ def _journal(path: str) -> str:
     return os.path.join(folder, f".{base}.commit")
 
 
+def _read_journal(path: str) -> list | None:
+    """The renames a journal of ours lists, or None for any other file (left alone)."""
+    try:
+        with open(path) as f:
+            data = json.load(f)
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    if isinstance(data, dict) and data.get("program") == JOURNAL and isinstance(data.get("renames"), list) \
+            and all(isinstance(x, list) and len(x) == 2 and all(isinstance(y, str) for y in x)
+                    for x in data["renames"]):
+        return data["renames"]
+    return None
+
+
 @contextmanager
 def _signals_held():
     held = {signal.SIGINT, signal.SIGTERM}
@@ -149,24 +170,29 @@ class ResultSet:
     def __init__(self, targets: dict):
         self.targets = {k: v for k, v in targets.items() if v}
         self.temps = {}
+        self.committed = False
         self.recover()
 
     def recover(self) -> None:
-        """Finish the renames of a run killed while committing these names; remove dead runs' temporaries."""
+        """Finish the renames of a run killed while committing any of these names; remove dead runs' temporaries.
+
+        A journal lies beside each folder's first output of its set and lists all
+        of them, so it is found from any name of the set.
+        """
+        for folder in {os.path.dirname(os.path.abspath(p)) for p in self.targets.values()}:
+            mine = {os.path.abspath(p) for p in self.targets.values()}
+            for journal in glob.glob(os.path.join(glob.escape(folder), ".*.commit")):
+                renames = _read_journal(journal)
+                if renames is None or not mine & {final for _, final in renames}:
+                    continue
+                for tmp, final in renames:
+                    if os.path.exists(tmp):
+                        os.replace(tmp, final)
+                for other in {_journal(final) for _, final in renames}:
+                    if os.path.exists(other) and _read_journal(other) is not None:
+                        os.remove(other)
+        host = socket.gethostname()
         for path in self.targets.values():
-            journal = _journal(path)
-            if os.path.exists(journal):
-                try:
-                    with open(journal) as f:
-                        renames = json.load(f)
-                    for tmp, final in renames:
-                        if os.path.exists(tmp):
-                            os.replace(tmp, final)
-                except (OSError, ValueError):
-                    pass
-                if os.path.exists(journal):
-                    os.remove(journal)
-            host = socket.gethostname()
             folder, base = os.path.split(os.path.abspath(path))
             for tmp in glob.glob(os.path.join(glob.escape(folder), f".{glob.escape(base)}.partial-*")):
                 owner = tmp.rsplit(".partial-", 1)[1]
@@ -186,16 +212,21 @@ class ResultSet:
         renames = [(self.temps[k], os.path.abspath(self.targets[k])) for k in self.targets if k in self.temps]
         if not renames:
             return
-        journal = _journal(renames[0][1])
-        with atomic_write(journal) as tmp:
-            with open(tmp, "w") as f:
-                json.dump(renames, f)
-                f.flush()
-                os.fsync(f.fileno())
+        journals = {}                              # one beside the first output of each folder
+        for _, final in renames:
+            journals.setdefault(os.path.dirname(final), _journal(final))
+        for journal in journals.values():
+            with atomic_write(journal) as tmp:
+                with open(tmp, "w") as f:
+                    json.dump({"program": JOURNAL, "renames": renames}, f)
+                    f.flush()
+                    os.fsync(f.fileno())
         with _signals_held():
             for tmp, final in renames:
                 os.replace(tmp, final)
-            os.remove(journal)
+            self.committed = True
+            for journal in journals.values():
+                os.remove(journal)
         self.temps = {}
 
     def discard(self) -> None:

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["uniform", "paper", "load_weights", "l2_weights", "EdgeGrid", "PAPER_UNIFORM", "PAPER_EXTRA",
-           "PAPER_SPLIT"]
+__all__ = ["uniform", "paper", "nested", "load_weights", "l2_weights", "EdgeGrid", "PAPER_UNIFORM",
+           "PAPER_EXTRA", "PAPER_SPLIT"]
 
 #: The paper's grid: 501 uniform nodes plus about 30 (N = 531): 30 elements halved.
 PAPER_UNIFORM, PAPER_EXTRA, PAPER_SPLIT = 501, 30, 2
@@ -40,6 +40,22 @@ def paper(rmax: float, n_uniform: int = PAPER_UNIFORM, extra: int = PAPER_EXTRA,
     a, h = r[first:first + extra], r[1] - r[0]
     inner = (a[:, None] + h * np.arange(1, split)[None, :] / split).ravel()
     return np.sort(np.concatenate([r, inner]))
+
+
+def nested(r: np.ndarray, level: int) -> np.ndarray:
+    """The grid ``level`` times refined (element midpoints added) or, for level < 0, coarsened
+    (every other node, both ends kept: the last element may merge two).
+
+    >>> nested(uniform(5, 1.0), -1)
+    array([0. , 0.5, 1. ])
+    >>> nested(uniform(3, 1.0), 1)
+    array([0.  , 0.25, 0.5 , 0.75, 1.  ])
+    """
+    for _ in range(max(0, -level)):
+        r = r[::2] if r.size % 2 else np.append(r[:-1:2], r[-1])
+    for _ in range(max(0, level)):
+        r = np.sort(np.concatenate([r, 0.5 * (r[1:] + r[:-1])]))
+    return r
 
 
 def load_weights(r: np.ndarray) -> np.ndarray:

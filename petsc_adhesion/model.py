@@ -46,6 +46,7 @@ class Model:
     rmax: float = 10.0
     roughness: str = "hermite"
     hermite_points: int = 16
+    farfield: bool = True      # add the rigid sphere's attraction beyond r_m (the half-infinite model)
 
     @property
     def coupling(self) -> float:

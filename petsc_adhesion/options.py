@@ -85,6 +85,8 @@ TABLE = {o.name: o for o in [
     Option("adh_hermite_points", "int", Model.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
     Option("adh_rmax", "real", None, f"end r_m of the computational domain (default: {RMAX:g} on grids that "
            f"follow the contact edge, {Model.rmax:g} as in the paper otherwise)", 0.0, 1e3, lo_open=True),
+    Option("adh_farfield", "flag", Model.farfield, "add the rigid sphere's attraction beyond r_m to the load: "
+           "the half-infinite model (false: the paper's model truncated at r_m)"),
     Option("adh_lambda", "real", None, "solve at this one approach lambda only (no continuation)", -1e3, 1e3),
     Option("adh_guess", "string", None, "HDF5 result whose H(r) is the initial guess of -adh_lambda"),
     Option("adh_pmat", "choice", "dense", "matrix handed to the preconditioner: the assembled Jacobian, "
@@ -122,8 +124,10 @@ TABLE = {o.name: o for o in [
     Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
     Option("cont_event_tol", "real", EVENT_TOL, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
     Option("cont_monitor", "flag", _S.monitor, "one line a continuation step"),
-    Option("cont_error_estimate", "flag", False, "trace again on every other node and give each event "
-           "its discretization error (Richardson) and the load truncated beyond r_m"),
+    Option("cont_error_estimate", "flag", True, "give every event its best value and error bar: located again "
+           "on its grid's coarser (or finer) nested levels, Richardson-extrapolated"),
+    Option("target_error", "real", None, "refine each event's levels until its error bars (lambda and F) are "
+           "below this", 0.0, 1.0, lo_open=True),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
@@ -206,7 +210,8 @@ class AppOptions:
     def given(self) -> dict:
         """Every option in the database as given: name -> value string (None for a bare flag).
 
-        petsc4py's getAll splits values at blanks; each value is read again whole.
+        petsc4py's getAll splits values at blanks; each value is read again whole,
+        which marks every option used: only after the checks for unused options.
         """
         return {k: (None if v is None else self.db.getString(k, "")) for k, v in self.db.getAll().items()}
 
@@ -228,7 +233,7 @@ def _strict_float(s: str) -> float:
 
 def _strict_int(s: str) -> int:
     x = _strict_float(s)
-    if x != int(x):
+    if not math.isfinite(x) or x != int(x):
         raise ValueError(s)
     return int(x)
 
@@ -253,8 +258,8 @@ def read_model(opts: AppOptions) -> Model:
     rmax = opts.real("adh_rmax")
     if rmax is None:
         rmax = RMAX if opts.choice("grid_type") == "edge" else Model.rmax
-    model = Model(mu=mu, sigma=opts.real("adh_sigma"), rmax=rmax,
-                  roughness=opts.choice("adh_roughness"), hermite_points=opts.int("adh_hermite_points"))
+    model = Model(mu=mu, sigma=opts.real("adh_sigma"), rmax=rmax, roughness=opts.choice("adh_roughness"),
+                  hermite_points=opts.int("adh_hermite_points"), farfield=opts.flag("adh_farfield"))
     if model.roughness == "none" and model.sigma > 0:
         raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
     return model
@@ -312,7 +317,10 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
     ignored = []
     if fixed:
         ignored += [(n, "applies to a curve, not with -adh_lambda") for n in
-                    _given(opts, [n for n in TABLE if n.startswith("cont_")] + ["profiles", "plot"])]
+                    _given(opts, [n for n in TABLE if n.startswith("cont_")] + ["profiles", "plot", "target_error"])]
+    elif not opts.flag("cont_error_estimate"):
+        ignored += [(n, "refines error bars, which -cont_error_estimate false turns off") for n in
+                    _given(opts, ["target_error"])]
     kind = opts.choice("grid_type")
     if kind == "paper":
         ignored += [(n, "is a -grid_type uniform option") for n in _given(opts, ["grid_n"])]
@@ -387,6 +395,8 @@ def read_guess(problem, lam: float, path: str | None) -> PETSc.Vec:
     if path is None:
         return H
     shown = printable(path)
+    if not os.path.isfile(path):
+        raise InputError(f"-adh_guess: '{shown}' is not a regular file")
     try:
         import h5py
         with h5py.File(path, "r") as f:
@@ -421,9 +431,10 @@ def petsc_error(err: PETSc.Error) -> InputError | str:
     words it uses ("Restart must be positive": -ksp_gmres_restart).
     """
     detail = capi.error_message(err.ierr) or f"PETSc error {err.ierr}"
-    given = AppOptions().given()
+    # the application's options are checked before PETSc sees them; a number quoted is no one's name
+    given = {k: v for k, v in AppOptions().given().items() if k not in TABLE}
     words = set(detail.lower().replace("'", " ").replace('"', " ").replace(",", " ").replace(":", " ").split())
-    by_value = [k for k, v in given.items() if v and v.lower() in words]
+    by_value = [k for k, v in given.items() if v and v.lower() in words and not _NUMBER.fullmatch(v.strip())]
     by_name = [k for k in given if any(len(w) >= 3 and w not in _GENERIC and w in words for w in k.lower().split("_"))]
     named = by_value or by_name
     if named:
@@ -495,8 +506,13 @@ _PETSC_RANGES = {
 
 
 def check_petsc_values(db: PETSc.Options | None = None) -> None:
-    """Raise :class:`InputError` for a solver tolerance or count out of its range, under any prefix."""
+    """Raise :class:`InputError` for a solver tolerance or count out of its range, under any prefix,
+    or a Python solver type (it needs a context this program does not give)."""
     db = db or PETSc.Options()
+    for name, value in db.getAll().items():        # getAll does not mark options used, getString would
+        if name.endswith("_type") and value == "python":
+            raise InputError(f"-{name} python: a Python type needs its context, which this program does not "
+                             f"set; choose one of PETSc's own types")
     for prefix in _prefixes():
         for name, (kind, lo, hi, lo_open, hi_open) in _PETSC_RANGES.items():
             if not db.hasName(prefix + name):

@@ -34,16 +34,24 @@ def _lines(path: str):
             yield n, line, line.split("#")[0].split("!")[0].split()
 
 
+def _utf8(line: str) -> bool:
+    try:
+        line.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
 def options_files(argv: list[str]) -> list[str]:
     """The files named by -options_file on the command line and, recursively, inside them."""
     out = []
     todo = [argv[i + 1] if i + 1 < len(argv) else "" for i, a in enumerate(argv) if a == "-options_file"]
     while todo:
         path = todo.pop(0)
-        if not path or path in out:
+        if path in out:
             continue
         out.append(path)
-        if os.path.isfile(path) and os.access(path, os.R_OK):
+        if path and os.path.isfile(path) and os.access(path, os.R_OK):
             todo += [t[1] for _, _, t in _lines(path) if len(t) == 2 and t[0] == "-options_file"]
     return out
 
@@ -64,6 +72,8 @@ def file_error(path: str, opened: tuple = ()) -> str | None:
     for n, line, tokens in _lines(path):
         ok = not tokens or (tokens[0] == "alias" and len(tokens) == 3) or \
             (tokens[0].startswith("-") and len(tokens) <= 2)
+        if not _utf8(line):
+            return f"-options_file {shown}: line {n} is not UTF-8: '{printable(line.strip())}'"
         if not ok:
             return f"-options_file {shown}: line {n}: expected '-name [value]', got '{printable(line.strip())}'"
         if tokens and tokens[0] == "-options_file":

@@ -20,7 +20,7 @@ __all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve
 # Units of the dimensionless results (docs/model.md)
 _EPS, _LOAD, _RAD, _PRES = "epsilon", "2 pi R gamma", "sqrt(epsilon R)", "8 gamma / (3 epsilon)"
 _STATE = f"lambda, H0: {_EPS}; F: {_LOAD}"
-_ERRORS = f"lambda_err: {_EPS}; F_err, F_truncation: {_LOAD}"
+_ERRORS = f"lambda_err, lambda_grid: {_EPS}; F_err, F_grid, F_beyond: {_LOAD}"
 #: path pattern (numbered groups as *) -> (units, one-line description), for every group and dataset
 DESCRIBE = {
     "": ("", "petsc-adhesion result: adhesive contact of an elastic sphere with a flat (Cheng, Dunn and Brach "
@@ -33,7 +33,8 @@ DESCRIBE = {
     "grid": ("", "the collocation grid (of the last segment when the grid followed the contact edge)"),
     "grid/r": (_RAD, "the nodes r_i on [0, r_m]"),
     "grid/lambda": (_EPS, "approach where each segment of the curve, on its own grid, starts"),
-    "grid/edge": (_RAD, "contact edge each segment's grid is centred on (NaN: a fixed grid)"),
+    "grid/edge": (_RAD, "contact edge (or, in the frame of the edge, contact radius) each segment's grid is "
+                        "centred on; absent on a fixed grid"),
     "grid/n_nodes": ("", "nodes of each segment's grid"),
     "solution": (f"{_STATE}; wall_time_s: s", "the state at one approach (-adh_lambda) and the solver's effort"),
     "solution/H": (_EPS, "separation H = h / epsilon - 1 at the nodes"),
@@ -72,7 +73,7 @@ def _describe(name: str, obj) -> None:
 
 def _write(group, tree: dict) -> None:
     """Dicts become groups, lists of dicts numbered groups; arrays datasets; scalars, strings and lists of
-    strings attributes."""
+    numbers or strings attributes (None: an empty string)."""
     import h5py
 
     for key, val in tree.items():
@@ -82,6 +83,8 @@ def _write(group, tree: dict) -> None:
             sub = group.require_group(key)
             for i, item in enumerate(val):
                 _write(sub.require_group(f"{i:04d}"), item)
+        elif isinstance(val, (list, tuple)) and all(isinstance(v, (int, float)) for v in val) and val:
+            group.attrs[key] = np.array(val)
         elif isinstance(val, (list, tuple)):
             group.attrs[key] = np.array([str(v) for v in val], dtype=h5py.string_dtype())
         elif isinstance(val, np.ndarray):
@@ -118,13 +121,14 @@ def write_json(path: str, summary: dict) -> None:
 
 
 # -- layout ---------------------------------------------------------------------
-_BRIEF = ("kind", "lambda", "F", "H0", "stable", "lambda_err", "F_err", "F_truncation")
+_BRIEF = ("kind", "lambda", "F", "H0", "stable", "lambda_err", "F_err", "lambda_grid", "F_grid", "F_beyond",
+          "levels", "target_met", "error_note")
 
 
 def _brief(e: dict) -> dict:
     out = {k: v for k, v in e.items() if k in _BRIEF}
     if "landing" in e:
-        out["landing"] = {k: v for k, v in e["landing"].items() if k in ("lambda", "F", "H0")}
+        out["landing"] = {k: v for k, v in e["landing"].items() if k in ("lambda", "F", "H0", "F_err", "F_grid")}
     return out
 
 
@@ -141,10 +145,12 @@ def curve_summary(res: dict, head: dict) -> dict:
     s = {**_common(head),
          "pull_off": _brief(po) if po else None,
          "folds": [_brief(e) for e in ev if e["kind"] in ("snap_on", "snap_off")],
-         "equilibria": [{k: v for k, v in _brief(e).items() if k != "F"} for e in ev if e["kind"] == "equilibrium"],
+         "equilibria": [{k: v for k, v in _brief(e).items() if k not in ("F", "F_err", "F_grid")}
+                       for e in ev if e["kind"] == "equilibrium"],
          "load_extrema": [_brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
          "at_lambda": [_brief(e) for e in ev if e["kind"] == "lambda"],
          "steps": res["steps"], "rejected_steps": res["rejected_steps"], "regrids": res["regrids"],
+         **{k: res[k] for k in ("guard_activations", "smallest_step", "most_newton_its", "most_ksp_its")},
          "stop_reason": res["stop_reason"],
          "grid_warning": res["grid_warning"], "warnings": res["warnings"], "complete": not res["incomplete"],
          "lambda_start": res["lambda_start"], "wall_time_s": res["wall_time_s"]}

@@ -18,7 +18,7 @@ from petsc4py import PETSc
 from .grid import l2_weights, load_weights
 from .preconditioning import Border, Dense, Layout
 from .pressure import PressureLaw
-from .reference import jkr_zero_load
+from .reference import jkr_zero_load, load_beyond, load_beyond_rates
 
 __all__ = ["Problem", "far_approach", "norm_radius", "TO_WALL"]
 
@@ -78,6 +78,7 @@ class Problem:
         self.jacobian = PETSc.Mat().createPython(A.getSizes(), _Jacobian(self), comm=self.comm)
         self.jacobian.setUp()
         self._gather = None
+        self.guarded = 0                  # Newton steps the domain guard shortened
 
     # -- state ------------------------------------------------------------------
     def create_vec(self) -> PETSc.Vec:
@@ -110,18 +111,29 @@ class Problem:
         out[:] = 1.0
         return out
 
-    def load(self, H: PETSc.Vec) -> float:
-        """F = (8/3) integral_0^{r_m} P r dr (eq. 26), exact for piecewise-linear P."""
+    def load(self, H: PETSc.Vec, lam: float) -> float:
+        """F = (8/3) integral_0^{r_m} P r dr (eq. 26), exact for piecewise-linear P, plus the far field
+        beyond r_m when the model has it."""
         pressure, _ = self.pressure(H)
-        return self._mpi.allreduce(float(self.q @ pressure))
+        return self._mpi.allreduce(float(self.q @ pressure)) + self.far_load(lam)
+
+    def far_load(self, lam: float) -> float:
+        """The rigid sphere's attraction beyond r_m (:func:`~petsc_adhesion.reference.load_beyond`) when the
+        model is the half-infinite one, else 0."""
+        return float(load_beyond(self.r[-1], lam)) if self.model.farfield else 0.0
 
     def observe(self, h: np.ndarray, lam: float, hdot: np.ndarray, lamdot: float):
         """The observable of the curve: the load F (eq. 26) and its rate dF/ds = (8/3) q . (P'(H) hdot).
 
-        ``h`` and ``hdot`` are local parts of H and of the tangent's H part.
+        ``h`` and ``hdot`` are local parts of H and of the tangent's H part.  With
+        the model's far field, the rigid sphere's attraction beyond r_m is added
+        (the half-infinite domain; :func:`~petsc_adhesion.reference.load_beyond`).
         """
         pressure, dpressure = self.law(h)
         F, dF = self._mpi.allreduce(np.array([self.q @ pressure, self.q @ (dpressure * hdot)]))
+        if self.model.farfield:
+            F += load_beyond(self.r[-1], lam)
+            dF += load_beyond_rates(self.r[-1], lam)[0] * lamdot
         return {"F": float(F)}, {"F": float(dF)}
 
     @staticmethod
@@ -156,8 +168,9 @@ class Problem:
         """
         room = h - self.law.wall
         toward = y > 0
-        alpha = float(np.min(TO_WALL * room[toward] / y[toward], initial=1.0))
-        return self._mpi.allreduce(alpha, op=MPI.MIN)
+        alpha = self._mpi.allreduce(float(np.min(TO_WALL * room[toward] / y[toward], initial=1.0)), op=MPI.MIN)
+        self.guarded += alpha < 1.0
+        return alpha
 
     # -- linearization --------------------------------------------------------------
     def linearize(self, H: PETSc.Vec, lam: float) -> None:

@@ -25,6 +25,8 @@ __all__ = [
     "JKR_PULL_OFF",
     "rigid_load",
     "load_beyond",
+    "load_beyond_rates",
+    "far_deflection",
     "disk_deflection",
     "hertz_deflection",
     "jkr_load",
@@ -113,6 +115,32 @@ def load_beyond(rmax: float, lam: ArrayLike) -> float | np.ndarray:
     """
     g = 1.0 - np.asarray(lam, dtype=float) + 0.5 * rmax**2
     return _out((8.0 / 3.0) * (g**-8 / 8.0 - g**-2 / 2.0))
+
+
+def load_beyond_rates(rmax: float, lam: float) -> tuple[float, float]:
+    """The derivatives of :func:`load_beyond` with respect to lambda and to rmax.
+
+    d/dlambda = (8/3) P(g_m) with P(g) = g^-9 - g^-3, and d/drmax = -(8/3) P(g_m) rmax.
+
+    >>> dlam, dr = load_beyond_rates(0.0, 0.0)          # P(1) = 0: eq. (28) is flat at lambda = 0
+    >>> abs(dlam) < 1e-15
+    True
+    """
+    g = 1.0 - lam + 0.5 * rmax**2
+    P = (8.0 / 3.0) * (g**-9 - g**-3)
+    return float(P), float(-P * rmax)
+
+
+def far_deflection(rmax: float, coupling: float) -> float:
+    """A bound on the deflection the attraction beyond rmax causes inside it (the far field's remainder).
+
+    c integral_{rmax}^inf t/(t + r) K P dt <= c (pi/2) integral_{rmax}^inf |P| dt with the
+    rigid gap t^2/2, where |P| <= 8 / t^6: c (pi/2) 8 / (5 rmax^5).
+
+    >>> f"{far_deflection(10.0, 3.3953):.1e}"
+    '8.5e-05'
+    """
+    return coupling * (math.pi / 2) * 8.0 / (5.0 * rmax**5)
 
 
 def disk_deflection(r: ArrayLike, a: float) -> float | np.ndarray:

@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from .grid import PAPER_UNIFORM
+from .scaled import edge_level
 
-__all__ = ["check", "NODES_PER_ZONE", "MAX_TRUE_FOLDS"]
+__all__ = ["check", "cohesive_zone", "NODES_PER_ZONE", "MAX_TRUE_FOLDS"]
 
 #: Nodes needed across the cohesive zone: measured at mu = 3 and 5, where uniform
 #: grids with h > zone/5 showed staircases of spurious folds and h <= zone/5 did not.
@@ -21,20 +22,32 @@ NODES_PER_ZONE = 5
 MAX_TRUE_FOLDS = 8
 
 
-def check(model, states, folds: int) -> str:
+def cohesive_zone(model, law) -> float:
+    """The cohesive zone at the contact edge: 0.75 mu^-1.5 for a smooth surface, wider with roughness.
+
+    The roughness average spreads the force over a range of the mean gap wider by
+    the heights' reach above the mean plane (the rule's wall + 1); at the edge of a
+    JKR-like contact the gap opens as the distance^(3/2), so the zone widens as the
+    2/3 power of that range.
+    """
+    return model.cohesive_zone * (2.0 + law.wall) ** (2.0 / 3.0)
+
+
+def check(model, law, states, folds: int) -> str:
     """One line when a grid did not resolve the cohesive zone where the contact edge was, else "".
 
-    ``states``: (nodes, nodal pressure) of each point of the curve; the contact
-    edge of a point is its radius of peak attraction (P most negative), and the
-    spacing there must be at most zone / NODES_PER_ZONE.  ``folds``: the turning
-    points the curve showed, the other symptom (more than :data:`MAX_TRUE_FOLDS`).
-    The line names the spacing the case needs there.
+    ``states``: (nodes, H, P) of each point of the curve; the contact edge of a
+    point is where H rises through ``level`` (the pinned level of the frame of the
+    edge) when it has a contact, else its radius of peak attraction (P most
+    negative), and the spacing there must be at most zone / NODES_PER_ZONE.
+    ``folds``: the turning points the curve showed, the other symptom (more than
+    :data:`MAX_TRUE_FOLDS`).  The line names the spacing the case needs there.
     """
-    zone = model.cohesive_zone
+    zone, level = cohesive_zone(model, law), edge_level(law)
     spacing, where = [], []
-    for r, P in states:
-        k = int(np.argmin(P))
-        if P[k] < 0 and np.isfinite(zone):
+    for r, H, P in states:
+        k = int(np.argmax(H >= level)) if H[0] < level else int(np.argmin(P))
+        if (P[k] < 0 or H[0] < level) and np.isfinite(zone):
             h = np.diff(r)
             spacing.append(h[max(0, k - 1):k + 1].max())
             where.append(r[k])

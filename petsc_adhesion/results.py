@@ -24,6 +24,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from .events import Extremum, Fold, ParameterValue, Zero
+from .reference import far_deflection, load_beyond
 
 __all__ = ["curve_events", "curve", "stop_reason", "assess", "report_curve", "report_solve", "WALL_GAP"]
 
@@ -59,12 +60,43 @@ def _state(problem, pt, profiles: bool) -> dict:
 
 
 def event_record(problem, found, profiles: bool) -> dict:
-    """One event as the result files hold it (collective: H0 and profiles gather)."""
+    """One event as the result files hold it (collective: H0 and profiles gather).
+
+    With an error estimate, ``lambda`` and ``F`` are the best values, ``*_err``
+    their bars and ``*_grid`` the values on the grid it was located on.  A lambda
+    asked for is exact, so is F = 0 at an equilibrium.  The half-infinite model
+    adds the rigid sphere's attraction beyond r_m to F (``F_beyond``); its
+    remainder, the deflection that attraction causes inside, enters both bars
+    (:func:`~petsc_adhesion.reference.far_deflection`).
+    """
     ev = {"kind": found.label, **_state(problem, found.point, profiles), "segment": found.segment}
     if not isinstance(found.event, Fold):          # at a fold lambdadot = 0: marginal
         ev["stable"] = bool(problem.stable(found.point))
     if found.landing is not None:
         ev["landing"] = _state(found.landing_by.cont.pb, found.landing, profiles)
+    est = getattr(found, "estimate", None)
+    if est is None:
+        return ev
+    if not est:
+        ev["error_note"] = "no error bar: the event was not found again on the coarser and finer levels"
+        return ev
+    model = problem.model
+    rm = float(problem.nodes(found.point.x)[-1])
+    far = far_deflection(rm, model.coupling) if model.farfield else 0.0
+    ev |= {"lambda_grid": ev["lambda"], "F_grid": ev["F"], "levels": est["levels"], "target_met": est["target_met"],
+           "F_beyond": float(load_beyond(rm, ev["lambda"])) if model.farfield else 0.0}
+    beyond = far
+    if found.label == "lambda":
+        ev |= {"F": est["F"], "F_err": est["F_err"] + beyond, "lambda_err": 0.0}
+    elif found.label == "equilibrium":
+        ev |= {"lambda": est["lambda"], "lambda_err": est["lambda_err"] + beyond, "F": 0.0, "F_err": 0.0}
+    else:
+        ev |= {"lambda": est["lambda"], "lambda_err": est["lambda_err"] + beyond, "F": est["F"],
+               "F_err": est["F_err"] + beyond}
+    if "landing" in ev and "landing" in est:
+        land = est["landing"]
+        ev["landing"] |= {"lambda": ev["lambda"], "F": land["F"], "F_err": land["F_err"] + beyond,
+                          "F_grid": land["F_grid"]}
     return ev
 
 
@@ -96,18 +128,22 @@ def curve(segments, profiles: bool = False) -> dict:
         for p in seg.cont.points:
             r, H = pb.nodes(p.x), _whole(pb, pb.separation(p.x))
             if H is not None:
-                states.append((r, pb.law(H)[0]))
+                states.append((r, H, pb.law(H)[0]))
     mins = [e for e in events if e["kind"] == "F_min"]
     last = segments[-1].cont
     return {"points": pts, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
             "steps": sum(len(seg.cont.points) - 1 for seg in segments),
             "rejected_steps": sum(seg.cont.rejected for seg in segments),
             "folds": sum(seg.cont.folds for seg in segments), "regrids": len(segments) - 1,
+            "guard_activations": sum(seg.problem.guarded for seg in segments),
+            "smallest_step": min((p.ds for p in pts if p.ds > 0), default=0.0),
+            "most_newton_its": max(p.newton_its for p in pts), "most_ksp_its": max(p.ksp_its for p in pts),
             "stop": last.stop, "stop_reason": stop_reason(last.stop, last.set), "states": states,
             "grid": segments[-1].problem.nodes(segments[-1].cont.points[-1].x),
             "grids": {"lambda": np.array([seg.cont.points[0].p for seg in segments]),
-                      "edge": np.array([np.nan if seg.grid is None else seg.grid.edge for seg in segments]),
-                      "n_nodes": np.array([seg.problem.layout.N for seg in segments])}}
+                      "n_nodes": np.array([seg.problem.layout.N for seg in segments]),
+                      **({"edge": np.array([seg.grid.edge for seg in segments])}
+                         if all(seg.grid is not None for seg in segments) else {})}}
 
 
 #: The contact reaches the end of the domain when |P(r_m)| exceeds this share of the peak attraction.
@@ -122,7 +158,8 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
     warn, short = [], []
     problem = segments[-1].problem
     law, pts, mpi = problem.law, res["points"], problem.comm.tompi4py()
-    gap = mpi.allreduce(min(float(p.x.min()) for p in pts) - law.wall, op=MPI.MIN)
+    gap = mpi.allreduce(min(float(seg.problem.separation(p.x).min()) for seg in segments for p in seg.cont.points)
+                        - law.wall, op=MPI.MIN)
     if not law.smooth and gap < WALL_GAP:
         warn.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
                     f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
@@ -133,13 +170,20 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
         short.append(res["grid_warning"])
     pull_off = res["pull_off"]
     lowest = min(p.values["F"] for p in pts)
-    if pull_off is not None and not res["grid_warning"] and lowest < pull_off["F"] - 1e-9:
+    located = None if pull_off is None else pull_off.get("F_grid", pull_off["F"])     # on the same grids
+    if located is not None and not res["grid_warning"] and lowest < located - 1e-9:
         short.append(f"a computed point (F = {lowest:.6g}) is more tensile than the located pull-off "
-                     f"({pull_off['F']:.6g}): the load varies faster than the steps resolve; "
+                     f"({located:.6g}): the load varies faster than the steps resolve; "
                      f"lower -cont_dF_max or -cont_ds_max")
     if pts[0].values["F"] > 0:
         short.append(f"the curve starts in contact (F = {pts[0].values['F']:.3g} > 0 at lambda = {pts[0].p:g}): "
                      f"the approach and its events lie before it; give -cont_lambda_start further apart")
+    missed = [e for e in res["events"] if e.get("target_met") is False]
+    if missed:
+        e = max(missed, key=lambda e: max(e.get("lambda_err", 0), e.get("F_err", 0)))
+        short.append(f"-target_error not reached for {len(missed)} event(s): {e['kind']} at lambda = {e['lambda']:.6g} "
+                     f"has lambda +- {e.get('lambda_err', 0):.1e}, F +- {e.get('F_err', 0):.1e} on levels up to "
+                     f"{max(e['levels'])}, the finest tried")
     found = [e["lambda"] for e in res["events"] if e["kind"] == "lambda"]
     for t in at_lambda:
         if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):
@@ -154,35 +198,32 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
     return warn + short, short
 
 
-def _err(e: dict) -> str:
-    if "lambda_err" not in e:
-        return ""
-    f = f", F +- {e['F_err']:.1e} (+ truncation {e['F_truncation']:.1e})" if "F" in e else ""
-    lam = f"lambda +- {e['lambda_err']:.1e}" if e["kind"] != "lambda" else "lambda exact"
-    return f"   [error: {lam}{f}]"
+def _pm(e: dict, key: str, digits: int = 8) -> str:
+    """``key = value`` with its bar when it has one."""
+    bar = e.get(f"{key}_err")
+    return f"{key} = {e[key]:.{digits}f}" + ("" if bar is None or bar == 0 else f" +- {bar:.1e}")
 
 
 def report_curve(s: dict) -> None:
     """The console lines of a curve's summary (rank 0)."""
     out = []
     po = s["pull_off"]
-    extra = f" + {s['error_estimate']['coarse_wall_time_s']:.3g} s for the error estimate" \
-        if "error_estimate" in s else ""
+    extra = f" + {s['error_estimate']['wall_time_s']:.3g} s for the error bars" if "error_estimate" in s else ""
     out.append(f"mu = {s['mu']:g}  sigma = {s['sigma']:g}  N = {s['n_nodes']}  steps {s['steps']} "
                f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s{extra}; stopped: {s['stop_reason']}")
     if po:
-        out.append(f"  pull-off (load control)  lambda = {po['lambda']:.8f}  F = {po['F']:.8f}{_err(po)}")
+        out.append(f"  pull-off (load control)  {_pm(po, 'lambda')}  {_pm(po, 'F')}")
         if "F_N" in po:
             out.append(f"                           = {po['F_N']:.6g} N at an approach of {po['lambda_m']:.6g} m "
                        f"(mu = {s['mu']:.4g} from -adh_physical)")
     for f in s["folds"]:
         land = f.get("landing")
-        to = f"  -> lands at F = {land['F']:.8f}" if land else ""
-        out.append(f"  {f['kind']:<23}  lambda = {f['lambda']:.8f}  F = {f['F']:.8f}{to}{_err(f)}")
+        to = f"  -> lands at {_pm(land, 'F')}" if land else ""
+        out.append(f"  {f['kind']:<23}  {_pm(f, 'lambda')}  {_pm(f, 'F')}{to}")
     for e in s["equilibria"]:
-        out.append(f"  equilibrium F = 0       lambda = {e['lambda']:.8f}{_err(e)}")
+        out.append(f"  equilibrium F = 0       {_pm(e, 'lambda')}")
     for e in s["at_lambda"]:
-        out.append(f"  at lambda               lambda = {e['lambda']:.8f}  F = {e['F']:.8f}{_err(e)}")
+        out.append(f"  at lambda               {_pm(e, 'lambda')}  {_pm(e, 'F')}")
     for w in s["warnings"]:
         out.append(f"  WARNING: {w}")
     PETSc.Sys.Print("\n".join(out), comm=PETSc.COMM_SELF)

@@ -11,11 +11,11 @@ the deformation D = H - a^2 rho^2 / 2 (H itself would change by r^2/a per
 unit change of a far out, and make the curve look long), and eq. (12) reads
 
     G_i = D_i + lambda - c a sum_j Ahat_ij P(D_j + a^2 rho_j^2 / 2)            (eq. 12)
-    G_a = D(1) + a^2 / 2 - LEVEL                                               (the pin)
+    G_a = D(1) + a^2 / 2 - level                                               (the pin)
 
-with D(1) interpolated between its two nodes: the edge is where the gap
-opens to LEVEL + 1 epsilon.  The unknowns are x = (D_0 .. D_{N-1}, a), a the
-last entry (on the last rank); it implements the continuation's protocol.
+with D(1) interpolated between its two nodes: the edge is where H reaches
+:func:`edge_level`.  The unknowns are x = (D_0 .. D_{N-1}, a), a the last
+entry (on the last rank); it implements the continuation's protocol.
 """
 from __future__ import annotations
 
@@ -27,11 +27,15 @@ from .grid import l2_weights, load_weights
 from .preconditioning import Border, Layout
 from .pressure import PressureLaw
 from .problem import TO_WALL, norm_radius
+from .reference import load_beyond, load_beyond_rates
 
-__all__ = ["ScaledProblem", "LEVEL"]
+__all__ = ["ScaledProblem", "edge_level"]
 
-#: H at the pinned contact edge: the gap there is LEVEL + 1 epsilon (inside the cohesive zone).
-LEVEL = 0.5
+
+def edge_level(law) -> float:
+    """H at the pinned contact edge: 1.5 epsilon above the wall of the roughness average, inside the
+    cohesive zone (0.5 for a smooth surface: a gap of 1.5 epsilon)."""
+    return law.wall + 1.5
 
 
 class ScaledProblem:
@@ -58,6 +62,7 @@ class ScaledProblem:
         self.comm = A.getComm()
         self._mpi = self.comm.tompi4py()
         self.law = PressureLaw(model.sigma, model.roughness, model.hermite_points)
+        self.level = edge_level(self.law)
         self.c = model.coupling
         self.lo, self.hi = A.getOwnershipRange()
         self.nloc, N = self.hi - self.lo, rho.size
@@ -82,6 +87,7 @@ class ScaledProblem:
                                                  _Jacobian(self), comm=self.comm)
         self.jacobian.setUp()
         self._gather = None
+        self.guarded = 0                  # Newton steps the domain guard shortened
 
     # -- x = (H, a) --------------------------------------------------------------------
     def create_vec(self) -> PETSc.Vec:
@@ -121,7 +127,7 @@ class ScaledProblem:
         self.p.setArray(pressure)
         self.A.mult(self.p, self.Ap)
         g = d + lam - self.c * a * self.Ap.getArray(readonly=True)
-        G.setArray(np.append(g, d1 + 0.5 * a * a - LEVEL) if self.last else g)
+        G.setArray(np.append(g, d1 + 0.5 * a * a - self.level) if self.last else g)
 
     def dG_dp(self, X: PETSc.Vec, lam: float, out: np.ndarray) -> np.ndarray:
         """G_lambda: ones on the rows of eq. (12), zero on the pin."""
@@ -136,7 +142,12 @@ class ScaledProblem:
         pressure, dpressure = self.law(d + a * a * self.half_rho2)
         hdot = ddot + 2 * a * adot * self.half_rho2
         S, dS = self._mpi.allreduce(np.array([self.q @ pressure, self.q @ (dpressure * hdot)]))
-        return {"F": float(a * a * S)}, {"F": float(2 * a * adot * S + a * a * dS)}
+        F, dF = a * a * S, 2 * a * adot * S + a * a * dS
+        if self.model.farfield:                 # beyond r_m = a rho_m (problem.Problem.observe)
+            rm = a * self.rho[-1]
+            dlam, drm = load_beyond_rates(rm, lam)
+            F, dF = F + load_beyond(rm, lam), dF + dlam * pdot + drm * self.rho[-1] * adot
+        return {"F": float(F)}, {"F": float(dF)}
 
     @staticmethod
     def stable(point) -> bool:
@@ -160,7 +171,9 @@ class ScaledProblem:
         alpha = float(np.min(TO_WALL * room[toward] / yh[toward], initial=1.0))
         if ya > 0:
             alpha = min(alpha, 0.5 * a / ya)
-        return self._mpi.allreduce(alpha, op=MPI.MIN)
+        alpha = self._mpi.allreduce(alpha, op=MPI.MIN)
+        self.guarded += alpha < 1.0
+        return alpha
 
     # -- linearization -----------------------------------------------------------------------
     def linearize(self, X: PETSc.Vec, lam: float) -> None:

@@ -8,6 +8,7 @@ work), and calls the modules named for each step, in that order.
 """
 from __future__ import annotations
 
+import signal
 import sys
 import time
 from dataclasses import dataclass
@@ -20,6 +21,7 @@ from . import __version__, error_estimate, preconditioning, resolution, results
 from .adaptive import Tracer, grid_for
 from .continuation import Continuation, Settings
 from .events import jumps
+from .errors import Interrupted
 from .files import PLOT_FORMATS, ResultSet, check_targets
 from .influence import create_influence
 from .model import Model, scales
@@ -87,25 +89,36 @@ def discretize(model, r, pmat=None) -> Problem:
 
 
 def trace(model, r, pmat, settings, lam0: float, at_lambda=(), tol: float | None = None,
-          profiles: bool = False, started=None, level: int = 0) -> dict:
-    """The load-approach curve from lam0 on grid ``r`` (None: grids following the contact edge, at
-    refinement ``level``), with its events, landings, pull-off, resolution check and warnings.
+          profiles: bool = False, started=None, errors: bool = True, target_error: float | None = None) -> dict:
+    """The load-approach curve from lam0 on grid ``r`` (None: grids following the contact edge), with
+    its events, landings, pull-off, error bars (``errors``: down to ``target_error`` when given),
+    resolution check and warnings.
 
     ``started()`` is called once the first point and its tangent are computed (the
     solvers then have read all their options).
     """
     t0 = time.perf_counter()
-    tracer = Tracer(model, settings, results.curve_events(at_lambda), tol, nodes=r, pmat=pmat, level=level,
-                    rmax=model.rmax)
+    tracer = Tracer(model, settings, results.curve_events(at_lambda), tol, nodes=r, pmat=pmat, rmax=model.rmax)
     segments = tracer.run(lam0, started)
     jumps([seg.finder for seg in segments], Problem.stable)
     wall = time.perf_counter() - t0
+    if errors:
+        t1 = time.perf_counter()
+        for seg in segments:
+            for found in seg.finder.found:
+                found.estimate = error_estimate.event_errors(tracer, seg, found, target_error)
+        errors_wall = time.perf_counter() - t1
     res = results.curve(segments, profiles)
     mpi = PETSc.COMM_WORLD.tompi4py()
     states = res.pop("states")
-    res["grid_warning"] = mpi.bcast(resolution.check(model, states, res["folds"]) if mpi.Get_rank() == 0 else None)
+    law = tracer.segments[0].problem.law
+    res["grid_warning"] = mpi.bcast(resolution.check(model, law, states, res["folds"])
+                                    if mpi.Get_rank() == 0 else None)
     res["warnings"], res["incomplete"] = results.assess(segments, res, at_lambda)
     res |= {"wall_time_s": wall, "lambda_start": lam0}
+    if errors:
+        res["error_estimate"] = {"wall_time_s": errors_wall, "target_error": target_error,
+                                 "levels": sorted({k for e in res["events"] for k in e.get("levels", ())})}
     tracer.destroy()
     return res
 
@@ -122,7 +135,7 @@ def fixed_solve(problem: Problem, newton: Newton, lam: float, H: PETSc.Vec) -> d
     pressure, _ = problem.pressure(H)
     Hall = problem.gather(H.getArray(readonly=True))
     its, kits = newton.iterations
-    return {"lambda": lam, "F": problem.load(H), "H0": float(Hall[0]), "H": Hall,
+    return {"lambda": lam, "F": problem.load(H, lam), "F_beyond": problem.far_load(lam), "H0": float(Hall[0]), "H": Hall,
             "P": problem.gather(pressure), "snes_iterations": its, "ksp_iterations": kits, "wall_time_s": wall}
 
 
@@ -135,7 +148,9 @@ def _head(comm, opts: AppOptions, model, grid: dict) -> dict:
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(),
             "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize(),
             "options": opts.given(),
-            "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **rough},
+            "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **rough,
+                      "domain": "half-infinite (the rigid sphere's attraction beyond r_m added)" if model.farfield
+                      else "truncated at r_m (the paper's model)"},
             "grid": grid, **({"scales": scales(*phys)} if phys else {})}
 
 
@@ -160,11 +175,8 @@ def main(argv: list[str] | None = None) -> int:
             problem.destroy()
             return 0
         at, tol, profiles = opts.reals("cont_at_lambda"), opts.real("cont_event_tol"), opts.flag("profiles")
-        res = trace(p.model, p.r, pmat, p.settings, lam0, at, tol, profiles, started=check_unused)
-        if opts.flag("cont_error_estimate"):
-            coarse = None if p.r is None else error_estimate.coarsen(p.r)
-            error_estimate.attach(res, trace(p.model, coarse, pmat, p.settings, lam0, at, tol, level=-1),
-                                  p.model.rmax)
+        res = trace(p.model, p.r, pmat, p.settings, lam0, at, tol, profiles, started=check_unused,
+                    errors=opts.flag("cont_error_estimate"), target_error=opts.real("target_error"))
         grid = {"r": res["grid"], **res["grids"]}
     else:
         r = p.r if p.r is not None else grid_for(p.model, rigid_edge(p.lam)).nodes()
@@ -178,7 +190,7 @@ def main(argv: list[str] | None = None) -> int:
         problem.destroy()
         grid = {"r": r}
     check_unused()
-    status = 0
+    status = 3 if p.lam is None and res["incomplete"] else 0
     if comm.getRank() == 0:
         files = ResultSet(p.targets)
         head = _head(comm, opts, p.model, grid)
@@ -188,9 +200,13 @@ def main(argv: list[str] | None = None) -> int:
             else:
                 write_solve(res, head, files)
                 results.report_solve(res)
+        except Interrupted as e:
+            if not files.committed:
+                raise
+            # held during the renames, the signal came once the set was complete: say so, end as done
+            print(f"petsc-adhesion: {signal.Signals(e.signum).name} came after the results were written",
+                  file=sys.stderr, flush=True)
         finally:
             files.discard()
-    if p.lam is None and res["incomplete"]:
-        status = 3
     PETSc.garbage_cleanup()
     return status

@@ -18,6 +18,7 @@ import pytest
 from petsc4py import PETSc
 
 import petsc_adhesion
+from petsc_adhesion.reference import load_beyond
 import conftest
 from conftest import run_cli
 from petsc_adhesion.options import TABLE
@@ -295,17 +296,20 @@ def test_stdout_line(solve201):
 
 
 def test_F_against_trapz(solve201):
-    """F = (8/3) int P r dr: trapz on the stored (r, P) agrees to O(h^2)."""
+    """F = (8/3) int P r dr + F_beyond: trapz on the stored (r, P) agrees to O(h^2)."""
     h = solve201["h5"]
-    r, P, F = h["r"], h["P"], h["solution"]["F"]
+    r, P, F = h["r"], h["P"], h["solution"]["F"] - h["solution"]["F_beyond"]
     trapz = getattr(np, "trapezoid", None) or np.trapz
     assert (8.0 / 3.0) * trapz(P * r, r) == pytest.approx(F, rel=1e-3)
 
 
 def test_F_is_exact_for_linear_P(solve201):
-    """The program integrates the piecewise-linear P times r exactly (eq. 26)."""
+    """The program integrates the piecewise-linear P times r exactly (eq. 26); the far field is
+    the rigid sphere's attraction beyond r_m (eq. 28's integrand, reference.load_beyond)."""
     h = solve201["h5"]
     r, P, F = h["r"], h["P"], h["solution"]["F"]
+    assert h["solution"]["F_beyond"] == pytest.approx(load_beyond(10.0, -2.0), rel=1e-14)
+    F -= h["solution"]["F_beyond"]
     dr = np.diff(r)
     exact = np.sum(dr / 6.0 * (P[:-1] * (2 * r[:-1] + r[1:]) + P[1:] * (r[:-1] + 2 * r[1:])))
     assert (8.0 / 3.0) * exact == pytest.approx(F, rel=1e-12, abs=1e-15)
@@ -349,7 +353,7 @@ def test_F_trapz_error_shrinks_as_h2(pc_runs, solve201):
     trapz = getattr(np, "trapezoid", None) or np.trapz
 
     def gap(h):
-        return abs((8.0 / 3.0) * trapz(h["P"] * h["r"], h["r"]) - h["solution"]["F"])
+        return abs((8.0 / 3.0) * trapz(h["P"] * h["r"], h["r"]) - h["solution"]["F"] + h["solution"]["F_beyond"])
 
     g101, g201 = gap(pc_runs["default"]), gap(solve201["h5"])
     assert 3.0 < g101 / g201 < 5.0

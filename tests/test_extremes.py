@@ -73,7 +73,7 @@ def test_secondary_turning_points_at_mu5(tmp_path):
     assert s["grid_warning"] == ""
     kinds = [f["kind"] for f in s["folds"]]
     assert kinds == ["snap_on", "snap_off", "snap_on", "snap_off"]
-    lam = [f["lambda"] for f in s["folds"]]
+    lam = [f["lambda_grid"] for f in s["folds"]]
     assert np.allclose(lam, [-4.262812, -4.520195, -4.504167, -8.189277], atol=2e-6)
     on, off = lam[0], lam[3]
     assert off < lam[1] < lam[2] < on                        # secondary pair inside the primary

@@ -220,14 +220,15 @@ def test_signal_ends_cleanly(tmp_path, signum):
 def test_journal_of_a_killed_commit_is_finished_by_the_next_run(tmp_path):
     """A run killed between the journal and its renames: the next run writing those names completes
     the set it was committing (roll forward) and removes dead runs' temporaries."""
-    from petsc_adhesion.files import ResultSet
+    from petsc_adhesion.files import JOURNAL, ResultSet
     old = {"out": tmp_path / "r.h5", "summary": tmp_path / "r.json"}
     for p in old.values():
         p.write_text("old")
     new = {k: tmp_path / f".{p.name}.partial-{os.uname().nodename}-999999999" for k, p in old.items()}
     for p in new.values():
         p.write_text("new")
-    (tmp_path / ".r.h5.commit").write_text(json.dumps([[str(new[k]), str(old[k])] for k in old]))
+    (tmp_path / ".r.h5.commit").write_text(json.dumps({"program": JOURNAL,
+                                                       "renames": [[str(new[k]), str(old[k])] for k in old]}))
     stray = tmp_path / f".r.json.partial-{os.uname().nodename}-999999998"
     stray.write_text("dead")
     ResultSet({k: str(v) for k, v in old.items()})
@@ -279,7 +280,8 @@ def test_every_group_and_dataset_has_units_and_a_description(tmp_path):
         assert list(f["summary"].attrs["warnings"]) == s["warnings"]
         po = f["summary/pull_off"].attrs
         assert po["F"] == s["pull_off"]["F"] and po["F_err"] == s["pull_off"]["F_err"]
-        assert f["summary/error_estimate"].attrs["coarse_events_matched"] == s["error_estimate"]["coarse_events_matched"]
+        assert list(f["summary/error_estimate"].attrs["levels"]) == s["error_estimate"]["levels"]
+        assert list(f["summary/pull_off"].attrs["levels"]) == s["pull_off"]["levels"] and 0 in s["pull_off"]["levels"]
         assert f["summary"].attrs["lambda_start"] == s["lambda_start"] == f["curve/lambda"][0]
         assert f["model"].attrs["roughness"] == "hermite" and f["model"].attrs["hermite_points"] == 16
     proc = run_cli(*SOLVE, "-out", tmp_path / "s.h5")

@@ -20,13 +20,13 @@ def truncation(lam):
     return load_beyond(RMAX, lam)
 
 
-def load(n, lam):
-    pb, newton = make_problem(mu=0.0, r=grid.uniform(n, RMAX))
+def load(n, lam, farfield=False):
+    pb, newton = make_problem(mu=0.0, r=grid.uniform(n, RMAX), farfield=farfield)
     H = pb.rigid(lam, pb.create_vec())
     H.shift(0.05)   # start off the solution
     assert newton.solve(lam, H)
     assert np.allclose(H.getArray(), -lam + pb.r**2 / 2, rtol=0, atol=1e-13)
-    return pb.load(H)
+    return pb.load(H, lam)
 
 
 def test_closed_form_limits():
@@ -50,9 +50,18 @@ def test_truncation_error_of_paper_domain():
     """At lambda = 0 the attraction beyond r_m = 10 is -5.1e-4 (NOTES: some 5e-4)."""
     assert truncation(0.0) == pytest.approx(-5.13e-4, rel=2e-3)
     # on the paper grid the discrete load sits off eq. (28) by the truncation and an O(h^2) rest
-    pb, newton = make_problem(mu=0.0, r=grid.paper(RMAX))
+    pb, newton = make_problem(mu=0.0, r=grid.paper(RMAX), farfield=False)
     H = pb.rigid(0.0, pb.create_vec())
     assert newton.solve(0.0, H)
-    off = pb.load(H) - rigid_load(0.0)
+    off = pb.load(H, 0.0) - rigid_load(0.0)
     # measured: 4.91e-4 = 5.13e-4 (truncation) - 2.1e-5 (grid): the truncation dominates
     assert abs(off + truncation(0.0)) < 0.05 * abs(truncation(0.0))
+
+
+@pytest.mark.parametrize("lam, order", [(-1.0, 2), (0.2, 2)])
+def test_far_field_gives_the_half_infinite_load(lam, order):
+    """With the far field (the default) the load converges to eq. (28) itself, at second order: the
+    rigid sphere's attraction beyond r_m is added exactly."""
+    errors = [abs(load(n, lam, farfield=True) - rigid_load(lam)) for n in (101, 201, 401)]
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(np.abs(orders - order) < 0.15), orders
