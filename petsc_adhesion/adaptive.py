@@ -36,12 +36,12 @@ from .events import EventFinder
 from . import grid
 from .grid import EdgeGrid
 from .influence import create_influence
-from .pressure import PressureLaw
+from .pressure import pressure_law
 from .problem import Problem
 from .resolution import NODES_PER_ZONE, cohesive_zone
 from .scaled import ScaledProblem, edge_level
 
-__all__ = ["grid_for", "edge_of", "contact_radius", "Segment", "Tracer", "BAND", "CONTACT_SPACING", "RMAX",
+__all__ = ["grid_for", "scaled_grid_for", "scaled_band", "edge_of", "contact_radius", "Segment", "Tracer", "BAND", "CONTACT_SPACING", "RMAX",
            "REACH", "A_SWITCH", "GROW"]
 
 #: Half-width of the fine band about the edge in the physical frame.
@@ -60,7 +60,7 @@ GROW = 1.5
 
 def _zone(model) -> float:
     """The cohesive zone of the model, roughness included (:func:`~petsc_adhesion.resolution.cohesive_zone`)."""
-    return cohesive_zone(model, PressureLaw(model.sigma, model.roughness, model.hermite_points))
+    return cohesive_zone(model, pressure_law(model))
 
 
 def _fine(model) -> float:
@@ -73,15 +73,27 @@ def grid_for(model, edge: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid
                     level=level)
 
 
-def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid:
+def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: float | None = None) -> EdgeGrid:
     """The grid of the frame of the edge, in physical units for contact radius ``a`` (divide by a for rho).
 
     Fine enough for the zone while a grows by GROW^2 (a change waits at most that
-    long), over two zones about the pinned edge (the peak attraction lies within
-    one), out to rmax GROW^2 at a, so past rmax at a / GROW^2.
+    long), over ``band`` about the pinned edge (default two zones: a smooth surface's
+    peak attraction lies within one; :func:`scaled_band`), out to rmax GROW^2 at a, so
+    past rmax at a / GROW^2.
     """
-    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=rmax * GROW**2, band=2 * _zone(model),
-                    contact=CONTACT_SPACING, reach=REACH, level=level)
+    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=rmax * GROW**2,
+                    band=2 * _zone(model) if band is None else band, contact=CONTACT_SPACING, reach=REACH,
+                    level=level)
+
+
+def scaled_band(model, a: float, peak: float) -> float:
+    """The fine band of the frame of the edge at contact radius ``a`` with the peak attraction at ``peak``.
+
+    Two zones, or wider so that it holds the peak attraction with a zone to spare: on a
+    rough surface the gap rises slowly at the edge, and the pinned level can lie far
+    from the peak in r (0.34 at mu = 20, sigma = 1).
+    """
+    return max(2 * _zone(model), abs(a - peak) + _zone(model))
 
 
 def sharp(model) -> bool:
@@ -177,22 +189,25 @@ class _Regrid:
     def target(self, b) -> tuple | None:
         """(kind, where, forced) of the next segment, or None to stay."""
         seg, tr = self.seg, self.tracer
+        edge = edge_of(seg.problem, b.x)
         if seg.kind == "scaled":
             a = seg.problem.radius(b.x)
             ratio = a / seg.grid.edge
-            return None if 1 / GROW <= ratio <= GROW else ("scaled", a, not 1 / GROW**2 <= ratio <= GROW**2)
-        if tr.sharp and contact_radius(seg.problem, b.x) >= A_SWITCH:
-            return "scaled", contact_radius(seg.problem, b.x), False
-        edge = edge_of(seg.problem, b.x)
+            return None if 1 / GROW <= ratio <= GROW else ("scaled", a, not 1 / GROW**2 <= ratio <= GROW**2, edge)
+        # a contact, and the peak attraction off the centre (a rough centre may still attract most)
+        a = contact_radius(seg.problem, b.x)
+        if tr.sharp and min(edge, a) >= A_SWITCH:
+            return "scaled", a, False, edge
         moved = abs(edge - seg.grid.edge)
-        return None if moved <= self.travel else ("edge", edge, moved > self.forced)
+        return None if moved <= self.travel else ("edge", edge, moved > self.forced, edge)
 
     def __call__(self, a, b) -> bool:
         where = self.target(b)
         if where is None:
             return False
-        kind, at, forced = where
-        new = self.tracer.segment(kind, at, self.seg)
+        kind, at, forced, peak = where
+        band = scaled_band(self.seg.problem.model, at, peak) if kind == "scaled" else None
+        new = self.tracer.segment(kind, at, self.seg, band=band)
         pt = carry(self.seg, new, b, at if kind == "scaled" else None)
         same = pt is not None and all(np.sign(ev.test(b)) == np.sign(ev.test(pt)) != 0
                                       for ev in self.tracer.events)
@@ -218,9 +233,10 @@ class Tracer:
         self.sharp = None
 
     def segment(self, kind: str, at: float | None = None, before: Segment | None = None,
-                level: int | None = None, settings: Settings | None = None) -> Segment:
+                level: int | None = None, settings: Settings | None = None, band: float | None = None) -> Segment:
         """A segment of ``kind`` (fixed, edge, scaled) centred on ``at`` at refinement ``level`` (default:
-        the tracer's), continuing ``before``'s budget, or with ``settings`` of its own."""
+        the tracer's), continuing ``before``'s budget, or with ``settings`` of its own; ``band``: the
+        fine band of a scaled segment (:func:`scaled_band`)."""
         level = self.level if level is None else level
         if kind == "fixed":
             nodes = grid.nested(self.nodes, level - self.level)
@@ -230,7 +246,7 @@ class Tracer:
             r = design.nodes()
             problem = Problem(self.model, r, create_influence(r), self.pmat)
         else:
-            design = scaled_grid_for(self.model, at, level, self.rmax)
+            design = scaled_grid_for(self.model, at, level, self.rmax, band)
             rho = design.nodes() / at
             problem = ScaledProblem(self.model, rho, create_influence(rho), at, self.pmat)
         s = settings or self.set

@@ -17,9 +17,13 @@ a measurement, not a test.
   design (:class:`~petsc_adhesion.solver.PCReuse`); each repeat expires it,
   so every repeat assembles and factors it again.
 * curve: :func:`~petsc_adhesion.study.trace` with the program's defaults
-  (mu = 1, paper grid): the time of the call (its solvers made inside, as in
-  the program), its steps, and a check that it found both turning points,
-  the pull-off and the equilibrium.
+  (mu = 1, grids that follow the contact edge, error bars): the time of the
+  call (its solvers made inside, as in the program), its steps, and a check
+  that it found both turning points, the pull-off and the equilibrium; and the
+  same curve on the paper grid (N = 531, r_m = 10), the grid it must not be slower than.
+* stiff: the default curves at mu = 7 (target 10 s) and mu = 20 (target 60 s),
+  error bars included, checked for their fold pairs, pull-off and equilibrium
+  and for no warning (3 repeats each).
 
 ``-bench_profile`` profiles one more curve (cProfile, which slows the Python
 side) and prints the ten functions of largest own time; ``-log_view`` gives PETSc's account of all runs.
@@ -56,7 +60,9 @@ from .study import discretize, trace
 __all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main"]
 
 #: -bench_only choices, in the order they run
-PARTS = ("influence", "solve", "curve")
+PARTS = ("influence", "solve", "curve", "stiff")
+#: Stiff curves: mu -> (target in s, turning points of the resolved curve; docs/stability.md).
+STIFF = {7.0: (10.0, 4), 20.0: (60.0, 6)}
 
 
 def row(quantity: str, times: list[float], target: float | None = None, **extra) -> dict:
@@ -123,11 +129,11 @@ def check_curve(res: dict) -> dict:
             "equilibrium_lambda": first["equilibrium"]["lambda"]}
 
 
-def _trace() -> dict:
-    """The program's default curve: mu = 1 on grids that follow the contact edge, step control from
-    the options (-cont_*)."""
-    model = Model(mu=1.0, rmax=RMAX)
-    return trace(model, None, Dense(), read_settings(AppOptions()), far_approach(model))
+def _trace(mu: float = 1.0, nodes=None) -> dict:
+    """The program's default curve at ``mu``: on grids that follow the contact edge (or on ``nodes``,
+    r_m = 10), step control from the options (-cont_*), error bars."""
+    model = Model(mu=mu, rmax=RMAX if nodes is None else 10.0)
+    return trace(model, nodes, Dense(), read_settings(AppOptions()), far_approach(model))
 
 
 def bench_curve(repeats: int | None = None) -> dict:
@@ -138,7 +144,34 @@ def bench_curve(repeats: int | None = None) -> dict:
         res = _trace()
         times.append(time.perf_counter() - t0)
         marks = check_curve(res)
-    return {"curve": row("curve, mu = 1, edge grid", times, 1.0, **marks)}
+    paper = []
+    for _ in range(repeats or 5):
+        t0 = time.perf_counter()
+        res = _trace(1.0, grid.paper(10.0))
+        paper.append(time.perf_counter() - t0)
+        check_curve(res)
+    return {"curve": row("curve, mu = 1, edge grid", times, 1.0, **marks),
+            "curve_paper": row("curve, mu = 1, paper grid", paper, None, steps=res["steps"])}
+
+
+def bench_stiff(repeats: int | None = None) -> dict:
+    """The default curves at mu = 7 and 20 (:data:`STIFF`), each repeat with fresh grids and solvers."""
+    out = {}
+    for mu, (target, folds) in STIFF.items():
+        times = []
+        for _ in range(repeats or 3):
+            t0 = time.perf_counter()
+            res = _trace(mu)
+            times.append(time.perf_counter() - t0)
+            got = sum(e["kind"] in ("snap_on", "snap_off") for e in res["events"])
+            if got != folds or res["pull_off"] is None or res["warnings"] or \
+                    not any(e["kind"] == "equilibrium" for e in res["events"]):
+                raise RuntimeError(f"mu = {mu:g} curve with {got} turning points (expected {folds}), "
+                                   f"warnings: {'; '.join(res['warnings']) or 'none'}")
+        out[f"curve_mu{mu:g}"] = row(f"curve, mu = {mu:g}, edge grid", times, target, steps=res["steps"],
+                                     n_nodes=int(max(res["grids"]["n_nodes"])), turning_points=got,
+                                     pull_off_F=res["pull_off"]["F"], pull_off_F_err=res["pull_off"].get("F_err"))
+    return out
 
 
 def _where(key: tuple) -> str:
@@ -185,6 +218,13 @@ def report(info: dict, results: dict, profile: dict | None) -> None:
               f"snap-on lambda = {c['snap_on_lambda']:.6f}, snap-off lambda = {c['snap_off_lambda']:.6f}, "
               f"pull-off F = {c['pull_off_F']:.6f} at lambda = {c['pull_off_lambda']:.6f}, "
               f"equilibrium lambda = {c['equilibrium_lambda']:.6f}")
+        p = results["curve_paper"]
+        print(f"curve: the edge grid takes {c['median_s'] / p['median_s']:.2f} times the paper grid's time "
+              f"(medians of this run; {p['steps']} steps on the paper grid)")
+    for key, q in results.items():
+        if key.startswith("curve_mu"):
+            print(f"{q['quantity']}: {q['steps']} steps, {q['turning_points']} turning points, up to "
+                  f"{q['n_nodes']} nodes, pull-off F = {q['pull_off_F']:.6f} +- {q['pull_off_F_err']:.1e}")
     if profile:
         print(f"curve profile (cProfile, one run, {_t(profile['total_s'])} in all; "
               f"top {len(profile['top'])} by own time):")
@@ -217,6 +257,8 @@ def main() -> int:
         results |= bench_solve(mu1_problem(), repeats)
     if "curve" in parts:
         results |= bench_curve(repeats)
+    if "stiff" in parts:
+        results |= bench_stiff(repeats)
     top = profile_curve() if profile else None
     info = {"program": "petsc-adhesion bench", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(), "mpi_ranks": 1,

@@ -50,7 +50,8 @@ def relocate(tracer, seg, found, level: int, target=None):
     settings = replace(tracer.set, ds=length / 2, ds_max=length, max_steps=LOCAL_STEPS, max_folds=10**6,
                        monitor=False)
     at = owner.grid.edge if owner.grid is not None else None
-    new = tracer.segment(owner.kind, at, level=level, settings=settings)
+    new = tracer.segment(owner.kind, at, level=level, settings=settings,
+                         band=owner.grid.band if owner.kind == "scaled" else None)
     try:
         start = _carry_start(owner, new, a)
         if start is None:

@@ -260,7 +260,75 @@ def tabor():
           "./run figures tabor")
 
 
-FIGURES = {f.__name__: f for f in (smooth, rough, snaps, convergence, hermite, coarse, reduction, tabor)}
+#: The roughness models compared: label -> options (docs/model.md, "Roughness models").
+MODELS = {"Hermite, 16 points (paper)": (),
+          "truncated Gaussian, K = 3": ("-adh_roughness", "truncated_gaussian"),
+          "truncated Gaussian, K = 4": ("-adh_roughness", "truncated_gaussian", "-adh_roughness_cutoff", 4),
+          "truncated Gaussian, K = 5": ("-adh_roughness", "truncated_gaussian", "-adh_roughness_cutoff", 5),
+          "Weibull, skewness -1": ("-adh_roughness", "weibull", "-adh_roughness_skewness", -1),
+          "Weibull, skewness 0": ("-adh_roughness", "weibull")}
+
+
+def quadrature():
+    """The pull-off as each roughness model's quadrature is refined (mu = 1): converging, unlike Hermite's."""
+    plt = _plt()
+    points = (3, 6, 12, 24, 48)
+    hermite = (8, 16, 32, 64)
+    rules = [label for label in MODELS if "Hermite" not in label]
+    cases = [(s, label, n) for s in (0.2, 1.0) for label in rules for n in points]
+    cases += [(s, "Hermite", n) for s in (0.2, 1.0) for n in hermite]
+    res = runs([("-adh_mu", 1, "-adh_sigma", s, "-cont_F_max", 0.2, "-cont_error_estimate", "false",
+                 *(MODELS[label] + ("-adh_quadrature_points", n) if label != "Hermite" else
+                   ("-adh_hermite_points", n))) for s, label, n in cases])
+    F = {c: summ["pull_off"]["F"] for c, (summ, _) in zip(cases, res)}
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
+    rows = []
+    for ax, s in zip(axes, (0.2, 1.0)):
+        for label in rules:
+            best = F[(s, label, points[-1])]
+            change = [abs(F[(s, label, n)] - best) for n in points[:-1]]
+            ax.semilogy(points[:-1], np.maximum(change, 1e-17), "o-", label=label)
+            rows.append([f"{s:g}", label] + [f"{F[(s, label, n)]:.10f}" for n in points])
+        hb = F[(s, "Hermite", hermite[-1])]
+        ax.semilogy(hermite[:-1], [abs(F[(s, "Hermite", n)] - hb) for n in hermite[:-1]], "ks--",
+                    label="Hermite (against 64 points)")
+        rows.append([f"{s:g}", "Hermite, points " + ", ".join(map(str, hermite))]
+                    + [f"{F[(s, 'Hermite', n)]:.10f}" for n in hermite] + [""])
+        ax.set_title(f"mu = 1, sigma = {s:g}")
+        ax.set_xlabel("quadrature points (moving part at the wall)")
+        ax.set_ylabel("|F_p - F_p(48 points)|")
+    axes[0].legend(fontsize=7)
+    table = _table(["sigma", "model"] + [f"n={n}" for n in points], rows)
+    table += "\n\nPull-off F at mu = 1 against the points of each model's quadrature (error bars off)."
+    _save(fig, "quadrature", table, "./run figures quadrature")
+
+
+def models():
+    """The pull-off against sigma for the paper's rule and the well-posed models, at mu = 0.01, 1 and 5."""
+    plt = _plt()
+    sig = (0.0, 0.05, 0.1, 0.2, 0.3, 0.4, 0.6, 0.8, 1.0)
+    mus = (0.01, 1.0, 5.0)
+    cases = [(m, label, s) for m in mus for label in MODELS for s in sig]
+    res = runs([("-adh_mu", m, "-adh_sigma", s, "-cont_F_max", 0.2, *(MODELS[label] if s else ()))
+                for m, label, s in cases])
+    out = {c: summ for c, (summ, _) in zip(cases, res)}
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), sharey=True)
+    rows = []
+    for ax, m in zip(axes, mus):
+        for label in MODELS:
+            po = [out[(m, label, s)]["pull_off"] for s in sig]
+            ax.errorbar(sig, [-p["F"] for p in po], yerr=[p.get("F_err", 0) for p in po], fmt="o-", ms=3,
+                        label=label)
+            rows.append([f"{m:g}", label] + [f"{p['F']:.5f} +- {p.get('F_err', float('nan')):.0e}" for p in po])
+        ax.set_title(f"mu = {m:g}")
+        ax.set_xlabel("sigma")
+    axes[0].set_ylabel("pull-off |F| / (2 pi R gamma)")
+    axes[0].legend(fontsize=7)
+    _save(fig, "models", _table(["mu", "model"] + [f"sigma={s:g}" for s in sig], rows), "./run figures models")
+
+
+FIGURES = {f.__name__: f for f in (smooth, rough, snaps, convergence, hermite, coarse, reduction, tabor,
+                                   quadrature, models)}
 
 if __name__ == "__main__":
     names = sys.argv[1:] or list(FIGURES)

@@ -7,7 +7,11 @@ sqrt(epsilon R), pressures in 8 gamma / (3 epsilon) and loads in 2 pi R gamma.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .roughness import NEAR_POINTS
 
 __all__ = ["Model", "tabor", "scales"]
 
@@ -44,8 +48,12 @@ class Model:
     mu: float = 1.0
     sigma: float = 0.0
     rmax: float = 10.0
-    roughness: str = "hermite"
+    roughness: str = "hermite"   # the height distribution and its average (pressure.pressure_law)
     hermite_points: int = 16
+    roughness_cutoff: float = 3.0     # truncated_gaussian: highest asperity at K sigma
+    roughness_skewness: float = 0.0   # weibull: third standardised moment of the heights
+    quadrature_points: int = NEAR_POINTS  # truncated_gaussian, weibull: points of the moving part at the wall
+    heights: np.ndarray | None = field(default=None, repr=False, compare=False)  # measured, units of epsilon
     farfield: bool = True      # add the rigid sphere's attraction beyond r_m (the half-infinite model)
 
     @property

@@ -25,6 +25,7 @@ from .adaptive import RMAX
 from .continuation import ARCLENGTH_PREFIX, CORRECTORS, NATURAL_PREFIX, Settings
 from .events import EVENT_TOL
 from .model import Model, tabor
+from .roughness import DISTRIBUTIONS, HeightFileError, Measured, Weibull, read_heights
 from .solver import PC_REUSE_ITS
 
 __all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "petsc_error", "print_help",
@@ -65,6 +66,8 @@ def _fmt(x: float) -> str:
     return "inf" if x == math.inf else "-inf" if x == -math.inf else f"{x:g}"
 
 
+#: -adh_roughness values averaged by a Gauss-Hermite rule (pressure.RULES without "none").
+RULES_HERMITE = ("hermite",)
 #: The load at which a curve stops by default: past equilibrium, into compression.
 F_MAX = 2.0
 #: Options prefixes of the three solvers: (prefix, what it solves).
@@ -80,9 +83,21 @@ TABLE = {o.name: o for o in [
     Option("adh_physical", "reals", (), "R,gamma,E,epsilon in SI (m, J/m^2, Pa, m): mu from eq. (9), "
            "results also in SI", 0.0, 1e12, lo_open=True),
     Option("adh_sigma", "real", Model.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
-    Option("adh_roughness", "choice", Model.roughness, "roughness average of the pressure (eq. 14)",
-           choices=("none", "hermite")),
+    Option("adh_roughness", "choice", Model.roughness, "height distribution averaged over (eq. 7, 10): the "
+           "paper's Gaussian by its Gauss-Hermite rule (eq. 14), whose rule is the model; Gaussian truncated at "
+           "the highest asperity; skewed (reversed Weibull); measured heights; none (smooth)",
+           choices=("none", *RULES_HERMITE, *DISTRIBUTIONS)),
     Option("adh_hermite_points", "int", Model.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
+    Option("adh_roughness_cutoff", "real", Model.roughness_cutoff, "truncated_gaussian: the highest asperity, "
+           "in standard deviations (-adh_sigma) of the untruncated Gaussian", 0.0, 10.0, lo_open=True),
+    Option("adh_roughness_skewness", "real", Model.roughness_skewness, "weibull: skewness of the heights "
+           "(-2: exponential valleys, 0.5: the most symmetric bounded)", *Weibull.SKEWNESS),
+    Option("adh_roughness_file", "string", None, "measured: heights, one a line in units of epsilon; a table "
+           "(Gwyddion ASCII export, '# Value units: m'), .gsf or .npy height map; it sets sigma itself"),
+    Option("adh_roughness_unit", "real", None, "measured: metres per value of a file that states no unit "
+           "(needs epsilon from -adh_physical)", 0.0, 1.0, lo_open=True),
+    Option("adh_quadrature_points", "int", Model.quadrature_points, "truncated_gaussian, weibull: points of "
+           "the quadrature's moving part at the wall (its fixed panels get 2/3 as many)", 2, 400),
     Option("adh_rmax", "real", None, f"end r_m of the computational domain (default: {RMAX:g} on grids that "
            f"follow the contact edge, {Model.rmax:g} as in the paper otherwise)", 0.0, 1e3, lo_open=True),
     Option("adh_farfield", "flag", Model.farfield, "add the rigid sphere's attraction beyond r_m to the load: "
@@ -258,11 +273,36 @@ def read_model(opts: AppOptions) -> Model:
     rmax = opts.real("adh_rmax")
     if rmax is None:
         rmax = RMAX if opts.choice("grid_type") == "edge" else Model.rmax
-    model = Model(mu=mu, sigma=opts.real("adh_sigma"), rmax=rmax, roughness=opts.choice("adh_roughness"),
-                  hermite_points=opts.int("adh_hermite_points"), farfield=opts.flag("adh_farfield"))
+    rough, sigma, heights = opts.choice("adh_roughness"), opts.real("adh_sigma"), None
+    if rough == "measured":
+        heights = read_measured(opts, phys[3] if phys else None)
+        sigma = Measured(heights).rms
+    model = Model(mu=mu, sigma=sigma, rmax=rmax, roughness=rough, hermite_points=opts.int("adh_hermite_points"),
+                  roughness_cutoff=opts.real("adh_roughness_cutoff"),
+                  roughness_skewness=opts.real("adh_roughness_skewness"),
+                  quadrature_points=opts.int("adh_quadrature_points"), heights=heights,
+                  farfield=opts.flag("adh_farfield"))
     if model.roughness == "none" and model.sigma > 0:
         raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
     return model
+
+
+def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
+    """The heights of -adh_roughness_file in units of epsilon (:func:`~.roughness.read_heights`)."""
+    path = opts.string("adh_roughness_file")
+    if path is None:
+        raise InputError("-adh_roughness_file: required with -adh_roughness measured: a file of heights")
+    if opts.db.hasName("adh_sigma"):
+        raise InputError("-adh_sigma: not with -adh_roughness measured, whose heights set it")
+    try:
+        heights = read_heights(path, epsilon, opts.real("adh_roughness_unit"))
+        Measured(heights)
+    except HeightFileError as e:
+        why = str(e).replace("need epsilon (> 0, in metres) for units of epsilon", "need -adh_physical's epsilon")
+        raise InputError(f"-adh_roughness_file: {printable(why)}") from None
+    if not np.sqrt(np.mean((heights - heights.mean()) ** 2)) <= TABLE["adh_sigma"].hi:
+        raise InputError(f"-adh_roughness_file: heights of rms above {TABLE['adh_sigma'].hi:g} epsilon")
+    return heights
 
 
 def read_grid(opts: AppOptions, model: Model) -> np.ndarray | None:
@@ -291,6 +331,11 @@ def read_settings(opts: AppOptions) -> Settings:
                     p_max=math.inf if lam_max is None else lam_max, max_steps=opts.int("cont_max_steps"),
                     pc_reuse_its=opts.int("adh_pc_reuse_its"), monitor=opts.flag("cont_monitor"))
 
+
+#: Options of one roughness model: name -> the -adh_roughness values that use it.
+ROUGHNESS_OPTIONS = {"adh_hermite_points": RULES_HERMITE, "adh_roughness_cutoff": ("truncated_gaussian",),
+                     "adh_roughness_skewness": ("weibull",), "adh_quadrature_points": ("truncated_gaussian", "weibull"),
+                     "adh_roughness_file": ("measured",), "adh_roughness_unit": ("measured",)}
 
 #: The attraction beyond r_m may carry at most this share of the DMT pull-off at contact.
 DOMAIN_SHARE = 0.05
@@ -327,9 +372,12 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
     else:
         ignored += [(n, "is a -grid_type paper option") for n in _given(opts, [n for n in TABLE
                                                                                 if n.startswith("grid_paper_")])]
-    if model.sigma == 0 or model.roughness == "none":
-        ignored += [(n, "sets the roughness average, not used at -adh_sigma 0") for n in
-                    _given(opts, ["adh_hermite_points"])]
+    for name, kinds in ROUGHNESS_OPTIONS.items():
+        if opts.db.hasName(name):
+            if model.roughness not in kinds:
+                ignored.append((name, f"applies to -adh_roughness {' or '.join(kinds)}"))
+            elif model.sigma == 0:
+                ignored.append((name, "sets the roughness average, not used at -adh_sigma 0"))
     if opts.choice("adh_pmat") != "band":
         ignored += [(n, "applies to -adh_pmat band") for n in _given(opts, ["adh_pmat_band"])]
     if ignored:

@@ -149,6 +149,7 @@ def curve_summary(res: dict, head: dict) -> dict:
                        for e in ev if e["kind"] == "equilibrium"],
          "load_extrema": [_brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
          "at_lambda": [_brief(e) for e in ev if e["kind"] == "lambda"],
+         "wall_gap": res["wall_gap"],
          "steps": res["steps"], "rejected_steps": res["rejected_steps"], "regrids": res["regrids"],
          **{k: res[k] for k in ("guard_activations", "smallest_step", "most_newton_its", "most_ksp_its")},
          "stop_reason": res["stop_reason"],

@@ -17,7 +17,7 @@ from petsc4py import PETSc
 
 from .grid import l2_weights, load_weights
 from .preconditioning import Border, Dense, Layout
-from .pressure import PressureLaw
+from .pressure import pressure_law
 from .reference import jkr_zero_load, load_beyond, load_beyond_rates
 
 __all__ = ["Problem", "far_approach", "norm_radius", "TO_WALL"]
@@ -37,7 +37,7 @@ def far_approach(model) -> float:
 
     The rigid gap at r = 0 is then 3 + 2 mu above the wall of the roughness rule.
     """
-    wall = PressureLaw(model.sigma, model.roughness, model.hermite_points).wall
+    wall = pressure_law(model).wall
     return -(wall + 1.0) - 3.0 - 2.0 * model.mu
 
 
@@ -64,7 +64,7 @@ class Problem:
         self.model, self.r, self.A = model, r, A
         self.comm = A.getComm()
         self._mpi = self.comm.tompi4py()
-        self.law = PressureLaw(model.sigma, model.roughness, model.hermite_points)
+        self.law = pressure_law(model)
         self.c = model.coupling
         self.lo, self.hi = A.getOwnershipRange()
         self.layout = Layout(self.lo, self.hi, r.size, self.comm.getRank() == self.comm.getSize() - 1)

@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 
 from .grid import PAPER_UNIFORM
-from .scaled import edge_level
 
 __all__ = ["check", "cohesive_zone", "NODES_PER_ZONE", "MAX_TRUE_FOLDS"]
 
@@ -37,17 +36,18 @@ def check(model, law, states, folds: int) -> str:
     """One line when a grid did not resolve the cohesive zone where the contact edge was, else "".
 
     ``states``: (nodes, H, P) of each point of the curve; the contact edge of a
-    point is where H rises through ``level`` (the pinned level of the frame of the
-    edge) when it has a contact, else its radius of peak attraction (P most
-    negative), and the spacing there must be at most zone / NODES_PER_ZONE.
+    point is its radius of peak attraction (P most negative), which lies inside the
+    cohesive zone whether or not there is a contact (and is what the grids follow,
+    :func:`~petsc_adhesion.adaptive.edge_of`); the spacing there must be at most
+    zone / NODES_PER_ZONE.
     ``folds``: the turning points the curve showed, the other symptom (more than
     :data:`MAX_TRUE_FOLDS`).  The line names the spacing the case needs there.
     """
-    zone, level = cohesive_zone(model, law), edge_level(law)
+    zone = cohesive_zone(model, law)
     spacing, where = [], []
-    for r, H, P in states:
-        k = int(np.argmax(H >= level)) if H[0] < level else int(np.argmin(P))
-        if (P[k] < 0 or H[0] < level) and np.isfinite(zone):
+    for r, _, P in states:
+        k = int(np.argmin(P))
+        if P[k] < 0 and np.isfinite(zone):
             h = np.diff(r)
             spacing.append(h[max(0, k - 1):k + 1].max())
             where.append(r[k])

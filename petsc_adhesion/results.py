@@ -19,10 +19,13 @@ jump (Figs. 6, 7).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from . import grid
 from .events import Extremum, Fold, ParameterValue, Zero
 from .reference import far_deflection, load_beyond
 
@@ -85,7 +88,7 @@ def event_record(problem, found, profiles: bool) -> dict:
     far = far_deflection(rm, model.coupling) if model.farfield else 0.0
     ev |= {"lambda_grid": ev["lambda"], "F_grid": ev["F"], "levels": est["levels"], "target_met": est["target_met"],
            "F_beyond": float(load_beyond(rm, ev["lambda"])) if model.farfield else 0.0}
-    beyond = far
+    beyond = far + quadrature_error(problem, found.point)
     if found.label == "lambda":
         ev |= {"F": est["F"], "F_err": est["F_err"] + beyond, "lambda_err": 0.0}
     elif found.label == "equilibrium":
@@ -98,6 +101,27 @@ def event_record(problem, found, profiles: bool) -> dict:
         ev["landing"] |= {"lambda": ev["lambda"], "F": land["F"], "F_err": land["F_err"] + beyond,
                           "F_grid": land["F_grid"]}
     return ev
+
+
+#: The load of the quadrature error, times this, bounds its effect on results (tests/test_roughness_models.py).
+QUADRATURE_MARGIN = 3.0
+
+
+def quadrature_error(problem, pt) -> float:
+    """The part of an event's error bars due to the roughness quadrature (collective).
+
+    The load of the pressure's quadrature error e(r) = |P - P_ref| at the event's
+    state, (8/3) integral e r dr (eq. 26), is the first-order change of F at fixed
+    H; the elastic response and, at a fold, the conversion into lambda change it
+    by a factor of order one, which QUADRATURE_MARGIN covers (measured: bars 1.2 to
+    20 times the error at 3 and 6 points, up to 1000 at 12, where both are tiny).
+    Zero for the smooth law, the Hermite rule (which is the model) and a histogram
+    (exact but for rounding).
+    """
+    H = _whole(problem, problem.separation(pt.x))
+    r = problem.nodes(pt.x)
+    load = 0.0 if H is None else 8.0 / 3.0 * float(grid.load_weights(r) @ problem.law.error(H))
+    return QUADRATURE_MARGIN * problem.comm.tompi4py().bcast(load)
 
 
 def stop_reason(stop, settings) -> str:
@@ -114,6 +138,12 @@ def stop_reason(stop, settings) -> str:
             "max_folds": f"more than -cont_max_folds {value} turning points"}[reason]
 
 
+def _current(segments, seg) -> list:
+    """``seg``'s points but, when another segment follows, its last: that is the next one's first,
+    solved again on the grid the curve moved to, and the two differ by the grids' errors."""
+    return seg.cont.points if seg is segments[-1] else seg.cont.points[:-1]
+
+
 def curve(segments, profiles: bool = False) -> dict:
     """The traced curve (its segments, in order) with its events as dicts and the pull-off.
 
@@ -125,13 +155,15 @@ def curve(segments, profiles: bool = False) -> dict:
     states = []
     for seg in segments:
         pb = seg.problem
-        for p in seg.cont.points:
+        for p in _current(segments, seg):
             r, H = pb.nodes(p.x), _whole(pb, pb.separation(p.x))
             if H is not None:
                 states.append((r, H, pb.law(H)[0]))
     mins = [e for e in events if e["kind"] == "F_min"]
     last = segments[-1].cont
+    lowest = min(float(seg.problem.separation(p.x).min()) for seg in segments for p in seg.cont.points)
     return {"points": pts, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
+            "wall_gap": segments[-1].problem.comm.tompi4py().allreduce(lowest, op=MPI.MIN) - segments[-1].problem.law.wall,
             "steps": sum(len(seg.cont.points) - 1 for seg in segments),
             "rejected_steps": sum(seg.cont.rejected for seg in segments),
             "folds": sum(seg.cont.folds for seg in segments), "regrids": len(segments) - 1,
@@ -152,15 +184,40 @@ EDGE_SHARE = 1e-3
 PEAK_ATTRACTION = 2.0 / (3.0 * 3.0 ** 0.5)
 
 
+def _missed_minimum(segments) -> str:
+    """Why the located pull-off may not be the most tensile load of the curve, or "".
+
+    A discrete minimum F[k-1] > F[k] < F[k+1] of a grid segment, more tensile than
+    every located minimum, must lie next to a located minimum (on step k-1 or k)
+    no higher than itself; a step that passes a shallow minimum and maximum of
+    the load elsewhere (a wiggle of the unstable branch) does not matter here.
+    Within one grid: the grids of two segments differ by their discretization errors.
+    """
+    found = [(seg, f) for seg in segments for f in seg.finder.found if f.label == "F_min"]
+    pull_off = min((f.point.values["F"] for _, f in found), default=math.inf)
+    for seg in segments:
+        F = [p.values["F"] for p in _current(segments, seg)]
+        located = {f.segment: f.point.values["F"] for s, f in found if s is seg}
+        for k in range(1, len(F) - 1):
+            if not F[k - 1] > F[k] < F[k + 1] or F[k] >= pull_off:
+                continue
+            near = [located[j] for j in (k - 1, k) if j in located]
+            if not near:
+                return f"a computed point (F = {F[k]:.6g}) is a load minimum more tensile than the located " \
+                       f"pull-off ({pull_off:.6g})"
+            if min(near) > F[k] + 1e-9:
+                return f"a computed point (F = {F[k]:.6g}) is more tensile than the load minimum located " \
+                       f"next to it ({min(near):.6g})"
+    return ""
+
+
 def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
     """What makes a traced curve untrustworthy, one line each: (warnings, the subset that makes it
     not what was asked for: exit status 3).  Collective."""
     warn, short = [], []
     problem = segments[-1].problem
-    law, pts, mpi = problem.law, res["points"], problem.comm.tompi4py()
-    gap = mpi.allreduce(min(float(seg.problem.separation(p.x).min()) for seg in segments for p in seg.cont.points)
-                        - law.wall, op=MPI.MIN)
-    if not law.smooth and gap < WALL_GAP:
+    law, pts, gap, mpi = problem.law, res["points"], res["wall_gap"], problem.comm.tompi4py()
+    if law.rule == "hermite" and gap < WALL_GAP:
         warn.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
                     f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
                     f"the loads there are properties of the rule and ill-conditioned; use fewer points")
@@ -168,13 +225,9 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
         short.append(f"the curve ended early: {res['stop_reason']}")
     if res["grid_warning"]:
         short.append(res["grid_warning"])
-    pull_off = res["pull_off"]
-    lowest = min(p.values["F"] for p in pts)
-    located = None if pull_off is None else pull_off.get("F_grid", pull_off["F"])     # on the same grids
-    if located is not None and not res["grid_warning"] and lowest < located - 1e-9:
-        short.append(f"a computed point (F = {lowest:.6g}) is more tensile than the located pull-off "
-                     f"({located:.6g}): the load varies faster than the steps resolve; "
-                     f"lower -cont_dF_max or -cont_ds_max")
+    missed_min = "" if res["grid_warning"] else _missed_minimum(segments)
+    if missed_min:
+        short.append(f"{missed_min}: the load varies faster than the steps resolve; lower -cont_dF_max or -cont_ds_max")
     if pts[0].values["F"] > 0:
         short.append(f"the curve starts in contact (F = {pts[0].values['F']:.3g} > 0 at lambda = {pts[0].p:g}): "
                      f"the approach and its events lie before it; give -cont_lambda_start further apart")

@@ -22,20 +22,46 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
+from scipy.optimize import minimize_scalar
 
 from .grid import l2_weights, load_weights
 from .preconditioning import Border, Layout
-from .pressure import PressureLaw
+from .pressure import pressure_law
 from .problem import TO_WALL, norm_radius
 from .reference import load_beyond, load_beyond_rates
 
 __all__ = ["ScaledProblem", "edge_level"]
 
 
+#: H at the pinned contact edge of a smooth surface: a gap of 1.5 epsilon, inside the cohesive zone.
+SMOOTH_LEVEL = 0.5
+#: H of the smooth law's peak attraction: a gap of 3^(1/6) epsilon (eq. 5).
+SMOOTH_PEAK = 3.0 ** (1.0 / 6.0) - 1.0
+
+
+def peak_attraction(law) -> float:
+    """The H at which the law attracts most (P most negative), above its wall.
+
+    A rough average spreads the attraction over the heights, and the peak can lie
+    far from the wall + 1.5 of a smooth surface: with the 16-point Hermite rule at
+    sigma = 1 it is 0.24 above the wall.  Sampled on a geometric scale from the
+    wall, then refined by Brent's method between the neighbours of the best sample.
+    """
+    if law.smooth:
+        return SMOOTH_PEAK
+    reach = 2.0 * (law.wall + 1.0) + 3.0          # past the lowest heights' reach, for any law here
+    H = law.wall + np.geomspace(1e-4, reach, 2000)
+    k = int(np.argmin(law(H)[0]))
+    lo, hi = H[max(k - 1, 0)], H[min(k + 1, H.size - 1)]
+    best = minimize_scalar(lambda h: float(law(np.array([h]))[0][0]), bounds=(lo, hi), method="bounded",
+                           options={"xatol": 1e-10})
+    return float(best.x)
+
+
 def edge_level(law) -> float:
-    """H at the pinned contact edge: 1.5 epsilon above the wall of the roughness average, inside the
-    cohesive zone (0.5 for a smooth surface: a gap of 1.5 epsilon)."""
-    return law.wall + 1.5
+    """H at the pinned contact edge: as far beyond the law's peak attraction as a smooth surface's
+    SMOOTH_LEVEL is beyond its own, so inside the cohesive zone whatever the roughness."""
+    return SMOOTH_LEVEL if law.smooth else peak_attraction(law) + (SMOOTH_LEVEL - SMOOTH_PEAK)
 
 
 class ScaledProblem:
@@ -61,7 +87,7 @@ class ScaledProblem:
         self.model, self.rho, self.A, self.scale, self.pc = model, rho, A, scale, pmat
         self.comm = A.getComm()
         self._mpi = self.comm.tompi4py()
-        self.law = PressureLaw(model.sigma, model.roughness, model.hermite_points)
+        self.law = pressure_law(model)
         self.level = edge_level(self.law)
         self.c = model.coupling
         self.lo, self.hi = A.getOwnershipRange()

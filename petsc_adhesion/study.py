@@ -30,6 +30,7 @@ from .options import (TABLE, AppOptions, InputError, check_consistency, check_me
                       check_unused, collective, print_help, read_grid, read_guess, read_model, read_physical,
                       read_settings)
 from .output import write_curve, write_solve
+from .pressure import pressure_law
 from .problem import Problem, far_approach
 from .solver import Newton
 
@@ -72,7 +73,8 @@ def plan(opts: AppOptions, comm, argv: list[str]) -> Plan:
     targets = {k: opts.string(k) for k in _OUTPUTS if opts.string(k)}
     if "plot" in targets and not targets["plot"].lower().endswith(tuple(PLOT_FORMATS)):
         raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
-    inputs = {"options_file": options_files(argv), "adh_guess": [opts.string("adh_guess") or ""]}
+    inputs = {"options_file": options_files(argv), "adh_guess": [opts.string("adh_guess") or ""],
+              "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
     return Plan(model, r, lam, read_settings(opts), targets, inputs)
@@ -142,8 +144,7 @@ def fixed_solve(problem: Problem, newton: Newton, lam: float, H: PETSc.Vec) -> d
 def _head(comm, opts: AppOptions, model, grid: dict) -> dict:
     """What every result file says about its run: versions, options, model, grid, SI scales."""
     phys = read_physical(opts)
-    rough = {"roughness": model.roughness, "hermite_points": model.hermite_points} \
-        if model.sigma > 0 and model.roughness != "none" else {}
+    rough = pressure_law(model).describe()
     return {"program": "petsc-adhesion", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(),
             "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize(),

@@ -20,7 +20,8 @@ def test_bench_json(tmp_path):
     assert run.returncode == 0, run.stderr
     out = json.loads(path.read_text())
     assert out["mpi_ranks"] == 1 and out["version"]
-    (q,) = out["results"].values()
+    q, paper = out["results"]["curve"], out["results"]["curve_paper"]
+    assert paper["repeats"] == 1 and paper["steps"] > 0
     assert q["repeats"] == 1 and math.isfinite(q["median_s"]) and q["median_s"] > 0
     assert q["target_s"] == 1.0 and isinstance(q["met"], bool)
     # the curve timed is the default study: the paper's mu = 1 landmarks (its text has

@@ -108,6 +108,21 @@ BAD = {
     "app_option_misspelled": (["-adh_muu", "1"], "-adh_muu", ["unknown option", r"-adh_mu(?!u)"]),
     "petsc_option_misspelled": (["-snes_monitr"], "-snes_monitr", ["unknown option"]),
     "guess_missing": (["-adh_guess", "/nonexistent.h5"], "-adh_guess", [R("/nonexistent.h5")]),
+    "cutoff_with_hermite": (["-adh_sigma", "0.2", "-adh_roughness_cutoff", "4"], "-adh_roughness_cutoff",
+                            ["truncated_gaussian"]),
+    "cutoff_zero": (["-adh_sigma", "0.2", "-adh_roughness", "truncated_gaussian", "-adh_roughness_cutoff", "0"],
+                    "-adh_roughness_cutoff", [R("(0, 10]")]),
+    "skewness_range": (["-adh_sigma", "0.2", "-adh_roughness", "weibull", "-adh_roughness_skewness", "1"],
+                       "-adh_roughness_skewness", [R("[-2, 0.5]")]),
+    "quadrature_smooth": (["-adh_roughness", "weibull", "-adh_quadrature_points", "12"], "-adh_quadrature_points",
+                          ["-adh_sigma 0"]),
+    "measured_no_file": (["-adh_roughness", "measured"], "-adh_roughness_file", ["required"]),
+    "measured_missing_file": (["-adh_roughness", "measured", "-adh_roughness_file", "/nonexistent.txt"],
+                              "-adh_roughness_file", [R("nonexistent.txt"), "cannot read"]),
+    "measured_with_sigma": (["-adh_roughness", "measured", "-adh_roughness_file", "/nonexistent.txt",
+                             "-adh_sigma", "0.2"], "-adh_sigma", ["heights set it"]),
+    "file_without_measured": (["-adh_sigma", "0.2", "-adh_roughness_file", "/nonexistent.txt"],
+                              "-adh_roughness_file", ["measured"]),
 }
 
 

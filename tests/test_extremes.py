@@ -80,3 +80,32 @@ def test_secondary_turning_points_at_mu5(tmp_path):
     assert all("landing" in f for f in s["folds"])
     # the JKR-like limit: pull-off near -0.75 (the paper's Fig. 8: near JKR for mu >= 5)
     assert -0.80 < s["pull_off"]["F"] < -0.75
+
+
+# The hardest cells of docs/stability.md on the default grid, with reduced settings (no error bars,
+# stopped past equilibrium): clean curves, the true number of turning points, no warning.  The counts
+# are those of resolved grids: three fold pairs at mu = 20 (5, 10 and 20 nodes across the zone, and
+# -grid_type paper with h = zone/5 give the same), two at mu = 7, 10 (paper Fig. 9), one at mu = 7,
+# sigma = 0.4 and none at sigma = 1, where the rough edge is smooth.
+HARDEST = {(20, 0.0): 6, (20, 0.4): 4, (10, 0.2): 4, (7, 0.4): 2, (10, 1.0): 0, (20, 1.0): 0}
+
+
+@pytest.fixture(scope="module")
+def hardest(tmp_path_factory):
+    from test_cli import run_all
+    d = tmp_path_factory.mktemp("hardest")
+    procs = run_all({c: (("-adh_mu", c[0], "-adh_sigma", c[1], "-cont_F_max", 0.2, "-cont_error_estimate", "false",
+                          "-summary", d / f"{c[0]}_{c[1]}.json"), {}) for c in HARDEST})
+    return {c: (p, d / f"{c[0]}_{c[1]}.json") for c, p in procs.items()}
+
+
+@pytest.mark.parametrize("case", list(HARDEST), ids=[f"mu{m:g}-sigma{s:g}" for m, s in HARDEST])
+def test_hardest_cells_trace_cleanly(hardest, case):
+    proc, js = hardest[case]
+    assert proc.returncode == 0, proc.stderr
+    s = json.loads(js.read_text())
+    assert s["complete"] and s["warnings"] == [] and s["grid_warning"] == ""
+    assert len(s["folds"]) == HARDEST[case]
+    kinds = [f["kind"] for f in s["folds"]]
+    assert kinds == ["snap_on", "snap_off"] * (len(kinds) // 2)
+    assert s["equilibria"] and s["wall_gap"] > 0.05

@@ -331,3 +331,28 @@ def test_bad_guess_files(tmp_path, kind, phrase):
     line = one_line(run_cli(*SOLVE, "-adh_guess", path, "-out", tmp_path / "x.h5"))
     assert line.startswith("-adh_guess") and phrase in line, line
     assert sorted(os.listdir(tmp_path)) == ["g.h5"]
+
+
+def test_missed_load_minimum_is_judged_per_grid():
+    """A discrete load minimum of a segment with no located minimum next to it, or one located above
+    it, is reported; a lower point on another grid (a regrid's re-solved state) and a lower point on
+    another part of the curve are not (results._missed_minimum)."""
+    from types import SimpleNamespace as NS
+
+    from petsc_adhesion.results import _missed_minimum
+
+    def seg(Fs, located=()):
+        """points with loads Fs; located: (step, F) of each F_min found on step [step, step + 1]."""
+        pts = [NS(values={"F": F}) for F in Fs]
+        found = [NS(label="F_min", segment=j, point=NS(values={"F": F})) for j, F in located]
+        return NS(cont=NS(points=pts), finder=NS(found=found))
+
+    # the minimum straddles a regrid: the old grid's last point is lower but is re-solved on the new one
+    a, b = seg([-0.1, -0.5, -0.6000054]), seg([-0.6, -0.59, -0.5], located=[(0, -0.6000001)])
+    assert _missed_minimum([a, b]) == ""
+    # a shallow wiggle passed in one step, less tensile than the pull-off: no matter
+    assert _missed_minimum([seg([-0.1, -0.3, -0.29, -0.31, -0.2]), b]) == ""
+    assert "more tensile than the located pull-off" in _missed_minimum([seg([-0.1, -0.7, -0.2, -0.1]), b])
+    assert "more tensile than the load minimum" in _missed_minimum([seg([-0.1, -0.7, -0.2, -0.1],
+                                                                        located=[(1, -0.6)]), b])
+    assert _missed_minimum([seg([-0.1, -0.2, -0.3])]) == ""     # monotone: the minimum lies beyond the curve
