@@ -20,8 +20,9 @@ from dataclasses import replace
 import numpy as np
 
 from .events import EventFinder, ParameterValue
+from .resolution import NODES_PER_ZONE, cohesive_zone
 
-__all__ = ["relocate", "extrapolate", "event_errors", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE",
+__all__ = ["relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE",
            "MAX_LEVEL"]
 
 #: Steps a local trace may take to pass the event on another level.
@@ -103,16 +104,36 @@ def extrapolate(values: dict) -> tuple:
     return float(best), max(BAR_FACTOR * abs(best - R), FLOOR * abs(X[2] - X[1]))
 
 
-#: The levels tried first, cheapest first; refined ones when a coarse level fails, and for -target_error.
+#: The levels tried first, cheapest first, as far as they resolve the contact edge (:func:`coarse_levels`);
+#: refined ones when a coarse level fails or does not resolve, and for -target_error.
 COARSE = (-1, -2)
 #: The finest level -target_error may reach.
 MAX_LEVEL = 4
 
 
+def coarse_levels(segments) -> tuple:
+    """The levels of COARSE whose grids still resolve the cohesive zone in each of ``segments``.
+
+    A grid that follows the edge has its finest spacing h there; level -k has
+    2^k h, which must stay below zone / NODES_PER_ZONE, or the coarse levels
+    trap the edge and their values are no guide to the error (mu = 7: the best
+    value from levels -2, -1, 0 was 60 times further from the truth than the
+    grid's own).  Fixed grids are the user's choice: all of COARSE.
+    """
+    keep = len(COARSE)
+    for seg in segments:
+        if seg.grid is not None:
+            spare = cohesive_zone(seg.problem.model, seg.problem.law) / NODES_PER_ZONE / seg.grid.fine
+            if np.isfinite(spare):                  # mu = 0: no edge to resolve
+                keep = min(keep, max(0, int(np.floor(np.log2(spare) + 1e-9))))
+    return COARSE[:keep]
+
+
 def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
     """Best values and error bars of one event's lambda and F (and its landing's F) from its levels.
 
-    Levels 0, -1, -2 by default; where a coarse level does not yield the event, 0,
+    Levels 0, -1, -2 by default, as far as they resolve the edge (:func:`coarse_levels`), then finer ones;
+    where a coarse level does not yield the event, 0,
     1, 2; with ``target_error``, finer levels up to MAX_LEVEL until every bar is
     below it (``target_met`` says whether it was).  Returns {lambda, F,
     lambda_err, F_err, levels, target_met} and, for a fold with a landing,
@@ -129,7 +150,8 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
             landing[level] = relocate(tracer, seg, found, level, target=pt.p)
         return True
 
-    for level in COARSE:
+    owners = [seg] + [s for s in tracer.segments if found.landing is not None and s.finder is found.landing_by]
+    for level in coarse_levels(owners):
         if not add(level):
             break
     while len(points) < 3:
