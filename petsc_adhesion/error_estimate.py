@@ -28,7 +28,7 @@ __all__ = ["relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_ST
 #: Steps a local trace may take to pass the event on another level.
 LOCAL_STEPS = 40
 #: The bar is this times the distance of the three-level value from Richardson's (docs/coverage.md:
-#: 2 already covers 95.7% of 207 quantities with a median bar of 2.4 times the true error).
+#: 234 of 235 quantities covered, median bar about 3 times the true error).
 BAR_FACTOR = 2.5
 #: ... and at least this times the last refinement's change: the two values can agree by accident
 #: (mu = 1, snap-on landing: 3e-9 apart, 2.4e-8 from the truth, after a change of 1e-4).
