@@ -59,8 +59,9 @@ from .study import discretize, trace
 
 __all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main"]
 
-#: -bench_only choices, in the order they run
-PARTS = ("influence", "solve", "curve", "stiff")
+#: -bench_only choices, in the order they run; the last, "workprecision" (about 20 minutes, writes
+#: docs/performance.md: petsc_adhesion/workprecision.py), only with -bench_only workprecision or -bench_workprecision
+PARTS = ("influence", "solve", "curve", "stiff", "workprecision")
 #: Stiff curves: mu -> (target in s, turning points of the resolved curve; docs/stability.md).
 STIFF = {7.0: (10.0, 4), 20.0: (60.0, 6)}
 
@@ -240,6 +241,7 @@ def main() -> int:
     only = opts.getString("only", "")
     path = opts.getString("json", "")
     profile = opts.getBool("profile", False)
+    workprecision = opts.getBool("workprecision", False)
     check_unused(lambda name: name.startswith("bench_"))
     if opts.hasName("repeats") and repeats < 1:
         raise InputError(f"-bench_repeats: expected an integer >= 1, got {repeats}")
@@ -251,7 +253,7 @@ def main() -> int:
         check_targets({"bench_json": path})
     load = os.getloadavg()[0]
 
-    parts = (only,) if only else PARTS
+    parts = (only,) if only else PARTS[:-1] + (PARTS[-1:] if workprecision else ())
     results = bench_influence(repeats) if "influence" in parts else {}
     if "solve" in parts:
         results |= bench_solve(mu1_problem(), repeats)
@@ -259,6 +261,9 @@ def main() -> int:
         results |= bench_curve(repeats)
     if "stiff" in parts:
         results |= bench_stiff(repeats)
+    if "workprecision" in parts:
+        from . import workprecision
+        results |= workprecision.run()
     top = profile_curve() if profile else None
     info = {"program": "petsc-adhesion bench", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(), "mpi_ranks": 1,

@@ -196,7 +196,7 @@ through it; the best value is the three-level extrapolation X + h^2 (A + B log h
 h = 2^-level (the collocation's error has an h^2 log h term besides h^2, from the
 log-singular kernel on graded grids: Richardson alone leaves it, and its error scatters
 too widely for a bar that both covers and stays tight), and the bar is 2.5 times the
-distance of that value from Richardson's, and at least 0.3% of the last refinement's
+distance of that value from Richardson's, and at least 0.06% of the last refinement's
 change (the two can agree by accident).  The coarse levels are used only as far as
 they resolve the contact edge (zone/5 there; `error_estimate.coarse_levels`): levels
 -2, -1, 0 at small mu, -1, 0, 1 or 0, 1, 2 at large mu; where a coarse level does

@@ -192,7 +192,8 @@ class ResultSet:
                     if os.path.exists(other) and _read_journal(other) is not None:
                         os.remove(other)
         host = socket.gethostname()
-        for path in self.targets.values():
+        # the outputs' temporaries, and those of a journal killed while it was being written
+        for path in [p for t in self.targets.values() for p in (t, _journal(os.path.abspath(t)))]:
             folder, base = os.path.split(os.path.abspath(path))
             for tmp in glob.glob(os.path.join(glob.escape(folder), f".{glob.escape(base)}.partial-*")):
                 owner = tmp.rsplit(".partial-", 1)[1]

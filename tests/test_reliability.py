@@ -356,3 +356,24 @@ def test_missed_load_minimum_is_judged_per_grid():
     assert "more tensile than the load minimum" in _missed_minimum([seg([-0.1, -0.7, -0.2, -0.1],
                                                                         located=[(1, -0.6)]), b])
     assert _missed_minimum([seg([-0.1, -0.2, -0.3])]) == ""     # monotone: the minimum lies beyond the curve
+
+
+def test_next_run_removes_a_journal_killed_while_being_written(tmp_path):
+    """A SIGKILL while the commit journal itself is written leaves '..NAME.commit.partial-HOST-PID'
+    (found by tests/test_kill.py); the next run over the same names removes it, as it does the outputs'
+    temporaries, and leaves a live process's alone."""
+    import socket
+    import subprocess
+    import sys
+
+    from petsc_adhesion.files import ResultSet
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    host = socket.gethostname()
+    stale = tmp_path / f"..k.h5.commit.partial-{host}-{dead}"
+    live = tmp_path / f"..k.h5.commit.partial-{host}-{os.getpid()}"
+    stale.write_text("{")
+    live.write_text("{")
+    ResultSet({"out": str(tmp_path / "k.h5"), "summary": str(tmp_path / "k.json")})
+    assert not stale.exists() and live.exists()
