@@ -224,10 +224,11 @@ class Tracer:
     """Trace a curve in segments: on a fixed grid (one segment), or on grids that follow the edge."""
 
     def __init__(self, model, settings: Settings, events, tol=None, nodes=None, pmat=None, level: int = 0,
-                 rmax: float = RMAX):
+                 rmax: float = RMAX, comm=None):
         """``nodes``: a fixed grid, or None for grids following the edge at refinement ``level`` out to
-        ``rmax``; ``pmat``: the preconditioning strategy of every segment's problem."""
-        self.model, self.set, self.events, self.tol = model, settings, list(events), tol
+        ``rmax``; ``pmat``: the preconditioning strategy of every segment's problem; ``comm``: the
+        communicator of every segment (PETSc.COMM_WORLD by default)."""
+        self.model, self.set, self.events, self.tol, self.comm = model, settings, list(events), tol, comm
         self.nodes, self.pmat, self.level, self.rmax = nodes, pmat, level, rmax
         self.segments: list[Segment] = []
         self.sharp = None
@@ -240,15 +241,15 @@ class Tracer:
         level = self.level if level is None else level
         if kind == "fixed":
             nodes = grid.nested(self.nodes, level - self.level)
-            problem, design = Problem(self.model, nodes, create_influence(nodes), self.pmat), None
+            problem, design = Problem(self.model, nodes, create_influence(nodes, self.comm), self.pmat), None
         elif kind == "edge":
             design = grid_for(self.model, at, level, self.rmax)
             r = design.nodes()
-            problem = Problem(self.model, r, create_influence(r), self.pmat)
+            problem = Problem(self.model, r, create_influence(r, self.comm), self.pmat)
         else:
             design = scaled_grid_for(self.model, at, level, self.rmax, band)
             rho = design.nodes() / at
-            problem = ScaledProblem(self.model, rho, create_influence(rho), at, self.pmat)
+            problem = ScaledProblem(self.model, rho, create_influence(rho, self.comm), at, self.pmat)
         s = settings or self.set
         if before is not None:
             steps = sum(len(g.cont.points) - 1 for g in self.segments)

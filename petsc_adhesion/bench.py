@@ -1,7 +1,7 @@
 """Benchmarks on one rank: the influence matrix, one Newton solve, the mu = 1 curve.
 
     OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.bench [-bench_repeats K] \\
-        [-bench_only influence|solve|curve] [-bench_json bench.json] [-bench_profile] [-log_view]
+        [-bench_only influence|solve|curve|stiff|leaveout|workprecision] [-bench_json bench.json] [-bench_profile] [-log_view]
 
 Each quantity is the median wall time of repeated runs (7, 3 at N = 4000 and 5
 for the curve, or K each), shown with its min, max and number of repeats,
@@ -59,9 +59,11 @@ from .study import discretize, trace
 
 __all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main"]
 
-#: -bench_only choices, in the order they run; the last, "workprecision" (about 20 minutes, writes
-#: docs/performance.md: petsc_adhesion/workprecision.py), only with -bench_only workprecision or -bench_workprecision
-PARTS = ("influence", "solve", "curve", "stiff", "workprecision")
+#: -bench_only choices, in the order they run; the last two only when asked for: "leaveout" (about
+#: 15 minutes, writes docs/figures/leaveout.md: petsc_adhesion/leaveout.py) with -bench_only leaveout,
+#: "workprecision" (about 20 minutes, writes docs/performance.md: petsc_adhesion/workprecision.py)
+#: with -bench_only workprecision or -bench_workprecision
+PARTS = ("influence", "solve", "curve", "stiff", "leaveout", "workprecision")
 #: Stiff curves: mu -> (target in s, turning points of the resolved curve; docs/stability.md).
 STIFF = {7.0: (10.0, 4), 20.0: (60.0, 6)}
 
@@ -253,7 +255,7 @@ def main() -> int:
         check_targets({"bench_json": path})
     load = os.getloadavg()[0]
 
-    parts = (only,) if only else PARTS[:-1] + (PARTS[-1:] if workprecision else ())
+    parts = (only,) if only else PARTS[:-2] + (PARTS[-1:] if workprecision else ())
     results = bench_influence(repeats) if "influence" in parts else {}
     if "solve" in parts:
         results |= bench_solve(mu1_problem(), repeats)
@@ -261,6 +263,9 @@ def main() -> int:
         results |= bench_curve(repeats)
     if "stiff" in parts:
         results |= bench_stiff(repeats)
+    if "leaveout" in parts:
+        from . import leaveout
+        results |= leaveout.run()
     if "workprecision" in parts:
         from . import workprecision
         results |= workprecision.run()

@@ -13,7 +13,7 @@ from functools import lru_cache
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["options_left", "error_message", "set_linesearch_type", "options_from"]
+__all__ = ["options_left", "error_message", "set_linesearch_type", "options_from", "options_of"]
 
 
 @lru_cache(maxsize=None)
@@ -68,27 +68,45 @@ def set_linesearch_type(snes: PETSc.SNES, kind: str) -> None:
 
 
 @contextmanager
-def options_from(argv: list[str]):
-    """A fresh options database holding ``argv``'s options, as PETSc's start-up reads them
-    (arguments, -options_file, PETSC_OPTIONS, .petscrc), made the global one for the block
-    (PetscOptionsCreate, PetscOptionsPush, PetscOptionsInsert); the caller's comes back after
-    (PetscOptionsPop, PetscOptionsDestroy)."""
+def _pushed():
+    """A fresh, empty options database, the global one for the block (PetscOptionsCreate,
+    PetscOptionsPush); the caller's comes back after (PetscOptionsPop, PetscOptionsDestroy)."""
     lib = _lib()
-    ptr = ctypes.POINTER
-    lib.PetscOptionsCreate.argtypes = [ptr(ctypes.c_void_p)]
+    lib.PetscOptionsCreate.argtypes = [ctypes.POINTER(ctypes.c_void_p)]
     lib.PetscOptionsPush.argtypes = [ctypes.c_void_p]
-    lib.PetscOptionsDestroy.argtypes = [ptr(ctypes.c_void_p)]
-    lib.PetscOptionsInsert.argtypes = [ctypes.c_void_p, ptr(ctypes.c_int), ptr(ptr(ctypes.c_char_p)), ctypes.c_char_p]
+    lib.PetscOptionsDestroy.argtypes = [ctypes.POINTER(ctypes.c_void_p)]
     db = ctypes.c_void_p()
     if lib.PetscOptionsCreate(ctypes.byref(db)) or lib.PetscOptionsPush(db):
         raise RuntimeError("cannot make an options database")
     try:
+        yield
+    finally:
+        lib.PetscOptionsPop()
+        lib.PetscOptionsDestroy(ctypes.byref(db))
+
+
+@contextmanager
+def options_from(argv: list[str]):
+    """A fresh options database holding ``argv``'s options, as PETSc's start-up reads them
+    (arguments, -options_file, PETSC_OPTIONS, .petscrc: PetscOptionsInsert, collective on
+    PETSC_COMM_WORLD), the global one for the block."""
+    lib, ptr = _lib(), ctypes.POINTER
+    lib.PetscOptionsInsert.argtypes = [ctypes.c_void_p, ptr(ctypes.c_int), ptr(ptr(ctypes.c_char_p)), ctypes.c_char_p]
+    with _pushed():
         args = [a.encode("utf-8", errors="surrogateescape") for a in argv]
         argc = ctypes.c_int(len(args))
         array = ctypes.cast((ctypes.c_char_p * len(args))(*args), ptr(ctypes.c_char_p))
         if lib.PetscOptionsInsert(None, ctypes.byref(argc), ctypes.byref(array), None):
             raise RuntimeError("PETSc could not read the options")
         yield
-    finally:
-        lib.PetscOptionsPop()
-        lib.PetscOptionsDestroy(ctypes.byref(db))
+
+
+@contextmanager
+def options_of(values: dict):
+    """A fresh options database holding ``values`` (name without the dash -> value string, None
+    for a bare flag), the global one for the block; reads no file, so one rank may enter alone."""
+    with _pushed():
+        db = PETSc.Options()
+        for name, value in values.items():
+            db.setValue(name, value)
+        yield

@@ -1,13 +1,21 @@
-"""The figures and tables of docs/: each made by one function here, from real runs.
+"""The figures and tables of docs/, from real runs.
 
     ./run figures                  # all of them, into docs/figures/
-    ./run figures convergence      # one
+    ./run figures fig18            # one paper figure: the study options/fig18.opts
+    ./run figures convergence      # one of our own studies
+
+The paper's figures are the studies ``options/figNN.opts`` (:mod:`petsc_adhesion.sweep`),
+run here one after another as ``./run study`` runs them (``NP=2`` spreads each over two
+ranks); each writes its PNG and JSON summary into docs/figures/, and this module adds
+the table of its events, figNN.md.  Our own studies (refinement, quadrature, models)
+are the functions below.
 
 Every figure NAME.png comes with NAME.md, the table of the numbers behind it, which
 docs/results.md includes by reference; rerun after any change to the solver.
 """
 from __future__ import annotations
 
+import glob
 import json
 import os
 import subprocess
@@ -17,10 +25,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .reference import rigid_load
-from .plot import load_approach, profiles, read
+from .plot import load_approach, read
 
-__all__ = ["FIGURES", "run", "runs"]
+__all__ = ["FIGURES", "STUDIES", "study", "run", "runs"]
 
 OUT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs", "figures")
 TMP = tempfile.mkdtemp(prefix="petsc-adhesion-figures-")
@@ -68,74 +75,8 @@ def _f(x, fmt=".5f"):
     return "-" if x is None else format(x, fmt)
 
 
-def spacing_for(mu: float) -> int:
-    """Uniform N on [0, 10] that resolves the cohesive zone: h <= 0.75 mu^-1.5 / 5."""
-    return max(531, int(np.ceil(10 / (0.15 * mu ** -1.5))) + 1)
 
 
-def smooth():
-    """Load-approach curves of smooth spheres (paper Figs. 4, 5, 8) and the rigid limit."""
-    plt = _plt()
-    mus = (0.01, 0.5, 1.0, 2.0, 3.0)
-    res = runs([("-adh_mu", m) for m in mus])
-    fig, ax = plt.subplots(figsize=(7, 5))
-    lam = np.linspace(-4, 0.6, 300)
-    ax.plot(lam, rigid_load(lam), "k:", label="mu = 0, eq. (28)")
-    rows = []
-    for m, (s, h5) in zip(mus, res):
-        load_approach(ax, read(h5), label=f"mu = {m:g}")
-        fo = {f["kind"]: f["lambda"] for f in s["folds"]}
-        rows.append([f"{m:g}", _f(s["pull_off"]["F"]), _f(s["pull_off"]["lambda"]), _f(fo.get("snap_on")),
-                     _f(fo.get("snap_off")), _f(s["equilibria"][-1]["lambda"]), str(s["steps"]),
-                     f"{s['wall_time_s']:.2f}"])
-    ax.set_xlim(-6, 7)
-    ax.set_ylim(-1.1, 1.0)
-    ax.legend(fontsize=8)
-    _save(fig, "smooth", _table(["mu", "pull-off F", "lambda_p", "snap-on lambda", "snap-off lambda",
-                                 "equilibrium lambda", "steps", "time (s)"], rows),
-          "./run figures smooth")
-
-
-def rough():
-    """Roughness at mu = 0.01 and mu = 2 (paper Figs. 13, 14)."""
-    plt = _plt()
-    sig = (0.0, 0.2, 0.4, 1.0)
-    cases = [(m, s) for m in (0.01, 2.0) for s in sig]
-    res = runs([("-adh_mu", m, "-adh_sigma", s) for m, s in cases])
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    rows = []
-    for (m, s), (summ, h5) in zip(cases, res):
-        ax = axes[0 if m < 1 else 1]
-        load_approach(ax, read(h5), label=f"sigma = {s:g}")
-        ax.set_title(f"mu = {m:g}")
-        fo = {f["kind"]: f["lambda"] for f in summ["folds"]}
-        rows.append([f"{m:g}", f"{s:g}", _f(summ["pull_off"]["F"]), _f(summ["pull_off"]["lambda"]),
-                     _f(fo.get("snap_on")), _f(fo.get("snap_off")), _f(summ["equilibria"][-1]["lambda"])])
-    for ax in axes:
-        ax.set_ylim(-1.1, 0.6)
-        ax.set_xlim(-9, 6)
-        ax.legend(fontsize=8)
-    _save(fig, "rough", _table(["mu", "sigma", "pull-off F", "lambda_p", "snap-on", "snap-off", "equilibrium"],
-                               rows), "./run figures rough")
-
-
-def snaps():
-    """States just before and after snap-on and snap-off at mu = 1 (paper Figs. 6, 7)."""
-    plt = _plt()
-    (summ, h5), = runs([("-adh_mu", 1, "-profiles")])
-    res = read(h5)
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
-    rows = []
-    for col, kind in enumerate(("snap_on", "snap_off")):
-        ev = next(e for e in res["events"] if e["kind"] == kind)
-        profiles(axes[0, col], axes[1, col], res["r"], ev["H"], ev["P"], f"at the fold, F = {ev['F']:.4f}")
-        land = ev["landing"]
-        profiles(axes[0, col], axes[1, col], res["r"], land["H"], land["P"], f"after the jump, F = {land['F']:.4f}")
-        axes[0, col].set_title(f"{kind.replace('_', '-')} at lambda = {ev['lambda']:.5f}")
-        axes[0, col].legend(fontsize=8)
-        rows.append([kind, _f(ev["lambda"], ".8f"), _f(ev["F"]), _f(land["F"]), _f(ev["H0"]), _f(land["H0"])])
-    _save(fig, "snaps", _table(["fold", "lambda", "F before", "F after", "H(0) before", "H(0) after"], rows),
-          "./run figures snaps")
 
 
 def convergence():
@@ -217,47 +158,6 @@ def coarse():
     _save(fig, "coarse", _table(["N", "h", "folds", "stopped", "grid_warning"], rows), "./run figures coarse")
 
 
-def reduction():
-    """Reduction of the pull-off by roughness, phi_r = 1 - F_p / F_p0 (eq. 29, paper Fig. 17)."""
-    plt = _plt()
-    sig = (0.0, 0.1, 0.2, 0.3, 0.4, 0.6, 0.8, 1.0, 1.2)
-    mus = (0.01, 1.0, 2.0)
-    res = runs([("-adh_mu", m, "-adh_sigma", s, "-cont_F_max", 0.2) for m in mus for s in sig])
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    rows = []
-    for i, m in enumerate(mus):
-        F = np.array([res[i * len(sig) + j][0]["pull_off"]["F"] for j in range(len(sig))])
-        phi = 1 - F / F[0]
-        ax.plot(sig, phi, "o-", label=f"mu = {m:g}")
-        rows.append([f"{m:g}"] + [f"{p:.3f}" for p in phi])
-    ax.set_xlabel("sigma")
-    ax.set_ylabel("reduction rate phi_r")
-    ax.legend()
-    _save(fig, "reduction", _table(["mu"] + [f"sigma={s:g}" for s in sig], rows), "./run figures reduction")
-
-
-def tabor():
-    """Pull-off against the Tabor parameter, smooth and rough (paper Fig. 18), on resolving grids."""
-    plt = _plt()
-    mus = (0.01, 0.1, 0.3, 0.5, 1.0, 2.0, 3.0, 4.0)
-    sig = (0.0, 0.2, 1.0)
-    cases = [(m, s) for s in sig for m in mus]
-    res = runs([("-adh_mu", m, "-adh_sigma", s, "-grid_type", "uniform", "-grid_n", spacing_for(m),
-                 "-cont_F_max", 0.2) for m, s in cases])
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    rows = {}
-    for (m, s), (summ, _) in zip(cases, res):
-        rows.setdefault(s, []).append(summ["pull_off"]["F"])
-    for s, F in rows.items():
-        ax.semilogx(mus, -np.array(F), "o-", label=f"sigma = {s:g}")
-    ax.axhline(1.0, color="0.6", lw=0.8)
-    ax.axhline(0.75, color="0.6", lw=0.8)
-    ax.set_xlabel("Tabor parameter mu")
-    ax.set_ylabel("pull-off |F| / (2 pi R gamma)")
-    ax.legend()
-    _save(fig, "tabor", _table(["sigma"] + [f"mu={m:g}" for m in mus],
-                               [[f"{s:g}"] + [_f(x, ".4f") for x in F] for s, F in rows.items()]),
-          "./run figures tabor")
 
 
 #: The roughness models compared: label -> options (docs/model.md, "Roughness models").
@@ -327,8 +227,51 @@ def models():
     _save(fig, "models", _table(["mu", "model"] + [f"sigma={s:g}" for s in sig], rows), "./run figures models")
 
 
-FIGURES = {f.__name__: f for f in (smooth, rough, snaps, convergence, hermite, coarse, reduction, tabor,
-                                   quadrature, models)}
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+#: The studies of the paper's figures, by name: figNN -> its options file.
+STUDIES = {os.path.basename(f)[:-5]: f for f in sorted(glob.glob(os.path.join(ROOT, "options", "fig[0-9]*.opts")))}
+
+
+def _pm(e: dict | None, key: str) -> str:
+    if not e:
+        return "-"
+    bar = e.get(f"{key}_err")
+    return f"{e[key]:.6f}" + (f" +- {bar:.1e}" if bar else "")
+
+
+def study(name: str) -> None:
+    """Run the study options/NAME.opts as ``./run study`` does (from the repository, NP ranks) and
+    write NAME.md, the table of each case's events with their error bars."""
+    np_ = os.environ.get("NP")
+    launcher = ["mpiexec", "-n", np_] if np_ else []
+    cmd = launcher + [sys.executable, "-m", "petsc_adhesion", "-options_file", os.path.relpath(STUDIES[name], ROOT)]
+    os.makedirs(os.path.join(ROOT, "results"), exist_ok=True)
+    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    if proc.returncode not in (0, 3):
+        raise RuntimeError(f"{' '.join(cmd)}: {proc.stderr.strip().splitlines()[-1]}")
+    with open(os.path.join(OUT, f"{name}.json")) as f:
+        s = json.load(f)
+    rows = []
+    for c in s["cases"]:
+        # the primary turning points: snap-on at the largest lambda, snap-off at the smallest
+        folds = {k: f([e for e in c["folds"] if e["kind"] == k], key=lambda e: e["lambda"], default=None)
+                 for k, f in (("snap_on", max), ("snap_off", min))}
+        eq = c["equilibria"][0] if c["equilibria"] else None
+        po = c["pull_off"]
+        rows.append([", ".join(f"{k.replace('adh_', '')} = {v:g}" for k, v in c["values"].items()),
+                     _pm(po, "F"), _pm(po, "lambda"), _pm(folds.get("snap_on"), "lambda"),
+                     _pm(folds.get("snap_off"), "lambda"), _pm(eq, "lambda"),
+                     "-" if s["study"]["compute"] == "pull_off" else str(len(c["folds"])),
+                     f"{c['wall_time_s']:.1f}" + ("" if c["complete"] else " (incomplete)")])
+    rows += [[f"case {f['case'] + 1} failed: {f['error']}"] + ["-"] * 7 for f in s["failed"]]
+    table = _table(["case", "pull-off F", "pull-off lambda", "snap-on lambda", "snap-off lambda",
+                    "equilibrium lambda", "turning points", "time (s)"], rows)
+    with open(os.path.join(OUT, f"{name}.md"), "w") as f:
+        f.write(f"<!-- made by: ./run figures {name} (the study options/{name}.opts) -->\n{table}\n")
+
+
+OWN = {f.__name__: f for f in (convergence, hermite, coarse, quadrature, models)}
+FIGURES = {**{n: (lambda n=n: study(n)) for n in STUDIES}, **OWN}
 
 if __name__ == "__main__":
     names = sys.argv[1:] or list(FIGURES)

@@ -52,10 +52,12 @@ class Option:
         """What the option accepts, in words."""
         if self.kind == "choice":
             return "one of " + ", ".join(self.choices)
-        if self.kind in ("real", "int", "reals"):
+        if self.kind == "choices":
+            return "comma-separated names from " + ", ".join(self.choices)
+        if self.kind in ("real", "int", "reals", "sweep"):
             left, right = "(" if self.lo_open else "[", ")" if self.hi_open else "]"
-            what = {"real": "a finite real", "int": "an integer",
-                    "reals": "comma-separated finite reals"}[self.kind]
+            what = {"real": "a finite real", "int": "an integer", "reals": "comma-separated finite reals",
+                    "sweep": "comma-separated reals or ranges lo:hi:n[:log]"}[self.kind]
             if self.lo == -math.inf and self.hi == math.inf:
                 return what
             return f"{what} in {left}{_fmt(self.lo)}, {_fmt(self.hi)}{right}"
@@ -143,6 +145,24 @@ TABLE = {o.name: o for o in [
            "on its grid's coarser (or finer) nested levels, Richardson-extrapolated"),
     Option("target_error", "real", None, "refine each event's levels until its error bars (lambda and F) are "
            "below this", 0.0, 1.0, lo_open=True),
+    # studies: a sweep over cases (petsc_adhesion.sweep)
+    Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 50.0),
+    Option("study_sigma", "sweep", (), "study: the roughness sigma of its cases", 0.0, 5.0),
+    Option("study_option", "string", None, "study: a further real or integer option swept over -study_values "
+           "(without the dash, e.g. phys_radius, adh_hermite_points, grid_n)"),
+    Option("study_values", "sweep", (), "study: the values of -study_option", -1e12, 1e12),
+    Option("study_compute", "choice", "curve", "study: what each case computes: the whole curve; the events up to "
+           "equilibrium; only the pull-off and the equilibrium after it; only the turning points; the critical "
+           "roughness sigma_c(mu) of each -study_mu and the critical mu_c(sigma) of each -study_sigma",
+           choices=("curve", "events", "pull_off", "folds", "critical")),
+    Option("study_profiles", "choices", (), "study: the event kinds whose H(r), P(r) each case keeps",
+           choices=("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda")),
+    Option("study_ranks", "int", 1, "study: MPI ranks per case; the cases are spread over the groups of this "
+           "many ranks, the longest first", 1, 10**6),
+    Option("study_plot", "choice", "curves", "study: what -plot draws: load-approach curves; one panel per case "
+           "about its turning points; the profiles of -study_profiles; pull-off against mu; reduction of the "
+           "pull-off against sigma; critical roughness",
+           choices=("curves", "folds", "profiles", "pull_off", "reduction", "critical")),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
@@ -192,6 +212,48 @@ class AppOptions:
         if raw is None:
             return o.default
         return tuple(self._number(o, s.strip(), _strict_float) for s in raw.split(",") if s.strip())
+
+    def sweep(self, name: str) -> tuple:
+        """The values of a sweep: comma-separated reals or ranges ``lo:hi:n`` (n evenly spaced values)
+        and ``lo:hi:n:log`` (n geometrically spaced, lo > 0), each checked, in the order given.
+
+        >>> AppOptions._range("0.01:1:3:log"), AppOptions._range("0:1:5")
+        ((0.01, 0.1, 1.0), (0.0, 0.25, 0.5, 0.75, 1.0))
+        """
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        out = []
+        for item in (s.strip() for s in raw.split(",")):
+            try:
+                values = self._range(item) if ":" in item else (_strict_float(item),)
+            except ValueError:
+                raise self._bad(o, raw) from None
+            out += [self._number(o, repr(x), float) for x in values]
+        if not out:
+            raise self._bad(o, raw)
+        return tuple(out)
+
+    @staticmethod
+    def _range(item: str) -> tuple:
+        parts = item.split(":")
+        if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] != "log"):
+            raise ValueError(item)
+        lo, hi, n = _strict_float(parts[0]), _strict_float(parts[1]), _strict_int(parts[2])
+        if n < 2 or not lo < hi or (len(parts) == 4 and lo <= 0):
+            raise ValueError(item)
+        xs = np.geomspace(lo, hi, n) if len(parts) == 4 else np.linspace(lo, hi, n)
+        return tuple(float(x) for x in np.round(xs, 12))
+
+    def choices(self, name: str) -> tuple:
+        """A comma-separated subset of an option's choices, or its default."""
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        picked = tuple(s.strip() for s in raw.split(","))
+        if not all(p in o.choices for p in picked):
+            raise self._bad(o, raw)
+        return picked
 
     def choice(self, name: str) -> str:
         """The value of a choice option, one of its choices, or its default."""

@@ -14,7 +14,8 @@ import numpy as np
 
 from .files import PLOT_FORMATS, ResultSet
 
-__all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve", "write_solve"]
+__all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve", "write_solve", "study_table",
+           "write_study"]
 
 
 # Units of the dimensionless results (docs/model.md)
@@ -60,13 +61,25 @@ DESCRIBE = {
     "events/*/landing/H": (_EPS, "separation at the nodes after the jump (-profiles)"),
     "events/*/landing/P": (_PRES, "pressure at the nodes after the jump (-profiles)"),
     "summary": (f"{_STATE}; {_ERRORS}; *_s: s", "the JSON summary (docs/output.md)"),
+    "study": ("", "a study (kind: study): what its cases compute, the options swept, ranks per case, the figure"),
+    "cases": ("", "the cases of a study that ran, in their order; each holds a curve's layout and its values"),
+    "cases/*": ("", "one case: the options it sets (values), its model, grid, curve, events and summary"),
+    "cases/*/values": ("", "the options this case sets (name without the dash: value)"),
+    "failed": ("", "the cases of a study that did not run or failed, each with its one-line reason"),
+    "table": (f"{_STATE}; {_ERRORS}", "every case's events, one row each: case number, the swept options, kind, "
+              "best lambda and F with their error bars (NaN: none), the single-grid values"),
+    "table/*": ("", "one column of the table (units as the table's)"),
 }
 
 
 def _describe(name: str, obj) -> None:
     key = "/".join("*" if part.isdigit() else part for part in name.split("/"))
-    if key.startswith("summary/"):
-        key = "summary"
+    if key.startswith("cases/*/") and key not in DESCRIBE:     # a study's case holds a curve's layout
+        key = key[len("cases/*/"):]
+    if key.startswith(("summary/", "study/", "failed/")):
+        key = key.split("/")[0]
+    elif key.startswith("table/"):
+        key = "table/*"
     units, text = DESCRIBE[key]
     obj.attrs["units"], obj.attrs["description"] = units, text
 
@@ -200,3 +213,40 @@ def write_solve(res: dict, head: dict, files: ResultSet) -> None:
     if "summary" in files.targets:
         write_json(files.temp("summary"), {**_common(head), **brief})
     files.commit()
+
+
+def study_table(done: list[dict], axes: list[str]) -> dict:
+    """Every case's events as columns: case, the swept options, kind, best values, bars, grid values."""
+    rows = [(r, e) for r in done for e in r["tree"]["events"]]
+    cols = {"case": np.array([r["case"] for r, _ in rows], dtype=int)}
+    cols |= {name: np.array([r["values"][name] for r, _ in rows], dtype=float) for name in axes}
+    cols["kind"] = np.array([e["kind"] for _, e in rows], dtype="S12")
+    for k in ("lambda", "lambda_err", "F", "F_err", "lambda_grid", "F_grid"):
+        cols[k] = np.array([e.get(k, np.nan) for _, e in rows], dtype=float)
+    return cols
+
+
+def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
+    """The files of a study (:mod:`petsc_adhesion.sweep`), committed together; returns the summary.
+
+    ``done``: each case that ran as {case, values, summary, tree}; ``failed``: {case, values, error}.
+    """
+    brief = {k: v for k, v in prog.items() if k != "options"}
+    cases = [{"case": r["case"], "values": r["values"], **r["summary"]} for r in done]
+    summ = {**brief, "kind": "study", "study": study, "cases": cases, "failed": failed}
+    tree = {**prog, "kind": "study", "study": study,
+            "cases": [{"case": r["case"], "values": r["values"], **r["tree"]} for r in done],
+            "table": study_table(done, study["axes"]),
+            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in failed]}
+               if failed else {})}
+    if "out" in files.targets:
+        write_h5(files.temp("out"), tree)
+    if "plot" in files.targets:
+        from .studyplot import study_figure
+
+        fmt = PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()]
+        study_figure(tree, files.temp("plot"), study["plot"], fmt)
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), summ)
+    files.commit()
+    return summ

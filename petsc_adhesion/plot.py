@@ -10,7 +10,7 @@ import sys
 import h5py
 import numpy as np
 
-__all__ = ["read", "from_tree", "load_approach", "profiles", "curve_figure"]
+__all__ = ["read", "read_group", "from_tree", "load_approach", "profiles", "curve_figure"]
 
 MARK = {"snap_on": ("v", "snap-on"), "snap_off": ("^", "snap-off"), "F_min": ("o", "load extremum"),
         "equilibrium": ("s", "equilibrium"), "lambda": ("x", "at lambda")}
@@ -25,16 +25,21 @@ def from_tree(tree: dict) -> dict:
 def read(path: str) -> dict:
     """A curve result file as plain arrays and event dicts."""
     with h5py.File(path, "r") as f:
-        out = {"mu": f["model"].attrs["mu"], "sigma": f["model"].attrs["sigma"], "r": f["grid/r"][()],
-               "curve": {k: v[()] for k, v in f["curve"].items()}, "events": []}
-        for name in sorted(f["events"]) if "events" in f else []:
-            g = f["events"][name]
-            ev = dict(g.attrs)
-            ev.update({k: g[k][()] for k in ("r", "H", "P") if k in g})
-            if "landing" in g:
-                ev["landing"] = dict(g["landing"].attrs) | {k: g["landing"][k][()] for k in ("r", "H", "P")
-                                                            if k in g["landing"]}
-            out["events"].append(ev)
+        return read_group(f)
+
+
+def read_group(f) -> dict:
+    """A curve's layout from an HDF5 group (a curve file's root, or a study's case)."""
+    out = {"mu": f["model"].attrs["mu"], "sigma": f["model"].attrs["sigma"], "r": f["grid/r"][()],
+           "curve": {k: v[()] for k, v in f["curve"].items()}, "events": []}
+    for name in sorted(f["events"]) if "events" in f else []:
+        g = f["events"][name]
+        ev = dict(g.attrs)
+        ev.update({k: g[k][()] for k in ("r", "H", "P") if k in g})
+        if "landing" in g:
+            ev["landing"] = dict(g["landing"].attrs) | {k: g["landing"][k][()] for k in ("r", "H", "P")
+                                                        if k in g["landing"]}
+        out["events"].append(ev)
     return out
 
 

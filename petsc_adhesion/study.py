@@ -34,10 +34,16 @@ from .pressure import pressure_law
 from .problem import Problem, far_approach
 from .solver import Newton
 
-__all__ = ["Plan", "discretize", "trace", "fixed_solve", "main"]
+__all__ = ["Plan", "plan", "discretize", "trace", "curve", "fixed_solve", "program", "head", "main"]
 
 _APP = ("adh_", "grid_", "cont_")
 _OUTPUTS = ("out", "summary", "plot")
+
+
+def _is_sweep(opts: AppOptions) -> bool:
+    """Whether the options describe a study of many cases (:mod:`petsc_adhesion.sweep`)."""
+    return any(opts.db.hasName(n) for n in ("study_mu", "study_sigma", "study_option")) or \
+        opts.choice("study_compute") == "critical"
 
 
 def _is_app(name: str) -> bool:
@@ -91,38 +97,56 @@ def discretize(model, r, pmat=None) -> Problem:
 
 
 def trace(model, r, pmat, settings, lam0: float, at_lambda=(), tol: float | None = None,
-          profiles: bool = False, started=None, errors: bool = True, target_error: float | None = None) -> dict:
+          profiles: bool = False, started=None, errors: bool = True, target_error: float | None = None,
+          kinds=None, comm=None) -> dict:
     """The load-approach curve from lam0 on grid ``r`` (None: grids following the contact edge), with
     its events, landings, pull-off, error bars (``errors``: down to ``target_error`` when given),
     resolution check and warnings.
 
     ``started()`` is called once the first point and its tangent are computed (the
-    solvers then have read all their options).
+    solvers then have read all their options).  ``kinds``: the event kinds to report
+    (None: all); the others are left out of the result, unestimated (their levels' traces saved).
+    ``comm``: the communicator of the run (PETSc.COMM_WORLD by default).
     """
     t0 = time.perf_counter()
-    tracer = Tracer(model, settings, results.curve_events(at_lambda), tol, nodes=r, pmat=pmat, rmax=model.rmax)
+    comm = comm or PETSc.COMM_WORLD
+    tracer = Tracer(model, settings, results.curve_events(at_lambda), tol, nodes=r, pmat=pmat, rmax=model.rmax,
+                    comm=comm)
     segments = tracer.run(lam0, started)
     jumps([seg.finder for seg in segments], Problem.stable)
+    kept = (lambda label: True) if kinds is None else (lambda label: label in kinds or label == "lambda")
     wall = time.perf_counter() - t0
     if errors:
         t1 = time.perf_counter()
         for seg in segments:
-            for found in seg.finder.found:
+            for found in filter(lambda f: kept(f.label), seg.finder.found):
                 found.estimate = error_estimate.event_errors(tracer, seg, found, target_error)
         errors_wall = time.perf_counter() - t1
     res = results.curve(segments, profiles)
-    mpi = PETSc.COMM_WORLD.tompi4py()
+    mpi = comm.tompi4py()
     states = res.pop("states")
     law = tracer.segments[0].problem.law
     res["grid_warning"] = mpi.bcast(resolution.check(model, law, states, res["folds"])
                                     if mpi.Get_rank() == 0 else None)
     res["warnings"], res["incomplete"] = results.assess(segments, res, at_lambda)
+    res["events"] = [e for e in res["events"] if kept(e["kind"])]
+    if not kept("F_min"):
+        res["pull_off"] = None
     res |= {"wall_time_s": wall, "lambda_start": lam0}
     if errors:
         res["error_estimate"] = {"wall_time_s": errors_wall, "target_error": target_error,
                                  "levels": sorted({k for e in res["events"] for k in e.get("levels", ())})}
     tracer.destroy()
     return res
+
+
+def curve(opts: AppOptions, p: Plan, pmat, lam0: float, comm=None, kinds=None, profiles: bool = False) -> tuple:
+    """The curve of plan ``p`` from lam0 as its options ask (:func:`trace`); ``kinds`` and ``profiles``
+    as a study's case asks.  Returns the result and its grids."""
+    res = trace(p.model, p.r, pmat, p.settings, lam0, opts.reals("cont_at_lambda"), opts.real("cont_event_tol"),
+                profiles or opts.flag("profiles"), started=check_unused, errors=opts.flag("cont_error_estimate"),
+                target_error=opts.real("target_error"), kinds=kinds, comm=comm)
+    return res, {"r": res["grid"], **res["grids"]}
 
 
 def fixed_solve(problem: Problem, newton: Newton, lam: float, H: PETSc.Vec) -> dict:
@@ -141,14 +165,18 @@ def fixed_solve(problem: Problem, newton: Newton, lam: float, H: PETSc.Vec) -> d
             "P": problem.gather(pressure), "snes_iterations": its, "ksp_iterations": kits, "wall_time_s": wall}
 
 
-def _head(comm, opts: AppOptions, model, grid: dict) -> dict:
-    """What every result file says about its run: versions, options, model, grid, SI scales."""
-    phys = read_physical(opts)
-    rough = pressure_law(model).describe()
+def program(comm, opts: AppOptions) -> dict:
+    """What every result file says about the program that wrote it: versions, ranks, options."""
     return {"program": "petsc-adhesion", "version": __version__,
             "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(),
-            "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize(),
-            "options": opts.given(),
+            "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize(), "options": opts.given()}
+
+
+def head(comm, opts: AppOptions, model, grid: dict) -> dict:
+    """What every result file says about its run: the program, model, grid, SI scales."""
+    phys = read_physical(opts)
+    rough = pressure_law(model).describe()
+    return {**program(comm, opts),
             "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **rough,
                       "domain": "half-infinite (the rigid sphere's attraction beyond r_m added)" if model.farfield
                       else "truncated at r_m (the paper's model)"},
@@ -165,7 +193,16 @@ def main(argv: list[str] | None = None) -> int:
     helping = opts.db.hasName("help")
     if helping and comm.getRank() == 0:
         print_help(sys.stdout)
-    p = collective(comm, plan, opts, comm, sys.argv if argv is None else argv)
+    argv = sys.argv if argv is None else argv
+    if collective(comm, _is_sweep, opts):
+        from . import sweep                      # a sweep runs cases of this module's kind
+
+        return sweep.main(opts, argv, helping)
+    stray = [n for n in TABLE if n.startswith("study_") and opts.db.hasName(n)]
+    if stray and not helping:
+        raise InputError(f"-{stray[0]}: applies to a study of many cases (-study_mu, -study_sigma or "
+                         f"-study_option); remove it")
+    p = collective(comm, plan, opts, comm, argv)
     pmat = preconditioning.create(opts.choice("adh_pmat"), opts.int("adh_pmat_band"))
     if p.lam is None:
         lam0 = opts.real("cont_lambda_start")
@@ -175,10 +212,7 @@ def main(argv: list[str] | None = None) -> int:
             Continuation(problem, p.settings).destroy()
             problem.destroy()
             return 0
-        at, tol, profiles = opts.reals("cont_at_lambda"), opts.real("cont_event_tol"), opts.flag("profiles")
-        res = trace(p.model, p.r, pmat, p.settings, lam0, at, tol, profiles, started=check_unused,
-                    errors=opts.flag("cont_error_estimate"), target_error=opts.real("target_error"))
-        grid = {"r": res["grid"], **res["grids"]}
+        res, grid = curve(opts, p, pmat, lam0)
     else:
         r = p.r if p.r is not None else grid_for(p.model, rigid_edge(p.lam)).nodes()
         problem = discretize(p.model, r, pmat)
@@ -194,12 +228,12 @@ def main(argv: list[str] | None = None) -> int:
     status = 3 if p.lam is None and res["incomplete"] else 0
     if comm.getRank() == 0:
         files = ResultSet(p.targets)
-        head = _head(comm, opts, p.model, grid)
+        about = head(comm, opts, p.model, grid)
         try:
             if p.lam is None:
-                results.report_curve(write_curve(res, head, files))
+                results.report_curve(write_curve(res, about, files))
             else:
-                write_solve(res, head, files)
+                write_solve(res, about, files)
                 results.report_solve(res)
         except Interrupted as e:
             if not files.committed:

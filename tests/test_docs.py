@@ -35,6 +35,7 @@ def test_every_options_file_sets_up(tmp_path):
     output paths are writable (relative to results/, as ./run study makes it);
     -help stops after the set-up."""
     (tmp_path / "results").mkdir()
+    (tmp_path / "docs" / "figures").mkdir(parents=True)          # the paper figures' studies write there
     for name in sorted(os.listdir(os.path.join(ROOT, "options"))):
         proc = run_cli("-options_file", os.path.join(ROOT, "options", name), "-help", cwd=tmp_path)
         assert proc.returncode == 0, (name, proc.stderr)

@@ -1,0 +1,310 @@
+"""Studies: a sweep over cases described by options, spread over MPI ranks.
+
+    ./run study options/fig18.opts
+    mpiexec -n 2 petsc-adhesion -options_file options/fig18.opts
+
+The cases are the product of ``-study_mu``, ``-study_sigma`` and ``-study_option``'s
+``-study_values`` (each a list or ranges ``lo:hi:n[:log]``); every other option
+applies to every case, which runs exactly as a single curve with those options
+(:func:`petsc_adhesion.study.curve`).  ``-study_compute`` says what a case
+computes and ``-study_profiles`` which states it keeps, so that a case leaves
+out what the study does not use.
+
+With P ranks the cases go to P / ``-study_ranks`` groups (MPI subcommunicators),
+the longest first to the least loaded group (by :func:`cost`); each group runs
+its cases in that order.  Rank 0 prints a line for every finished case, with
+the elapsed time and an estimate of the time left, when it next comes up for
+air (after a step of its own curve, or a case).  A case whose options are
+bad is said in one line before any work and left out; a case that fails at
+run time is said in one line and recorded; the others run, and the study's
+files hold them (exit status 3 when any case is missing).  One HDF5 file (a
+group per case and a table of every case's events with their error bars), one
+JSON summary (``cases``: each case's ``mu``, ``sigma`` and the keys of a single
+curve's summary) and the figure of ``-study_plot`` are written together.
+"""
+from __future__ import annotations
+
+import itertools
+import signal
+import sys
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
+
+from petsc4py import PETSc
+
+from . import capi, preconditioning
+from .errors import InputError, Interrupted
+from .files import ResultSet, check_targets
+from .options import TABLE, AppOptions, check_unused, collective
+from .optionsfile import options_files
+from .output import curve_summary, curve_tree, write_study
+from .problem import far_approach
+from .study import curve, head, plan, program
+
+__all__ = ["Case", "cases", "cost", "assign", "main", "KINDS"]
+
+#: The event kinds each -study_compute reports (None: all) and whether it stops at equilibrium.
+KINDS = {"curve": (None, False), "events": (None, True), "pull_off": (("F_min", "equilibrium"), True),
+         "folds": (("snap_on", "snap_off"), True)}
+#: Options a study sets for its cases or writes itself; a -study_option cannot be one of them.
+_OWN = ("adh_mu", "adh_sigma", "adh_lambda", "out", "summary", "plot")
+_TAG = 17
+
+
+@dataclass
+class Case:
+    """One case of a study: its number and the options it sets."""
+
+    index: int
+    values: dict                                      # option name -> value
+    error: str | None = field(default=None)          # why it cannot run, or None
+
+    @property
+    def label(self) -> str:
+        names = {"adh_mu": "mu", "adh_sigma": "sigma"}
+        return ", ".join(f"{names.get(k, k)} = {v:g}" for k, v in self.values.items())
+
+    def options(self, study: dict) -> dict:
+        """The options of this case: the study's (``study``: name -> value), less the study's own files,
+        with its values."""
+        keep = {k: v for k, v in study.items() if k not in ("out", "summary", "plot", "options_file")}
+        return keep | {k: f"{v:.17g}" for k, v in self.values.items()}
+
+
+def _check(opts: AppOptions) -> tuple[list, str]:
+    """The study's axes (option, values), checked; and the option its -study_values sweep."""
+    axes, swept = [], opts.string("study_option")
+    for name, own in (("study_mu", "adh_mu"), ("study_sigma", "adh_sigma")):
+        if opts.db.hasName(name):
+            if opts.db.hasName(own):
+                raise InputError(f"-{own}: not with -{name}, which sets it for each case")
+            axes.append((own, opts.sweep(name)))
+    if swept is not None:
+        o = TABLE.get(swept.lstrip("-"))
+        if o is None or o.kind not in ("real", "int") or o.name in _OWN or o.name.startswith("study_"):
+            why = "use -study_mu or -study_sigma" if o is not None and o.name in ("adh_mu", "adh_sigma") else \
+                "expected the name of a real or integer option (without the dash) other than the study's own"
+            raise InputError(f"-study_option: '{swept}': {why}")
+        if opts.db.hasName(o.name):
+            raise InputError(f"-{o.name}: not with -study_option {o.name}, which sets it for each case")
+        if not opts.db.hasName("study_values"):
+            raise InputError("-study_values: required with -study_option: the values it takes")
+        axes.append((o.name, opts.sweep("study_values")))
+    elif opts.db.hasName("study_values"):
+        raise InputError("-study_values: only with -study_option, the option they are values of")
+    if opts.real("adh_lambda") is not None:
+        raise InputError("-adh_lambda: a study traces curves; remove it")
+    if opts.db.hasName("study_ranks") and PETSc.COMM_WORLD.getSize() % opts.int("study_ranks"):
+        raise InputError(f"-study_ranks: {opts.int('study_ranks')} does not divide the "
+                         f"{PETSc.COMM_WORLD.getSize()} ranks of the run")
+    if not axes:
+        raise InputError("-study_mu: a study needs -study_mu, -study_sigma or -study_option")
+    return axes, swept
+
+
+def cases(axes: list) -> list[Case]:
+    """The product of the axes, the first varying slowest."""
+    names = [n for n, _ in axes]
+    return [Case(i, dict(zip(names, vals))) for i, vals in enumerate(itertools.product(*(v for _, v in axes)))]
+
+
+def cost(case: Case) -> float:
+    """A rough relative run time of a case, for ordering: the contact widens with mu (more steps,
+    larger grids) and roughness adds its quadrature to every evaluation."""
+    mu = case.values.get("adh_mu", 1.0)
+    return (1.0 + mu) * (1.5 if case.values.get("adh_sigma", 0.0) > 0 else 1.0)
+
+
+def assign(todo: list[Case], groups: int) -> list[list[Case]]:
+    """Longest first, each to the group with the least work so far (LPT scheduling)."""
+    load, out = [0.0] * groups, [[] for _ in range(groups)]
+    for c in sorted(todo, key=lambda c: (-cost(c), c.index)):
+        g = min(range(groups), key=lambda k: (load[k], k))
+        out[g].append(c)
+        load[g] += cost(c)
+    return out
+
+
+@contextmanager
+def _case(c: Case, study: dict):
+    """The options of case ``c`` as the global database for the block (the study's comes back after)."""
+    with capi.options_of(c.options(study)):
+        yield AppOptions()
+
+
+def _validate(todo: list[Case], study: dict, argv: list[str]) -> None:
+    """Each case's options checked as a single run's would be, before any work (every rank alike)."""
+    for c in todo:
+        try:
+            with _case(c, study) as opts:
+                plan(opts, PETSc.COMM_SELF, argv)
+        except InputError as e:
+            c.error = str(e)
+
+
+def _run(c: Case, study: dict, argv: list[str], comm, compute: str, keep: tuple) -> dict:
+    """One case on ``comm``: its summary and result tree on the group's rank 0 (None elsewhere)."""
+    kinds, stop = KINDS[compute]
+    with _case(c, study) as opts:
+        p = plan(opts, comm, argv)
+        if stop and not opts.db.hasName("cont_F_max"):
+            p = replace(p, settings=replace(p.settings, observable_max=0.0))
+        pmat = preconditioning.create(opts.choice("adh_pmat"), opts.int("adh_pmat_band"))
+        lam0 = opts.real("cont_lambda_start")
+        res, grid = curve(opts, p, pmat, far_approach(p.model) if lam0 is None else lam0, comm, kinds, bool(keep))
+        check_unused()
+        if comm.getRank():
+            return None
+        for e in res["events"]:
+            if not (opts.flag("profiles") or e["kind"] in keep):
+                for part in (e, e.get("landing", {})):
+                    for k in ("r", "H", "P"):
+                        part.pop(k, None)
+        about = head(comm, opts, p.model, grid)
+        summary = curve_summary(res, about)
+        tree = {k: v for k, v in curve_tree(res, about, summary).items() if k in ("model", "grid", "curve", "events",
+                                                                               "summary", "scales")}
+        return {"case": c.index, "values": c.values, "summary": summary, "tree": tree,
+                "incomplete": bool(res["incomplete"])}
+
+
+def _failure(c: Case, why: str) -> dict:
+    return {"case": c.index, "values": c.values, "error": why}
+
+
+class _Progress:
+    """Rank 0's line per finished case: which, how long, elapsed, and the time left by the cases' costs."""
+
+    def __init__(self, comm, todo: list[Case]):
+        self.mpi, self.t0, self.total = comm.tompi4py(), time.perf_counter(), sum(cost(c) for c in todo)
+        self.done, self.count, self.n, self.sent = 0.0, 0, len(todo), []
+
+    def finished(self, c: Case, record: dict, leader: bool) -> None:
+        """A case is done: rank 0 says so, another group's leader tells rank 0."""
+        if self.mpi.Get_rank() == 0:
+            self._say(c.index, _brief(record))
+        elif leader:
+            self.sent.append(self.mpi.isend((c.index, _brief(record)), dest=0, tag=_TAG))
+
+    def poll(self, block: int = 0) -> None:
+        """Rank 0: say what the other groups finished (waiting for ``block`` more of them)."""
+        if self.mpi.Get_rank():
+            return
+        while block > 0 or self.mpi.iprobe(tag=_TAG):
+            index, brief = self.mpi.recv(tag=_TAG)
+            self._say(index, brief)
+            block -= 1
+
+    def close(self) -> None:
+        for req in self.sent:
+            req.wait()
+
+    def _say(self, index: int, record: dict) -> None:
+        self.count += 1
+        self.done += record["cost"]
+        elapsed = time.perf_counter() - self.t0
+        left = elapsed * (self.total - self.done) / self.done if self.done else float("nan")
+        what = record.get("error") or record.get("what", "")
+        print(f"petsc-adhesion: case {index + 1} ({record['label']}) {what}; {self.count}/{self.n} done, "
+              f"{_clock(elapsed)} elapsed, about {_clock(left)} left", file=sys.stderr, flush=True)
+
+
+def _clock(s: float) -> str:
+    return "?" if s != s else f"{s:.0f} s" if s < 100 else f"{s / 60:.1f} min"
+
+
+def _brief(record: dict) -> dict:
+    """What the progress line says about a finished case."""
+    out = {"label": record["label"], "cost": record["cost"]}
+    if "error" in record:
+        return out | {"error": f"failed: {record['error']}"}
+    po = record["summary"].get("pull_off")
+    what = f"done in {record['summary']['wall_time_s']:.1f} s"
+    if po:
+        what += f", pull-off F = {po['F']:.6f}" + (f" +- {po['F_err']:.1e}" if po.get("F_err") else "")
+    return out | {"what": what}
+
+
+def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
+    """The study of the options database: its cases, spread over the ranks; its files from rank 0.
+
+    Returns the exit status: 0, or 3 when a case is missing (each said in one line).
+    ``helping`` (-help): check the study and its cases, then stop.
+    """
+    world = PETSc.COMM_WORLD
+    mpi = world.tompi4py()
+    axes, _ = collective(world, _check, opts)
+    compute = opts.choice("study_compute")
+    if compute == "critical":
+        from .critical import study as critical_study     # fold continuation: only for this kind of study
+        return critical_study(opts, argv, axes)
+    keep = opts.choices("study_profiles")
+    todo = cases(axes)
+    targets = {k: opts.string(k) for k in ("out", "summary", "plot") if opts.string(k)}
+    collective(world, lambda: check_targets(targets, {"options_file": options_files(argv)}) if mpi.Get_rank() == 0
+               else None)
+    given = opts.given()
+    _validate(todo, given, argv)
+    bad = [c for c in todo if c.error]
+    if len(bad) == len(todo):
+        raise InputError(bad[0].error)
+    if mpi.Get_rank() == 0:
+        for c in bad:
+            print(f"petsc-adhesion: case {c.index + 1} ({c.label}) left out: {c.error}", file=sys.stderr, flush=True)
+    if helping:
+        return 0
+    good = [c for c in todo if not c.error]
+    ranks = opts.int("study_ranks")
+    color = mpi.Get_rank() // ranks
+    plan_of = assign(good, mpi.Get_size() // ranks)
+    sub = mpi.Split(color, mpi.Get_rank())
+    comm = PETSc.Comm(sub)
+    progress = _Progress(world, good)
+    mine = []
+    try:
+        for c in plan_of[color]:
+            t0 = time.perf_counter()
+            try:
+                rec = _run(c, given, argv, comm, compute, keep)
+            except (InputError, RuntimeError, FloatingPointError, PETSc.Error) as e:
+                rec = _failure(c, _one_line(e))
+            leader = sub.Get_rank() == 0
+            if leader:
+                rec |= {"label": c.label, "cost": cost(c), "wall_s": time.perf_counter() - t0}
+                mine.append(rec)
+                progress.finished(c, rec, leader)
+            progress.poll()
+        progress.poll(block=progress.n - progress.count)
+    finally:
+        sub.Free()
+    gathered = mpi.gather(mine, root=0)
+    progress.close()
+    status = 0
+    if mpi.Get_rank() == 0:
+        records = sorted((r for part in gathered for r in part), key=lambda r: r["case"])
+        failed = [_failure(c, c.error) for c in bad] + [_failure(Case(r["case"], r["values"]), r["error"])
+                                                        for r in records if "error" in r]
+        done = [r for r in records if "error" not in r]
+        study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": ranks,
+                 "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
+        files = ResultSet(targets)
+        try:
+            write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
+        except Interrupted as e:
+            if not files.committed:
+                raise
+            print(f"petsc-adhesion: {signal.Signals(e.signum).name} came after the results were written",
+                  file=sys.stderr, flush=True)
+        finally:
+            files.discard()
+        status = 3 if failed or any(r["incomplete"] for r in done) else 0
+    return mpi.bcast(status, root=0)
+
+
+def _one_line(e: BaseException) -> str:
+    if isinstance(e, PETSc.Error):
+        from .options import petsc_error
+        return str(petsc_error(e))
+    text = str(e).strip()
+    return text.splitlines()[0] if text else type(e).__name__
