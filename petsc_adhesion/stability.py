@@ -23,7 +23,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 __all__ = ["MUS", "SIGMAS", "EXTRA", "cell", "main"]
 
-MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 7.0, 10.0, 20.0)
+MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 4.5, 7.0, 10.0, 20.0)
 SIGMAS = (0.0, 0.1, 0.2, 0.4, 1.0, 2.0)
 #: (mu, sigma, extra options, what the row shows)
 EXTRA = ((1.0, 0.0, ("-cont_F_max", "50"), "strong compression"),
