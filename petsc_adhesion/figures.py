@@ -230,6 +230,7 @@ def models():
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: The studies of the paper's figures, by name: figNN -> its options file.
 STUDIES = {os.path.basename(f)[:-5]: f for f in sorted(glob.glob(os.path.join(ROOT, "options", "fig[0-9]*.opts")))}
+STUDIES["paper_model"] = os.path.join(ROOT, "options", "paper_model.opts")      # the paper's truncated model
 
 
 def _pm(e: dict | None, key: str) -> str:
@@ -270,7 +271,14 @@ def study(name: str) -> None:
         f.write(f"<!-- made by: ./run figures {name} (the study options/{name}.opts) -->\n{table}\n")
 
 
-OWN = {f.__name__: f for f in (convergence, hermite, coarse, quadrature, models)}
+def validation():
+    """docs/validation.md from the studies (``./run figures`` runs them first; alone, run them before)."""
+    from . import validation as v
+
+    v.write()
+
+
+OWN = {f.__name__: f for f in (convergence, hermite, coarse, quadrature, models, validation)}
 FIGURES = {**{n: (lambda n=n: study(n)) for n in STUDIES}, **OWN}
 
 if __name__ == "__main__":

@@ -24,9 +24,9 @@ import socket
 import stat
 from contextlib import contextmanager
 
-from .errors import InputError
+from .errors import InputError, Interrupted
 
-__all__ = ["check_targets", "ResultSet", "atomic_write", "PLOT_FORMATS", "printable", "JOURNAL"]
+__all__ = ["check_targets", "ResultSet", "written", "atomic_write", "PLOT_FORMATS", "printable", "JOURNAL"]
 
 #: Figure formats by file extension.
 PLOT_FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
@@ -236,3 +236,21 @@ class ResultSet:
             if os.path.exists(tmp):
                 os.remove(tmp)
         self.temps = {}
+
+
+@contextmanager
+def written(targets: dict):
+    """A :class:`ResultSet` for the block, discarded after it.  A signal held during the renames
+    that comes once the set is complete is said in one line, and the run ends as done."""
+    import sys
+
+    files = ResultSet(targets)
+    try:
+        yield files
+    except Interrupted as e:
+        if not files.committed:
+            raise
+        print(f"petsc-adhesion: {signal.Signals(e.signum).name} came after the results were written",
+              file=sys.stderr, flush=True)
+    finally:
+        files.discard()

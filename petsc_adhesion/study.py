@@ -8,7 +8,6 @@ work), and calls the modules named for each step, in that order.
 """
 from __future__ import annotations
 
-import signal
 import sys
 import time
 from dataclasses import dataclass
@@ -21,8 +20,7 @@ from . import __version__, error_estimate, preconditioning, resolution, results
 from .adaptive import Tracer, grid_for
 from .continuation import Continuation, Settings
 from .events import jumps
-from .errors import Interrupted
-from .files import PLOT_FORMATS, ResultSet, check_targets
+from .files import PLOT_FORMATS, check_targets, written
 from .influence import create_influence
 from .model import Model, scales
 from .optionsfile import options_files
@@ -227,21 +225,12 @@ def main(argv: list[str] | None = None) -> int:
     check_unused()
     status = 3 if p.lam is None and res["incomplete"] else 0
     if comm.getRank() == 0:
-        files = ResultSet(p.targets)
         about = head(comm, opts, p.model, grid)
-        try:
+        with written(p.targets) as files:
             if p.lam is None:
                 results.report_curve(write_curve(res, about, files))
             else:
                 write_solve(res, about, files)
                 results.report_solve(res)
-        except Interrupted as e:
-            if not files.committed:
-                raise
-            # held during the renames, the signal came once the set was complete: say so, end as done
-            print(f"petsc-adhesion: {signal.Signals(e.signum).name} came after the results were written",
-                  file=sys.stderr, flush=True)
-        finally:
-            files.discard()
     PETSc.garbage_cleanup()
     return status

@@ -25,7 +25,6 @@ curve's summary) and the figure of ``-study_plot`` are written together.
 from __future__ import annotations
 
 import itertools
-import signal
 import sys
 import time
 from contextlib import contextmanager
@@ -34,8 +33,8 @@ from dataclasses import dataclass, field, replace
 from petsc4py import PETSc
 
 from . import capi, preconditioning
-from .errors import InputError, Interrupted
-from .files import ResultSet, check_targets
+from .errors import InputError
+from .files import check_targets, written
 from .options import TABLE, AppOptions, check_unused, collective
 from .optionsfile import options_files
 from .output import curve_summary, curve_tree, write_study
@@ -288,16 +287,8 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
         done = [r for r in records if "error" not in r]
         study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": ranks,
                  "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
-        files = ResultSet(targets)
-        try:
+        with written(targets) as files:
             write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
-        except Interrupted as e:
-            if not files.committed:
-                raise
-            print(f"petsc-adhesion: {signal.Signals(e.signum).name} came after the results were written",
-                  file=sys.stderr, flush=True)
-        finally:
-            files.discard()
         status = 3 if failed or any(r["incomplete"] for r in done) else 0
     return mpi.bcast(status, root=0)
 
