@@ -256,26 +256,42 @@ class Tracer:
             folds = sum(g.cont.folds for g in self.segments)
             s = replace(s, ds=before.cont.ds, max_steps=max(1, s.max_steps - steps),
                         max_folds=s.max_folds - folds)
-        cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments) if before else 0)
+        try:                    # a solver option refused: the problem's shell holds a cycle that gc cannot free
+            cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments) if before else 0)
+        except BaseException:
+            problem.destroy()
+            raise
         return Segment(kind, design, problem, cont, EventFinder(cont, self.events, *([self.tol] if self.tol else [])))
 
-    def run(self, lam0: float, started=None) -> list[Segment]:
-        """The curve from lam0, starting from the rigid state (eq. 27); ``started()`` after the first point."""
-        seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)
+    def run(self, lam0: float, started=None, pause=None) -> list[Segment]:
+        """The curve from lam0, starting from the rigid state (eq. 27); ``started()`` after the first point.
+
+        A tracer whose segments were restored from a checkpoint (:mod:`petsc_adhesion.checkpoint`)
+        goes on from its last segment's state instead.  ``pause(tracer)``: before every step
+        attempt (:meth:`~petsc_adhesion.continuation.Continuation.run`).
+        """
         self.sharp = self.nodes is None and sharp(self.model)
-        self.segments.append(seg)
-        x = seg.problem.rigid(lam0, seg.problem.create_vec())
-        try:
-            start = seg.cont.start(x, lam0)
-        except RuntimeError as e:
-            raise RuntimeError(f"{e}; give -cont_lambda_start further apart") from None
-        finally:
-            x.destroy()
+        start = None
+        if not self.segments:
+            seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)
+            self.segments.append(seg)
+            x = seg.problem.rigid(lam0, seg.problem.create_vec())
+            try:
+                start = seg.cont.start(x, lam0)
+            except RuntimeError as e:
+                raise RuntimeError(f"{e}; give -cont_lambda_start further apart") from None
+            finally:
+                x.destroy()
+        seg = self.segments[-1]
         if started:
             started()
+        hook = (lambda: pause(self)) if pause else None
         while True:
             regrid = _Regrid(self, seg) if seg.kind != "fixed" else None
-            seg.cont.run(start, on_step=seg.finder, until=regrid)
+            if start is None:
+                seg.cont.resume(on_step=seg.finder, until=regrid, pause=hook)
+            else:
+                seg.cont.run(start, on_step=seg.finder, until=regrid, pause=hook)
             if regrid is None or regrid.next is None:
                 return self.segments
             seg, start = regrid.next

@@ -18,7 +18,7 @@ from .errors import Interrupted
 from .files import printable
 from .optionsfile import environment_error, file_error, options_files, stray_word
 
-__all__ = ["main", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
+__all__ = ["main", "input_error", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
 
 EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INCOMPLETE = 0, 1, 2, 3
 
@@ -60,7 +60,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return _main(argv)
     except Interrupted as e:
-        _say(f"interrupted by {signal.Signals(e.signum).name}; nothing written")
+        _say(f"interrupted by {signal.Signals(e.signum).name}; nothing written"
+             + (f"; go on with -cont_restart {printable(e.restart)}" if e.restart else ""))
         return 128 + e.signum
     finally:
         for s, handler in old.items():
@@ -78,21 +79,25 @@ def _undecodable(argv: list[str]) -> str | None:
     return None
 
 
-def _main(argv: list[str]) -> int:
+def input_error(argv: list[str]) -> str | None:
+    """What is wrong with ``argv`` (or the options files and environment it reads) that must be said
+    before PETSc reads it, in one line; None when nothing is."""
     bad = _undecodable(argv)
     word = stray_word(argv[1:])
     if word is not None and not bad:
         bad = f"'{printable(word)}' is neither an option (they start with '-') nor an option's value"
     if bad:
-        _say(bad)
-        return EXIT_INPUT
+        return bad
     # PETSc aborts with a page of text on a bad options file: say it in one line first
     for path in options_files(argv):
         bad = file_error(path)
         if bad:
-            _say(bad)
-            return EXIT_INPUT
-    bad = environment_error(argv)
+            return bad
+    return environment_error(argv)
+
+
+def _main(argv: list[str]) -> int:
+    bad = input_error(argv)
     if bad:
         _say(bad)
         return EXIT_INPUT

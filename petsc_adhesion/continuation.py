@@ -147,6 +147,7 @@ class Bordered:
         # the hyperplane Q of eq. (24): through (x0, p0), normal (xdot, pdot), at distance ds
         self.x0, self.p0, self.xdot, self.pdot, self.ds = None, 0.0, None, 1.0, 0.0
         self.p = 0.0
+        self.border = (None, 1.0)       # the (xdot, pdot) of the bottom row, as last set
 
     # -- X = (x, p) --------------------------------------------------------------
     def split(self, X: PETSc.Vec):
@@ -167,6 +168,7 @@ class Bordered:
 
     def set_border(self, xdot: np.ndarray, pdot: float) -> None:
         """Bottom row (W xdot)^T, pdot of the bordered matrix."""
+        self.border = (xdot, pdot)
         full = self._mpi.allgather(self.pb.weights * xdot)
         if self.last:
             self.row.getDenseArray()[:] = np.concatenate(full)
@@ -201,6 +203,7 @@ class Bordered:
             row = self.row.getDenseArray()[0] if self.last else None
             corner = float(self.corner.getDenseArray()[0, 0]) if self.last else 0.0
             pb.fill_pmat(self.pmat, Border(self.gp, row, corner))
+            self.reuse.filled(self.x.getArray(readonly=True), self.p, *self.border)
         self.K.assemble()
 
     def precheck(self, X, Y, *args) -> bool:
@@ -415,15 +418,28 @@ class Continuation:
             return "max_folds", s.max_folds
         return None
 
-    def run(self, start: Point, on_step=None, until=None) -> list[Point]:
+    def run(self, start: Point, on_step=None, until=None, pause=None) -> list[Point]:
         """Trace from ``start`` until a stop criterion; ``on_step(a, b)`` sees every accepted step,
-        and ``until(a, b)`` True ends the run there (after on_step)."""
+        and ``until(a, b)`` True ends the run there (after on_step).
+
+        ``pause()`` is called before every step attempt, where the state is whole: the
+        points, ``ds``, the counters and what the solvers keep (the points their
+        preconditioners were built at, :class:`~petsc_adhesion.solver.PCReuse`).  A
+        checkpoint saves it there, and :meth:`resume` goes on from it alike.
+        """
+        self.points.append(start)
+        self.ds = self.set.ds
+        self.monitor(start)
+        return self.resume(on_step, until, pause)
+
+    def resume(self, on_step=None, until=None, pause=None) -> list[Point]:
+        """Go on from the last point with the step ``ds``: after :meth:`run`'s start, or from a state
+        restored as :meth:`run`'s ``pause`` saw it."""
         s = self.set
-        a = start
-        self.points.append(a)
-        ds = s.ds
-        self.monitor(a)
+        a, ds = self.points[-1], self.ds
         while True:
+            if pause:
+                pause()
             b = self.step(a, ds)
             if b is None:
                 self.newton.reuse.expire()

@@ -14,3 +14,4 @@ class Interrupted(BaseException):
     def __init__(self, signum: int):
         super().__init__(signum)
         self.signum = signum
+        self.restart = None          # the checkpoint to go on from (-cont_restart), once one is saved

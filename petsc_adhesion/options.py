@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-from . import capi, grid, preconditioning
+from . import capi, checkpoint, grid, preconditioning, progress
 from .errors import InputError
 from .files import printable
 from .adaptive import RMAX
@@ -29,6 +29,7 @@ from .roughness import DISTRIBUTIONS, HeightFileError, Measured, Weibull, read_h
 from .solver import PC_REUSE_ITS
 
 __all__ = ["InputError", "Option", "TABLE", "AppOptions", "check_unused", "petsc_error", "print_help",
+           "HELP_GROUPS", "help_groups", "shown_default",
            "read_model", "read_grid", "read_settings", "read_physical", "read_guess", "check_memory",
            "check_consistency", "check_petsc_values", "collective", "smallest_domain", "petsc_names",
            "F_MAX", "SOLVER_PREFIXES", "PETSC_GLOBAL"]
@@ -141,6 +142,13 @@ TABLE = {o.name: o for o in [
     Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
     Option("cont_event_tol", "real", EVENT_TOL, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
     Option("cont_monitor", "flag", _S.monitor, "one line a continuation step"),
+    Option("cont_checkpoint", "string", None, "save the curve's state into this file as it goes, for "
+           "-cont_restart (default: .NAME.checkpoint beside -out, else -summary or -plot; the file restarted "
+           "from; none: no checkpoint); a finished run removes it"),
+    Option("cont_checkpoint_interval", "real", checkpoint.INTERVAL, "least seconds between two checkpoint saves "
+           "(0: before every step)", 0.0, 1e6),
+    Option("cont_restart", "string", None, "go on from this checkpoint of an interrupted run with the same "
+           "options (output and printing options aside): the same steps, events and error bars"),
     Option("cont_error_estimate", "flag", True, "give every event its best value and error bar: located again "
            "on its grid's coarser (or finer) nested levels, Richardson-extrapolated"),
     Option("target_error", "real", None, "refine each event's levels until its error bars (lambda and F) are "
@@ -168,6 +176,10 @@ TABLE = {o.name: o for o in [
     Option("summary", "string", None, "JSON summary file"),
     Option("profiles", "flag", False, "store H(r) and P(r) at every event"),
     Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
+    Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "
+           "events, time elapsed and an estimate of the time left (default: when stderr is a terminal)"),
+    Option("progress_interval", "real", progress.INTERVAL, "least seconds between two progress lines", 0.0, 1e6,
+           lo_open=True),
 ]}
 
 
@@ -424,7 +436,8 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
     ignored = []
     if fixed:
         ignored += [(n, "applies to a curve, not with -adh_lambda") for n in
-                    _given(opts, [n for n in TABLE if n.startswith("cont_")] + ["profiles", "plot", "target_error"])]
+                    _given(opts, [n for n in TABLE if n.startswith(("cont_", "progress"))] + ["profiles", "plot",
+                                                                                     "target_error"])]
     elif not opts.flag("cont_error_estimate"):
         ignored += [(n, "refines error bars, which -cont_error_estimate false turns off") for n in
                     _given(opts, ["target_error"])]
@@ -631,12 +644,40 @@ def check_petsc_values(db: PETSc.Options | None = None) -> None:
             AppOptions(db)._number(o, db.getString(prefix + name, ""), _strict_float if kind == "real" else _strict_int)
 
 
+#: The groups of -help and docs/usage.md: (title, the name prefixes of its options); the last takes the rest.
+HELP_GROUPS = (("model (eq. 9-14) and its solver", ("adh_",)), ("physical units", ("phys_",)), ("grid", ("grid_",)),
+               ("continuation, events and error bars", ("cont_", "target_")), ("studies of many cases", ("study_",)),
+               ("output and progress", ()))
+
+
+def help_groups() -> list[tuple[str, list[Option]]]:
+    """The options of :data:`TABLE` in their :data:`HELP_GROUPS`, each in table order; empty groups left out."""
+    def group(name: str) -> int:
+        return next((i for i, (_, prefixes) in enumerate(HELP_GROUPS) if name.startswith(prefixes)),
+                    len(HELP_GROUPS) - 1)
+    return [(title, members) for i, (title, _) in enumerate(HELP_GROUPS)
+            if (members := [o for o in TABLE.values() if group(o.name) == i])]
+
+
+def shown_default(o: Option) -> str:
+    """The default of ``o`` as -help and docs/usage.md show it ("" when the option has none: the help says)."""
+    if o.default in (None, ()):
+        return ""
+    if isinstance(o.default, bool):
+        return "true" if o.default else "false"
+    if isinstance(o.default, tuple):
+        return ",".join(map(str, o.default))
+    return str(o.default)
+
+
 def print_help(out) -> None:
-    """Write the application options and the solvers' prefixes, as PETSc's -help writes its own."""
+    """Write the application options in their groups and the solvers' prefixes, as PETSc's -help writes its own."""
     out.write("petsc-adhesion application options (PETSc's follow):\n")
-    for o in TABLE.values():
-        default = "" if o.default in (None, ()) else f" <{o.default}>"
-        out.write(f"  -{o.name}{default}: {o.help}; {o.allowed()}\n")
+    for title, members in help_groups():
+        out.write(f" {title}:\n")
+        for o in members:
+            default = f" <{shown_default(o)}>" if shown_default(o) else ""
+            out.write(f"  -{o.name}{default}: {o.help}; {o.allowed()}\n")
     out.write("Solvers, each tuned by PETSc's options under its own prefix (-{prefix}snes_*, -{prefix}ksp_*, "
               "-{prefix}pc_*):\n")
     for prefix, what in SOLVER_PREFIXES:

@@ -205,14 +205,16 @@ def write_curve(res: dict, head: dict, files: ResultSet) -> dict:
     return summ
 
 
-def write_solve(res: dict, head: dict, files: ResultSet) -> None:
-    """The files of a fixed-approach solve, committed together."""
+def write_solve(res: dict, head: dict, files: ResultSet) -> dict:
+    """The files of a fixed-approach solve, committed together; returns the summary."""
     brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
+    summ = {**_common(head), **brief}
     if "out" in files.targets:
         write_h5(files.temp("out"), {**head, "kind": "solve", "solution": {"H": res["H"], "P": res["P"], **brief}})
     if "summary" in files.targets:
-        write_json(files.temp("summary"), {**_common(head), **brief})
+        write_json(files.temp("summary"), summ)
     files.commit()
+    return summ
 
 
 def study_table(done: list[dict], axes: list[str]) -> dict:

@@ -102,6 +102,10 @@ class Dense:
                 a[layout.nloc + j, :n] = b.row
                 a[layout.nloc + j, n] = b.corner
         P.assemble()
+        if P.getComm().getSize() > 1:
+            # block Jacobi factors the diagonal block, a Mat of its own over P's memory whose state a fill
+            # leaves alone: without this it would keep the factorization of the first fill for ever
+            P.getDiagonalBlock().stateIncrease()
 
     setup_pc = staticmethod(_lu_or_block_jacobi)
 

@@ -85,20 +85,32 @@ class PCReuse:
     left alone keeps its factorization across Newton iterations and
     continuation steps.  Refill when the last Krylov solve of ``ksp`` failed or
     took more than ``its`` iterations, or after :meth:`expire`.
+
+    ``at`` is the point the matrix was last filled at, as its owner recorded it
+    (:meth:`filled`): a checkpoint saves it, so that a restarted run fills the
+    same matrix and continues with the same preconditioner.
     """
 
     def __init__(self, its: int = PC_REUSE_ITS):
-        self.its, self.stale = its, True
+        self.its, self.stale, self.at = its, True, None
 
     def expire(self) -> None:
         """Refill at the next linearization."""
         self.stale = True
 
+    def pending(self, ksp: PETSc.KSP) -> bool:
+        """Whether the next linearization will refill (asking nothing)."""
+        return self.stale or ksp.getConvergedReason() < 0 or ksp.getIterationNumber() > self.its
+
     def __call__(self, ksp: PETSc.KSP) -> bool:
         """Whether to refill now (and, by asking, the matrix counts as fresh)."""
-        refill = self.stale or ksp.getConvergedReason() < 0 or ksp.getIterationNumber() > self.its
+        refill = self.pending(ksp)
         self.stale = False
         return refill
+
+    def filled(self, *at) -> None:
+        """Record the point the matrix was just filled at (arrays copied)."""
+        self.at = tuple(np.array(v) if isinstance(v, np.ndarray) else v for v in at)
 
 
 def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse, work: PETSc.Vec) -> bool:
@@ -192,6 +204,7 @@ class Newton:
         self.pb.linearize(x, self.p)
         if refill and self.pmat is not None:
             self.pb.fill_pmat(self.pmat)
+            self.reuse.filled(x.getArray(readonly=True), self.p)
 
     def _precheck(self, x, y, *args) -> bool:
         return guard(self.pb, x.getArray(readonly=True), y)

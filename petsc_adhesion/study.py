@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import time
+from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,9 +19,10 @@ from petsc4py import PETSc
 
 from . import __version__, error_estimate, preconditioning, resolution, results
 from .adaptive import Tracer, grid_for
+from .checkpoint import open_checkpoint
 from .continuation import Continuation, Settings
 from .events import jumps
-from .files import PLOT_FORMATS, check_targets, written
+from .files import PLOT_FORMATS, check_targets, printable, written
 from .influence import create_influence
 from .model import Model, scales
 from .optionsfile import options_files
@@ -30,6 +32,7 @@ from .options import (TABLE, AppOptions, InputError, check_consistency, check_me
 from .output import write_curve, write_solve
 from .pressure import pressure_law
 from .problem import Problem, far_approach
+from .progress import Progress, curve_end, curve_status
 from .solver import Newton
 
 __all__ = ["Plan", "plan", "discretize", "trace", "curve", "fixed_solve", "program", "head", "main"]
@@ -96,7 +99,7 @@ def discretize(model, r, pmat=None) -> Problem:
 
 def trace(model, r, pmat, settings, lam0: float, at_lambda=(), tol: float | None = None,
           profiles: bool = False, started=None, errors: bool = True, target_error: float | None = None,
-          kinds=None, comm=None) -> dict:
+          kinds=None, comm=None, checkpoint=None, progress=None) -> dict:
     """The load-approach curve from lam0 on grid ``r`` (None: grids following the contact edge), with
     its events, landings, pull-off, error bars (``errors``: down to ``target_error`` when given),
     resolution check and warnings.
@@ -104,22 +107,56 @@ def trace(model, r, pmat, settings, lam0: float, at_lambda=(), tol: float | None
     ``started()`` is called once the first point and its tangent are computed (the
     solvers then have read all their options).  ``kinds``: the event kinds to report
     (None: all); the others are left out of the result, unestimated (their levels' traces saved).
-    ``comm``: the communicator of the run (PETSc.COMM_WORLD by default).
+    ``comm``: the communicator of the run (PETSc.COMM_WORLD by default).  ``checkpoint``: a
+    :class:`~petsc_adhesion.checkpoint.Checkpoint` that saves the run as it goes, and restores
+    the state it holds first; ``progress``: a :class:`~petsc_adhesion.progress.Progress` for its lines.
     """
-    t0 = time.perf_counter()
+    t0 = t1 = time.perf_counter()
     comm = comm or PETSc.COMM_WORLD
     tracer = Tracer(model, settings, results.curve_events(at_lambda), tol, nodes=r, pmat=pmat, rmax=model.rmax,
                     comm=comm)
-    segments = tracer.run(lam0, started)
-    jumps([seg.finder for seg in segments], Problem.stable)
     kept = (lambda label: True) if kinds is None else (lambda label: label in kinds or label == "lambda")
-    wall = time.perf_counter() - t0
+    restored = checkpoint.restore(tracer) if checkpoint is not None else None
+    phase, spent = restored or ("trace", {"trace": 0.0, "errors": 0.0})
+    end, bars = curve_end(model, settings), []
+    if restored and progress is not None:
+        progress.line(f"going on from the checkpoint {printable(checkpoint.restart)} at lambda "
+                      f"{tracer.segments[-1].cont.points[-1].p:.6g}"
+                      + (", to its error bars" if phase == "errors" else ""))
+
+    def pause(tr, stage: str = "trace") -> None:
+        """Where the state is whole: a checkpoint may be saved, progress said."""
+        walls = {**spent, stage: spent[stage] + time.perf_counter() - (t0 if stage == "trace" else t1)}
+        if checkpoint is not None:
+            checkpoint.pause(tr, stage, walls)
+        if progress is not None and progress.due():
+            done = sum(f.estimate is not None for _, f in bars)
+            progress.update(*(curve_status(tr, lam0, end) if stage == "trace" else
+                              (done / len(bars), f"error bars: {done} of {len(bars)} events done")))
+
+    if phase == "trace":
+        try:                    # a solver option refused at the start: the run in one process may go on
+            segments = tracer.run(lam0, started, pause)
+        except BaseException:
+            tracer.destroy()
+            raise
+        jumps([seg.finder for seg in segments], Problem.stable)
+        spent["trace"] += time.perf_counter() - t0
+    else:
+        segments = tracer.segments
+        if started:
+            started()
+    wall = spent["trace"]
     if errors:
         t1 = time.perf_counter()
-        for seg in segments:
-            for found in filter(lambda f: kept(f.label), seg.finder.found):
+        bars = [(seg, f) for seg in segments for f in seg.finder.found if kept(f.label)]
+        if progress is not None:
+            progress.reset()
+        for seg, found in bars:
+            pause(tracer, "errors")
+            if found.estimate is None:
                 found.estimate = error_estimate.event_errors(tracer, seg, found, target_error)
-        errors_wall = time.perf_counter() - t1
+        errors_wall = spent["errors"] + time.perf_counter() - t1
     res = results.curve(segments, profiles)
     mpi = comm.tompi4py()
     states = res.pop("states")
@@ -138,12 +175,15 @@ def trace(model, r, pmat, settings, lam0: float, at_lambda=(), tol: float | None
     return res
 
 
-def curve(opts: AppOptions, p: Plan, pmat, lam0: float, comm=None, kinds=None, profiles: bool = False) -> tuple:
+def curve(opts: AppOptions, p: Plan, pmat, lam0: float, comm=None, kinds=None, profiles: bool = False,
+          checkpoint=None, progress=None) -> tuple:
     """The curve of plan ``p`` from lam0 as its options ask (:func:`trace`); ``kinds`` and ``profiles``
-    as a study's case asks.  Returns the result and its grids."""
+    as a study's case asks; ``checkpoint`` and ``progress`` as :func:`trace` takes them.  Returns the
+    result and its grids."""
     res = trace(p.model, p.r, pmat, p.settings, lam0, opts.reals("cont_at_lambda"), opts.real("cont_event_tol"),
                 profiles or opts.flag("profiles"), started=check_unused, errors=opts.flag("cont_error_estimate"),
-                target_error=opts.real("target_error"), kinds=kinds, comm=comm)
+                target_error=opts.real("target_error"), kinds=kinds, comm=comm, checkpoint=checkpoint,
+                progress=progress)
     return res, {"r": res["grid"], **res["grids"]}
 
 
@@ -181,10 +221,12 @@ def head(comm, opts: AppOptions, model, grid: dict) -> dict:
             "grid": grid, **({"scales": scales(*phys)} if phys else {})}
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, keep: dict | None = None) -> int:
     """The program: one study from the options database (initialised from ``argv``); its exit status.
 
-    Errors raise (:mod:`petsc_adhesion.cli` turns them into one line).
+    Errors raise (:mod:`petsc_adhesion.cli` turns them into one line).  ``keep`` (the Python API,
+    :mod:`petsc_adhesion.api`): a dict that receives, on rank 0, the run's ``result``, ``head`` and
+    ``summary`` instead of the console report; studies of many cases are the command line's.
     """
     comm = PETSc.COMM_WORLD
     opts = AppOptions()
@@ -195,6 +237,12 @@ def main(argv: list[str] | None = None) -> int:
     if collective(comm, _is_sweep, opts):
         from . import sweep                      # a sweep runs cases of this module's kind
 
+        if keep is not None:
+            raise InputError("-study_mu, -study_sigma, -study_option: a study of many cases runs from the "
+                             "command line (petsc-adhesion -options_file FILE); the Python API traces one curve")
+        own = [n for n in ("cont_checkpoint", "cont_checkpoint_interval", "cont_restart") if opts.db.hasName(n)]
+        if own:
+            raise InputError(f"-{own[0]}: applies to a single curve, not to a study of many cases; remove it")
         return sweep.main(opts, argv, helping)
     stray = [n for n in TABLE if n.startswith("study_") and opts.db.hasName(n)]
     if stray and not helping:
@@ -202,35 +250,50 @@ def main(argv: list[str] | None = None) -> int:
                          f"-study_option); remove it")
     p = collective(comm, plan, opts, comm, argv)
     pmat = preconditioning.create(opts.choice("adh_pmat"), opts.int("adh_pmat_band"))
+    ck = None
     if p.lam is None:
         lam0 = opts.real("cont_lambda_start")
         lam0 = far_approach(p.model) if lam0 is None else lam0
+        ck = open_checkpoint(opts, p.targets, p.inputs, comm)
         if helping:                                  # the solvers print their options
             problem = discretize(p.model, p.r if p.r is not None else grid_for(p.model, 0.0).nodes(), pmat)
             Continuation(problem, p.settings).destroy()
             problem.destroy()
             return 0
-        res, grid = curve(opts, p, pmat, lam0)
+        shown = opts.flag("progress")
+        progress = Progress(comm, sys.stderr.isatty() if shown is None else shown, opts.real("progress_interval"))
+        with ck.on_interrupt():
+            res, grid = curve(opts, p, pmat, lam0, checkpoint=ck, progress=progress)
     else:
         r = p.r if p.r is not None else grid_for(p.model, rigid_edge(p.lam)).nodes()
-        problem = discretize(p.model, r, pmat)
-        newton = Newton(problem, "", pc_reuse_its=opts.int("adh_pc_reuse_its"))
-        if helping:
-            return 0
-        H = collective(comm, read_guess, problem, p.lam, opts.string("adh_guess"))
-        res = fixed_solve(problem, newton, p.lam, H)
-        newton.destroy()
-        problem.destroy()
+        problem, newton = discretize(p.model, r, pmat), None
+        try:                    # on failure too: the shell's context holds a cycle that gc cannot free
+            newton = Newton(problem, "", pc_reuse_its=opts.int("adh_pc_reuse_its"))
+            if helping:
+                return 0
+            H = collective(comm, read_guess, problem, p.lam, opts.string("adh_guess"))
+            res = fixed_solve(problem, newton, p.lam, H)
+        finally:
+            if newton is not None:
+                newton.destroy()
+            problem.destroy()
         grid = {"r": r}
     check_unused()
     status = 3 if p.lam is None and res["incomplete"] else 0
     if comm.getRank() == 0:
         about = head(comm, opts, p.model, grid)
-        with written(p.targets) as files:
+        with ck.on_interrupt() if ck else nullcontext(), written(p.targets) as files:
             if p.lam is None:
-                results.report_curve(write_curve(res, about, files))
+                summary = write_curve(res, about, files)
+                if keep is None:
+                    results.report_curve(summary)
             else:
-                write_solve(res, about, files)
-                results.report_solve(res)
+                summary = write_solve(res, about, files)
+                if keep is None:
+                    results.report_solve(res)
+        if keep is not None:
+            keep |= {"result": res, "head": about, "summary": summary}
+    if ck:
+        ck.remove()
     PETSc.garbage_cleanup()
     return status

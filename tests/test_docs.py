@@ -39,3 +39,18 @@ def test_every_options_file_sets_up(tmp_path):
     for name in sorted(os.listdir(os.path.join(ROOT, "options"))):
         proc = run_cli("-options_file", os.path.join(ROOT, "options", name), "-help", cwd=tmp_path)
         assert proc.returncode == 0, (name, proc.stderr)
+
+
+def test_usage_md_is_the_option_table():
+    """docs/usage.md is what its command makes from the option table now, and lists every option
+    once, in the group -help shows it in."""
+    from petsc_adhesion import usage
+    from petsc_adhesion.options import TABLE, help_groups
+
+    text = open(os.path.join(ROOT, "docs", "usage.md")).read()
+    assert text == usage.markdown(), f"docs/usage.md is stale: regenerate it with {usage.COMMAND}"
+    grouped = [o.name for _, members in help_groups() for o in members]
+    assert sorted(grouped) == sorted(TABLE)
+    for title, members in help_groups():
+        section = text.split(f"## {title[0].upper()}{title[1:]}\n")[1].split("\n## ")[0]
+        assert re.findall(r"^\| `-(\w+)` \|", section, re.M) == [o.name for o in members]
