@@ -261,9 +261,8 @@ CUSP_A = (1.0, 0.1, 0.01, 1e-4)
 def cusp_trace(a: float, **kw) -> Trace:
     """From x0 = 3 X to p = -p(x0), X = sqrt(|a|/3), with steps of at most X/2.
 
-    The steps scale with the fold pair: a step much longer than the pair crosses
-    both folds without seeing either (pdot has the same sign at both ends), e.g.
-    a = 0.01 with the default ds_max = 0.5 finds no fold.
+    The steps scale with the fold pair, so that both folds show as sign changes of
+    pdot; :func:`test_fold_pair_inside_one_step` takes the default steps instead.
     """
     X = math.sqrt(abs(a) / 3)
     pb = Cusp(a)
@@ -296,6 +295,31 @@ def test_cusp_two_folds_with_labels_values_and_landings(cusp):
             # landing located in p to TOL; |dp/dx| = 3a there; measured <= 9.3e-12
             assert abs(land.x[0] + 2 * xe) <= 1e-9
             assert 3 * land.x[0] ** 2 - a > 0          # on a stable branch
+
+
+@pytest.mark.parametrize("a", [0.01, 1e-4, 1e-6])
+def test_fold_pair_inside_one_step(a):
+    """With the default steps (up to 0.5) from x = 2 the whole pair lies inside one step: pdot is
+    positive at every computed point.  The dip of pdot toward zero is walked again and both folds
+    and their landings are located as precisely as with steps that resolve them (pair width
+    4 (a/3)^(3/2) in p: 7.7e-10 at a = 1e-6)."""
+    pb = Cusp(a)
+    tr = trace(pb, 2.0, pb.on_curve(2.0), Settings(p_max=8.0), [Fold()], stable=pb.stable)
+    assert all(pt.pdot > 0 for pt in tr.points) and tr.folds == 0
+    assert tr.labels() == ["fold_max", "fold_min"]
+    X, P = math.sqrt(a / 3), 2 * (a / 3) ** 1.5
+    for f, (xe, pe) in zip(tr.found, [(X, P), (-X, -P)]):
+        # measured: p within 8e-15, x within 1.2e-11, landings within 1e-10 (a = 0.01 .. 1e-6)
+        assert abs(f.point.p - pe) <= TOL and abs(f.point.x[0] - xe) <= 1e-9
+        assert f.landing is not None and f.landing.p == pytest.approx(pe, abs=TOL)
+        assert abs(f.landing.x[0] + 2 * xe) <= 1e-9 and pb.stable(f.landing)
+
+
+def test_no_pair_where_pdot_only_dips():
+    """a < 0: pdot dips toward zero at x = 0 (to |a|) but keeps its sign: the walk finds no fold."""
+    pb = Cusp(-1e-4)
+    tr = trace(pb, 2.0, pb.on_curve(2.0), Settings(p_max=8.0), [Fold()], stable=pb.stable)
+    assert min(pt.pdot for pt in tr.points) < 0.1 and tr.found == [] and tr.stop[0] == "p_max"
 
 
 def test_cusp_folds_merge_as_a_goes_to_zero(cusp):
