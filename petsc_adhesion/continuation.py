@@ -48,7 +48,7 @@ first point), the arclength corrector ``arc_`` (also every tangent along it).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from petsc4py import PETSc
@@ -78,6 +78,10 @@ class Point:
     newton_its: int = 0         # Newton iterations of the corrector
     ksp_its: int = 0
     corrector: str = "start"    # "natural" | "arclength" | "start" | "event"
+
+    def reversed(self) -> Point:
+        """The same point with the curve's orientation reversed (tangent and rates negated)."""
+        return replace(self, xdot=-self.xdot, pdot=-self.pdot, rates={k: -v for k, v in self.rates.items()})
 
 
 @dataclass

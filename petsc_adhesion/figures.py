@@ -231,6 +231,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: The studies of the paper's figures, by name: figNN -> its options file.
 STUDIES = {os.path.basename(f)[:-5]: f for f in sorted(glob.glob(os.path.join(ROOT, "options", "fig[0-9]*.opts")))}
 STUDIES["paper_model"] = os.path.join(ROOT, "options", "paper_model.opts")      # the paper's truncated model
+STUDIES["critical_roughness"] = os.path.join(ROOT, "options", "critical_roughness.opts")
 
 
 def _pm(e: dict | None, key: str) -> str:
@@ -242,7 +243,7 @@ def _pm(e: dict | None, key: str) -> str:
 
 def study(name: str) -> None:
     """Run the study options/NAME.opts as ``./run study`` does (from the repository, NP ranks) and
-    write NAME.md, the table of each case's events with their error bars."""
+    write NAME.md, the table of each case's events (or cusps) with their error bars."""
     np_ = os.environ.get("NP")
     launcher = ["mpiexec", "-n", np_] if np_ else []
     cmd = launcher + [sys.executable, "-m", "petsc_adhesion", "-options_file", os.path.relpath(STUDIES[name], ROOT)]
@@ -252,6 +253,12 @@ def study(name: str) -> None:
         raise RuntimeError(f"{' '.join(cmd)}: {proc.stderr.strip().splitlines()[-1]}")
     with open(os.path.join(OUT, f"{name}.json")) as f:
         s = json.load(f)
+    table = _critical_table(s) if s["kind"] == "critical" else _events_table(s)
+    with open(os.path.join(OUT, f"{name}.md"), "w") as f:
+        f.write(f"<!-- made by: ./run figures {name} (the study options/{name}.opts) -->\n{table}\n")
+
+
+def _events_table(s: dict) -> str:
     rows = []
     for c in s["cases"]:
         # the primary turning points: snap-on at the largest lambda, snap-off at the smallest
@@ -265,10 +272,22 @@ def study(name: str) -> None:
                      "-" if s["study"]["compute"] == "pull_off" else str(len(c["folds"])),
                      f"{c['wall_time_s']:.1f}" + ("" if c["complete"] else " (incomplete)")])
     rows += [[f"case {f['case'] + 1} failed: {f['error']}"] + ["-"] * 7 for f in s["failed"]]
-    table = _table(["case", "pull-off F", "pull-off lambda", "snap-on lambda", "snap-off lambda",
-                    "equilibrium lambda", "turning points", "time (s)"], rows)
-    with open(os.path.join(OUT, f"{name}.md"), "w") as f:
-        f.write(f"<!-- made by: ./run figures {name} (the study options/{name}.opts) -->\n{table}\n")
+    return _table(["case", "pull-off F", "pull-off lambda", "snap-on lambda", "snap-off lambda",
+                   "equilibrium lambda", "turning points", "time (s)"], rows)
+
+
+def _critical_table(s: dict) -> str:
+    """The cusps of a critical study: sigma_c(mu), then mu_c(sigma), each with the cusp's lambda and F."""
+    rows = []
+    for name, fixed, k in (("critical_roughness", "mu", "sigma_c"), ("critical_mu", "sigma", "mu_c")):
+        for c in s[name]:
+            rows.append([f"{fixed} = {c[fixed]:g}", f"{k} = {c[k]:.7f} +- {c[k + '_err']:.1e}",
+                         _pm(c, "lambda_c"), _pm(c, "F_c"), " ".join(f"{v:.7f}" for v in c[k + "_grid"]),
+                         "/".join(str(n) for n in c["n_nodes"]), f"{c['wall_time_s']:.1f}"
+                         + (f" ({c['warning']})" if c.get("warning") else "")])
+    rows += [[f"case {f['case'] + 1} failed: {f['error']}"] + ["-"] * 6 for f in s["failed"]]
+    return _table(["case", "critical value", "lambda at the cusp", "F at the cusp", "on each grid level",
+                   "nodes", "time (s)"], rows)
 
 
 def validation():

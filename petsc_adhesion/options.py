@@ -169,7 +169,8 @@ TABLE = {o.name: o for o in [
            "many ranks, the longest first", 1, 10**6),
     Option("study_plot", "choice", "curves", "study: what -plot draws: load-approach curves; one panel per case "
            "about its turning points; the profiles of -study_profiles; pull-off against mu; reduction of the "
-           "pull-off against sigma; critical roughness",
+           "pull-off against sigma; the boundary of hysteresis (sigma_c, mu_c: the only one, and the default, with "
+           "-study_compute critical)",
            choices=("curves", "folds", "profiles", "pull_off", "reduction", "critical")),
     # output
     Option("out", "string", None, "HDF5 result file"),

@@ -15,7 +15,7 @@ import numpy as np
 from .files import PLOT_FORMATS, ResultSet
 
 __all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve", "write_solve", "study_table",
-           "write_study"]
+           "write_study", "CRITICAL_KEYS", "critical_table", "write_critical"]
 
 
 # Units of the dimensionless results (docs/model.md)
@@ -69,6 +69,15 @@ DESCRIBE = {
     "table": (f"{_STATE}; {_ERRORS}", "every case's events, one row each: case number, the swept options, kind, "
               "best lambda and F with their error bars (NaN: none), the single-grid values"),
     "table/*": ("", "one column of the table (units as the table's)"),
+    "critical_roughness": (f"mu: 1; sigma_c*: {_EPS}; lambda_c*: {_EPS}; F_c*: {_LOAD}; wall_time_s: s",
+                           "the critical roughness sigma_c(mu), above which the curve has no turning points: one "
+                           "row per mu of the study, the cusp's best values, error bars and values on each level"),
+    "critical_roughness/*": ("", "one column (units as the group's; *_grid, n_nodes: a row per mu, a column per "
+                                 "level)"),
+    "critical_mu": (f"sigma: {_EPS}; mu_c*: 1; lambda_c*: {_EPS}; F_c*: {_LOAD}; wall_time_s: s",
+                    "the critical Tabor parameter mu_c(sigma), below which the curve has no turning points: one "
+                    "row per sigma of the study"),
+    "critical_mu/*": ("", "one column (units as the group's; *_grid, n_nodes: a row per sigma, a column per level)"),
 }
 
 
@@ -78,8 +87,8 @@ def _describe(name: str, obj) -> None:
         key = key[len("cases/*/"):]
     if key.startswith(("summary/", "study/", "failed/")):
         key = key.split("/")[0]
-    elif key.startswith("table/"):
-        key = "table/*"
+    elif key.startswith(("table/", "critical_roughness/", "critical_mu/")):
+        key = key.split("/")[0] + "/*"
     units, text = DESCRIBE[key]
     obj.attrs["units"], obj.attrs["description"] = units, text
 
@@ -226,6 +235,54 @@ def study_table(done: list[dict], axes: list[str]) -> dict:
     for k in ("lambda", "lambda_err", "F", "F_err", "lambda_grid", "F_grid"):
         cols[k] = np.array([e.get(k, np.nan) for _, e in rows], dtype=float)
     return cols
+
+
+#: The columns of a critical study's cases (critical.sigma_c, critical.mu_c) by kind, in the JSON summary
+#: and the HDF5 tables (which add the values on each level).
+CRITICAL_KEYS = {k: (fixed, k, f"{k}_err", "lambda_c", "lambda_c_err", "F_c", "F_c_err", f"{k}_domain",
+                     "contact_radius", "wall_time_s")
+                 for k, fixed in (("sigma_c", "mu"), ("mu_c", "sigma"))}
+_CRITICAL = (("critical_roughness", "sigma_c"), ("critical_mu", "mu_c"))
+
+
+def critical_table(done: list[dict], kind: str) -> dict:
+    """The columns of the critical cases of ``kind`` (sigma_c or mu_c): CRITICAL_KEYS, the values on each
+    level (``*_grid``, a column per level) and the nodes of each level."""
+    rows = [r for r in done if r["kind"] == kind]
+    cols = {k: np.array([r[k] for r in rows], dtype=float) for k in CRITICAL_KEYS[kind]}
+    for k in (f"{kind}_grid", "lambda_c_grid", "F_c_grid"):
+        cols[k] = np.array([r[k] for r in rows], dtype=float)
+    cols["n_nodes"] = np.array([r["n_nodes"] for r in rows], dtype=int)
+    return cols
+
+
+def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
+    """The files of a critical study (``-study_compute critical``), committed together; returns the summary.
+
+    ``done``: the cases that ran, each a record of :func:`~petsc_adhesion.critical.sigma_c` or
+    :func:`~petsc_adhesion.critical.mu_c` with its ``kind``; ``failed``: {case, values, error}.
+    """
+    brief = {k: v for k, v in prog.items() if k != "options"}
+    def keys(kind):
+        return CRITICAL_KEYS[kind] + (f"{kind}_grid", "levels", "n_nodes", "bracket", "roughness", "rmax", "warning")
+
+    lists = {name: [{k: r[k] for k in keys(kind) if k in r} for r in done if r["kind"] == kind]
+             for name, kind in _CRITICAL}
+    summ = {**brief, "kind": "critical", "study": study, **lists, "failed": failed}
+    tree = {**prog, "kind": "critical", "study": study,
+            **{name: critical_table(done, kind) for name, kind in _CRITICAL},
+            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in failed]}
+               if failed else {})}
+    if "out" in files.targets:
+        write_h5(files.temp("out"), tree)
+    if "plot" in files.targets:
+        from .studyplot import critical_figure
+
+        critical_figure(tree, files.temp("plot"), PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()])
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), summ)
+    files.commit()
+    return summ
 
 
 def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:

@@ -7,7 +7,9 @@ The kinds are those of ``-study_plot``: ``curves`` (paper Figs. 4, 5, 8, 13, 14)
 ``folds`` (one panel per case about its turning points, Fig. 9), ``profiles``
 (Figs. 6, 7, 10-12, 15, 16), ``pull_off`` (against mu, Fig. 18) and
 ``reduction`` (1 - F_p(sigma) / F_p(0) against sigma, Fig. 17).  The maps read
-the study's event table; every pull-off is drawn with its error bar.
+the study's event table; every pull-off is drawn with its error bar.  A critical
+study (``-study_compute critical``) draws the boundary of hysteresis in (mu, sigma)
+(:func:`critical_figure`).
 """
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ import numpy as np
 
 from .plot import from_tree, load_approach, profiles, read_group
 
-__all__ = ["read_study", "study_figure", "pull_offs"]
+__all__ = ["read_study", "study_figure", "pull_offs", "read_critical", "critical_figure"]
 
 _NAMES = {"adh_mu": "mu", "adh_sigma": "sigma"}
 
@@ -169,6 +171,44 @@ KINDS = {"curves": _curves, "folds": _folds, "profiles": _profiles, "pull_off": 
          "reduction": _reduction}
 
 
+def read_critical(path: str) -> dict:
+    """A critical study's file (``-study_compute critical``): its two tables, as columns."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        if f.attrs.get("kind") != "critical":
+            raise ValueError(f"'{path}' is not a critical study (its kind is '{f.attrs.get('kind', '')}')")
+        return {name: {k: v[()] for k, v in f[name].items()} for name in ("critical_roughness", "critical_mu")
+                if name in f}
+
+
+def critical_figure(source, out: str, fmt: str = "png") -> None:
+    """The boundary of hysteresis in (mu, sigma): sigma_c(mu) and mu_c(sigma) with their error bars,
+    from a critical study's tree or file."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tree = read_critical(source) if isinstance(source, str) else source
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    rough, crit = tree.get("critical_roughness"), tree.get("critical_mu")
+    if rough is not None and rough["mu"].size:
+        ax.errorbar(rough["mu"], rough["sigma_c"], yerr=rough["sigma_c_err"], marker="o", ms=4, capsize=2,
+                    label="sigma_c(mu): fold continued in sigma")
+    if crit is not None and crit["sigma"].size:
+        ax.errorbar(crit["mu_c"], crit["sigma"], xerr=crit["mu_c_err"], marker="s", ms=4, mfc="none", ls="none",
+                    capsize=2, label="mu_c(sigma): fold continued in mu")
+    ax.set_xscale("log")
+    ax.set_xlabel("Tabor parameter mu")
+    ax.set_ylabel("roughness sigma / epsilon")
+    ax.text(0.97, 0.05, "snap-on and snap-off\n(hysteresis)", transform=ax.transAxes, ha="right", fontsize=8)
+    ax.text(0.03, 0.93, "no turning points", transform=ax.transAxes, va="top", fontsize=8)
+    ax.legend(fontsize=7, loc="upper center")
+    fig.tight_layout()
+    fig.savefig(out, dpi=120, format=fmt)
+    plt.close(fig)
+
+
 def study_figure(source, out: str, kind: str, fmt: str = "png") -> None:
     """Draw ``kind`` (one of KINDS) from a study tree or file into ``out``."""
     import matplotlib
@@ -186,5 +226,8 @@ def study_figure(source, out: str, kind: str, fmt: str = "png") -> None:
 if __name__ == "__main__":
     if len(sys.argv) not in (3, 4):
         sys.exit("usage: python -m petsc_adhesion.studyplot STUDY.h5 OUT.png [KIND]")
-    src = read_study(sys.argv[1])
-    study_figure(src, sys.argv[2], sys.argv[3] if len(sys.argv) == 4 else src["study"]["plot"])
+    if (sys.argv[3:] or [""])[0] == "critical":
+        critical_figure(sys.argv[1], sys.argv[2])
+    else:
+        src = read_study(sys.argv[1])
+        study_figure(src, sys.argv[2], sys.argv[3] if len(sys.argv) == 4 else src["study"]["plot"])

@@ -35,13 +35,13 @@ from petsc4py import PETSc
 from . import capi, preconditioning
 from .errors import InputError
 from .files import check_targets, written
-from .options import TABLE, AppOptions, check_unused, collective
+from .options import TABLE, AppOptions, check_unused, collective, read_model
 from .optionsfile import options_files
-from .output import curve_summary, curve_tree, write_study
+from .output import curve_summary, curve_tree, write_critical, write_study
 from .problem import far_approach
 from .study import curve, head, plan, program
 
-__all__ = ["Case", "cases", "cost", "assign", "main", "KINDS"]
+__all__ = ["Case", "cases", "cost", "assign", "spread", "main", "KINDS"]
 
 #: The event kinds each -study_compute reports (None: all) and whether it stops at equilibrium.
 KINDS = {"curve": (None, False), "events": (None, True), "pull_off": (("F_min", "equilibrium"), True),
@@ -172,6 +172,11 @@ def _failure(c: Case, why: str) -> dict:
     return {"case": c.index, "values": c.values, "error": why}
 
 
+def _failures(records: list[dict]) -> list[dict]:
+    """The records of the cases that failed at run time, as the files hold them."""
+    return [_failure(Case(r["case"], r["values"]), r["error"]) for r in records if "error" in r]
+
+
 class _Progress:
     """Rank 0's line per finished case: which, how long, elapsed, and the time left by the cases' costs."""
 
@@ -179,12 +184,13 @@ class _Progress:
         self.mpi, self.t0, self.total = comm.tompi4py(), time.perf_counter(), sum(cost(c) for c in todo)
         self.done, self.count, self.n, self.sent = 0.0, 0, len(todo), []
 
-    def finished(self, c: Case, record: dict, leader: bool) -> None:
-        """A case is done: rank 0 says so, another group's leader tells rank 0."""
+    def finished(self, c: Case, brief: dict, leader: bool) -> None:
+        """A case is done (``brief``: its label, cost and what to say): rank 0 says so, another group's
+        leader tells rank 0."""
         if self.mpi.Get_rank() == 0:
-            self._say(c.index, _brief(record))
+            self._say(c.index, brief)
         elif leader:
-            self.sent.append(self.mpi.isend((c.index, _brief(record)), dest=0, tag=_TAG))
+            self.sent.append(self.mpi.isend((c.index, brief), dest=0, tag=_TAG))
 
     def poll(self, block: int = 0) -> None:
         """Rank 0: say what the other groups finished (waiting for ``block`` more of them)."""
@@ -236,13 +242,13 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     axes, _ = collective(world, _check, opts)
     compute = opts.choice("study_compute")
     if compute == "critical":
-        from .critical import study as critical_study     # fold continuation: only for this kind of study
-        return critical_study(opts, argv, axes)
+        return _critical_main(opts, argv, axes, helping)
+    if opts.choice("study_plot") == "critical":
+        raise InputError("-study_plot: critical draws the cusps of -study_compute critical, not curves; "
+                         "one of curves, folds, profiles, pull_off, reduction")
     keep = opts.choices("study_profiles")
     todo = cases(axes)
-    targets = {k: opts.string(k) for k in ("out", "summary", "plot") if opts.string(k)}
-    collective(world, lambda: check_targets(targets, {"options_file": options_files(argv)}) if mpi.Get_rank() == 0
-               else None)
+    targets = _targets(opts, argv)
     given = opts.given()
     _validate(todo, given, argv)
     bad = [c for c in todo if c.error]
@@ -253,44 +259,115 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
             print(f"petsc-adhesion: case {c.index + 1} ({c.label}) left out: {c.error}", file=sys.stderr, flush=True)
     if helping:
         return 0
-    good = [c for c in todo if not c.error]
-    ranks = opts.int("study_ranks")
+    records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
+                     lambda c, comm: _run(c, given, argv, comm, compute, keep), _brief)
+    status = 0
+    if mpi.Get_rank() == 0:
+        failed = [_failure(c, c.error) for c in bad] + _failures(records)
+        done = [r for r in records if "error" not in r]
+        study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
+                 "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
+        with written(targets) as files:
+            write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
+        status = 3 if failed or any(r["incomplete"] for r in done) else 0
+    return mpi.bcast(status, root=0)
+
+
+def _targets(opts: AppOptions, argv: list[str]) -> dict:
+    """The study's files (-out, -summary, -plot), checked writable and apart from its inputs (collective)."""
+    targets = {k: opts.string(k) for k in ("out", "summary", "plot") if opts.string(k)}
+    world = PETSc.COMM_WORLD
+    collective(world, lambda: check_targets(targets, {"options_file": options_files(argv)})
+               if world.getRank() == 0 else None)
+    return targets
+
+
+def spread(todo: list[Case], ranks: int, work, brief) -> list[dict] | None:
+    """``work(case, comm)`` for each case, the cases spread over groups of ``ranks`` ranks (LPT by
+    :func:`cost`); a progress line on rank 0 for each finished case (``brief(record)``).
+
+    ``work`` returns the case's record on its group's rank 0; a case that raises is recorded with its
+    one-line error.  Returns every record on rank 0, in case order (None elsewhere).
+    """
+    world = PETSc.COMM_WORLD
+    mpi = world.tompi4py()
     color = mpi.Get_rank() // ranks
-    plan_of = assign(good, mpi.Get_size() // ranks)
+    plan_of = assign(todo, mpi.Get_size() // ranks)
     sub = mpi.Split(color, mpi.Get_rank())
     comm = PETSc.Comm(sub)
-    progress = _Progress(world, good)
+    progress = _Progress(world, todo)
     mine = []
     try:
         for c in plan_of[color]:
             t0 = time.perf_counter()
             try:
-                rec = _run(c, given, argv, comm, compute, keep)
+                rec = work(c, comm)
             except (InputError, RuntimeError, FloatingPointError, PETSc.Error) as e:
                 rec = _failure(c, _one_line(e))
             leader = sub.Get_rank() == 0
             if leader:
                 rec |= {"label": c.label, "cost": cost(c), "wall_s": time.perf_counter() - t0}
                 mine.append(rec)
-                progress.finished(c, rec, leader)
+                progress.finished(c, brief(rec), leader)
             progress.poll()
         progress.poll(block=progress.n - progress.count)
     finally:
         sub.Free()
     gathered = mpi.gather(mine, root=0)
     progress.close()
+    return sorted((r for part in gathered for r in part), key=lambda r: r["case"]) if mpi.Get_rank() == 0 else None
+
+
+def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool) -> int:
+    """-study_compute critical: sigma_c at each -study_mu and mu_c at each -study_sigma
+    (:mod:`~petsc_adhesion.critical`), each a case; the files from rank 0."""
+    world = PETSc.COMM_WORLD
+    mpi = world.tompi4py()
+    other = [n for n, _ in axes if n not in ("adh_mu", "adh_sigma")]
+    if other:
+        raise InputError("-study_option: not with -study_compute critical, which continues the turning points "
+                         "in mu (each -study_sigma) and in sigma (each -study_mu)")
+    if opts.db.hasName("study_plot") and opts.choice("study_plot") != "critical":
+        raise InputError(f"-study_plot: {opts.choice('study_plot')} draws curves; -study_compute critical "
+                         f"draws 'critical'")
+    model = collective(world, read_model, opts)
+    todo = [Case(i, {name: v}) for i, (name, v) in enumerate((n, v) for n, vals in axes for v in vals)]
+    targets = _targets(opts, argv)
+    if helping:
+        return 0
+    records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, comm), _cusp_brief)
     status = 0
     if mpi.Get_rank() == 0:
-        records = sorted((r for part in gathered for r in part), key=lambda r: r["case"])
-        failed = [_failure(c, c.error) for c in bad] + [_failure(Case(r["case"], r["values"]), r["error"])
-                                                        for r in records if "error" in r]
+        failed = _failures(records)
         done = [r for r in records if "error" not in r]
-        study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": ranks,
-                 "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
+        study = {"compute": "critical", "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
+                 "cases": len(todo), "plot": "critical"}
         with written(targets) as files:
-            write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
-        status = 3 if failed or any(r["incomplete"] for r in done) else 0
+            write_critical(program(world, opts), study, done, failed, files)
+        status = 3 if failed else 0
+    check_unused()
     return mpi.bcast(status, root=0)
+
+
+def _cusp(c: Case, model, comm) -> dict | None:
+    """One case of a critical study: sigma_c at its mu, or mu_c at its sigma."""
+    from .critical import mu_c, sigma_c           # fold continuation: only for this kind of study
+
+    (name, value), = c.values.items()
+    try:
+        out = sigma_c(model, value, comm=comm) if name == "adh_mu" else mu_c(model, value, comm=comm)
+    except ValueError as e:                        # no cusp in the range searched
+        raise RuntimeError(str(e)) from None
+    return {"case": c.index, "values": c.values, "kind": "sigma_c" if name == "adh_mu" else "mu_c", **out} \
+        if comm.getRank() == 0 else None
+
+
+def _cusp_brief(record: dict) -> dict:
+    out = {"label": record["label"], "cost": record["cost"]}
+    if "error" in record:
+        return out | {"error": f"failed: {record['error']}"}
+    k = record["kind"]
+    return out | {"what": f"{k} = {record[k]:.6f} +- {record[k + '_err']:.1e} in {record['wall_time_s']:.1f} s"}
 
 
 def _one_line(e: BaseException) -> str:
