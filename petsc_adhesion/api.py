@@ -44,7 +44,8 @@ class Event:
     ``lam_err`` and ``F_err`` their error bars, ``lam_grid`` and ``F_grid`` the values
     on the grid the event was located on (None, like the bars, without an error
     estimate: ``note`` says why).  ``stable`` is None at a fold (marginal).  ``landing``:
-    where the jump from a fold lands (kind ``"landing"``).  ``r``, ``H``, ``P``: the
+    where the jump from a fold lands (kind ``"landing"``).  ``contact_radius``: where the
+    separation rises through the edge level, on that grid (no bar).  ``r``, ``H``, ``P``: the
     profiles of eq. (12) and (14) with ``profiles=True``, else None.
     """
 
@@ -58,6 +59,7 @@ class Event:
     lam_grid: float | None = None
     F_grid: float | None = None
     F_beyond: float | None = None
+    contact_radius: float | None = None
     levels: tuple = ()
     note: str | None = None
     landing: Event | None = None
@@ -73,6 +75,7 @@ class Event:
         return cls(kind=e["kind"], lam=float(e["lambda"]), F=float(e["F"]), H0=float(e["H0"]),
                    stable=None if e.get("stable") is None else bool(e["stable"]), lam_err=num("lambda_err"),
                    F_err=num("F_err"), lam_grid=num("lambda_grid"), F_grid=num("F_grid"), F_beyond=num("F_beyond"),
+                   contact_radius=num("contact_radius"),
                    levels=tuple(int(k) for k in e.get("levels", ())), note=e.get("error_note"),
                    landing=cls.from_record({"kind": "landing", **e["landing"]}) if e.get("landing") else None,
                    r=e.get("r"), H=e.get("H"), P=e.get("P"))

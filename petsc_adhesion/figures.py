@@ -227,6 +227,42 @@ def models():
     _save(fig, "models", _table(["mu", "model"] + [f"sigma={s:g}" for s in sig], rows), "./run figures models")
 
 
+def critical_models():
+    """The critical roughness sigma_c(mu) of each roughness model (``-study_compute critical``), where it
+    exists below sigma = 8."""
+    plt = _plt()
+    mus = (0.75, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0, 20.0)
+    rows, fig = [], plt.figure(figsize=(6.4, 4.8))
+    ax = fig.gca()
+    with tempfile.TemporaryDirectory() as tmp:
+        for i, (label, args) in enumerate(MODELS.items()):
+            path = os.path.join(tmp, f"{i}.json")
+            cmd = [sys.executable, "-m", "petsc_adhesion", "-study_compute", "critical", "-study_mu",
+                   ",".join(f"{m:g}" for m in mus), *map(str, args), "-summary", path]
+            np_ = os.environ.get("NP")
+            proc = subprocess.run((["mpiexec", "-n", np_] if np_ else []) + cmd, cwd=ROOT, capture_output=True,
+                                  text=True)
+            if proc.returncode not in (0, 3):
+                raise RuntimeError(f"{' '.join(cmd)}: {proc.stderr.strip().splitlines()[-1]}")
+            with open(path) as f:
+                s = json.load(f)
+            got = {c["mu"]: c for c in s["critical_roughness"]}
+            why = {f["values"]["adh_mu"]: f["error"] for f in s["failed"]}
+            xs = sorted(got)
+            ax.errorbar(xs, [got[m]["sigma_c"] for m in xs], yerr=[got[m]["sigma_c_err"] for m in xs],
+                        fmt="o-", ms=3, label=label)
+            rows.append([label] + [f"{got[m]['sigma_c']:.6f} +- {got[m]['sigma_c_err']:.0e}" if m in got else
+                                   ("none below 8" if why.get(m, "").startswith("hysteresis at") else
+                                    "below 0.001" if why.get(m, "").startswith("no hysteresis") else "failed")
+                                   for m in mus])
+    ax.set_xscale("log")
+    ax.set_xlabel("Tabor parameter mu")
+    ax.set_ylabel("critical roughness sigma_c / epsilon")
+    ax.legend(fontsize=7)
+    _save(fig, "critical_models", _table(["model"] + [f"mu={m:g}" for m in mus], rows),
+          "./run figures critical_models")
+
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: The studies of the paper's figures, by name: figNN -> its options file.
 STUDIES = {os.path.basename(f)[:-5]: f for f in sorted(glob.glob(os.path.join(ROOT, "options", "fig[0-9]*.opts")))}
@@ -297,7 +333,7 @@ def validation():
     v.write()
 
 
-OWN = {f.__name__: f for f in (convergence, hermite, coarse, quadrature, models, validation)}
+OWN = {f.__name__: f for f in (convergence, hermite, coarse, quadrature, models, critical_models, validation)}
 FIGURES = {**{n: (lambda n=n: study(n)) for n in STUDIES}, **OWN}
 
 if __name__ == "__main__":

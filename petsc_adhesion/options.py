@@ -24,7 +24,8 @@ from .files import printable
 from .adaptive import RMAX
 from .continuation import ARCLENGTH_PREFIX, CORRECTORS, NATURAL_PREFIX, Settings
 from .events import EVENT_TOL
-from .model import Model, tabor
+from .model import Model
+from .physical import HAMAKER_CUTOFF, Bodies
 from .roughness import DISTRIBUTIONS, HeightFileError, Measured, Weibull, read_heights
 from .solver import PC_REUSE_ITS
 
@@ -83,8 +84,6 @@ _S = Settings
 TABLE = {o.name: o for o in [
     # model (paper eq. 9-14)
     Option("adh_mu", "real", Model.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
-    Option("adh_physical", "reals", (), "R,gamma,E,epsilon in SI (m, J/m^2, Pa, m): mu from eq. (9), "
-           "results also in SI", 0.0, 1e12, lo_open=True),
     Option("adh_sigma", "real", Model.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
     Option("adh_roughness", "choice", Model.roughness, "height distribution averaged over (eq. 7, 10): the "
            "paper's Gaussian by its Gauss-Hermite rule (eq. 14), whose rule is the model; Gaussian truncated at "
@@ -98,7 +97,7 @@ TABLE = {o.name: o for o in [
     Option("adh_roughness_file", "string", None, "measured: heights, one a line in units of epsilon; a table "
            "(Gwyddion ASCII export, '# Value units: m'), .gsf or .npy height map; it sets sigma itself"),
     Option("adh_roughness_unit", "real", None, "measured: metres per value of a file that states no unit "
-           "(needs epsilon from -adh_physical)", 0.0, 1.0, lo_open=True),
+           "(needs -phys_epsilon)", 0.0, 1.0, lo_open=True),
     Option("adh_quadrature_points", "int", Model.quadrature_points, "truncated_gaussian, weibull: points of "
            "the quadrature's moving part at the wall (its fixed panels get 2/3 as many)", 2, 400),
     Option("adh_rmax", "real", None, f"end r_m of the computational domain (default: {RMAX:g} on grids that "
@@ -113,6 +112,27 @@ TABLE = {o.name: o for o in [
     Option("adh_pc_reuse_its", "int", PC_REUSE_ITS, "keep the preconditioner while Krylov needs at most this many "
            "iterations (0: rebuild at every Newton iteration)", 0, 10**6),
     # grid
+    # physical inputs (SI): mu from eq. (9), sigma = rms / epsilon, results also in nN, nm, MPa
+    Option("phys_radius", "real", None, "radius R1 of the sphere (m); with -phys_young1, -phys_poisson1, "
+           "-phys_gamma (or -phys_hamaker) and -phys_epsilon it sets mu by eq. (9), and results are reported also "
+           "in nN, nm and MPa", 0.0, 1.0, lo_open=True),
+    Option("phys_radius2", "real", None, "radius R2 of a second sphere (m): R = R1 R2 / (R1 + R2) (default: a "
+           "flat)", 0.0, 1.0, lo_open=True),
+    Option("phys_young1", "real", None, "Young's modulus E1 of the sphere (Pa)", 0.0, 1e13, lo_open=True),
+    Option("phys_poisson1", "real", None, "Poisson's ratio nu1 of the sphere", -1.0, 0.5, lo_open=True),
+    Option("phys_young2", "real", None, "Young's modulus E2 of the flat (or second sphere) (Pa); eq. (2) "
+           "(default: rigid)", 0.0, 1e13, lo_open=True),
+    Option("phys_poisson2", "real", None, "Poisson's ratio nu2 of the flat (with -phys_young2)", -1.0, 0.5,
+           lo_open=True),
+    Option("phys_gamma", "real", None, "work of adhesion gamma (J/m^2)", 0.0, 100.0, lo_open=True),
+    Option("phys_hamaker", "real", None, "Hamaker constant A (J), instead of -phys_gamma: gamma = A / (12 pi D0^2)",
+           0.0, 1e-16, lo_open=True),
+    Option("phys_hamaker_cutoff", "real", None, f"cut-off distance D0 of -phys_hamaker (m; default "
+           f"{HAMAKER_CUTOFF:g}, Israelachvili's)", 0.0, 1e-8, lo_open=True),
+    Option("phys_epsilon", "real", None, "equilibrium spacing epsilon of the Lennard-Jones law (m)", 0.0, 1e-8,
+           lo_open=True),
+    Option("phys_rms", "real", None, "rms roughness of the combined surfaces (m): sigma = rms / epsilon", 0.0,
+           1e-6),
     Option("grid_type", "choice", "edge", "node set: graded about the contact edge and following it along "
            "the curve; the paper's; uniform", choices=("edge", "paper", "uniform")),
     Option("grid_n", "int", grid.PAPER_UNIFORM + grid.PAPER_EXTRA, "number of nodes of -grid_type uniform",
@@ -329,28 +349,58 @@ def _strict_int(s: str) -> int:
 
 
 # -- options into objects ------------------------------------------------------------
-def read_physical(opts: AppOptions) -> tuple | None:
-    """The four SI inputs of -adh_physical, or None."""
-    phys = opts.reals("adh_physical")
-    if phys and len(phys) != 4:
-        raise InputError(f"-adh_physical: expected 4 positive reals R,gamma,E,epsilon (SI), got {len(phys)}")
-    if phys and opts.db.hasName("adh_mu"):
-        raise InputError("-adh_mu: not with -adh_physical, which sets mu by eq. (9)")
-    return phys or None
+#: The options of :class:`~petsc_adhesion.physical.Bodies`, by field.
+PHYSICAL = {f: f"phys_{f}" for f in ("radius", "radius2", "young1", "poisson1", "young2", "poisson2", "gamma",
+                                     "hamaker", "hamaker_cutoff", "epsilon", "rms")}
+
+
+def read_physical(opts: AppOptions) -> Bodies | None:
+    """The bodies of the -phys_ options (SI), or None without them; one line for a missing or
+    contradicting input."""
+    given = {f: opts.real(name) for f, name in PHYSICAL.items() if opts.db.hasName(name)}
+    if not given:
+        return None
+    for f in ("radius", "young1", "poisson1", "epsilon"):
+        if f not in given:
+            raise InputError(f"-{PHYSICAL[f]}: required with the other -phys_ options (radius, young1, poisson1, "
+                             f"epsilon, and gamma or hamaker)")
+    if ("gamma" in given) == ("hamaker" in given):
+        raise InputError("-phys_gamma: not with -phys_hamaker; give one of them (the work of adhesion)"
+                         if "gamma" in given else "-phys_gamma: required, or -phys_hamaker (the work of adhesion)")
+    if ("young2" in given) != ("poisson2" in given):
+        raise InputError(f"-{PHYSICAL['poisson2' if 'young2' in given else 'young2']}: needed with "
+                         f"-{PHYSICAL['young2' if 'young2' in given else 'poisson2']} (eq. 2)")
+    if "hamaker_cutoff" in given and "hamaker" not in given:
+        raise InputError("-phys_hamaker_cutoff: only with -phys_hamaker")
+    for name, why in (("adh_mu", "the -phys_ options set mu by eq. (9)"),
+                      *((("adh_sigma", "-phys_rms sets sigma = rms / epsilon"),) if "rms" in given else ())):
+        if opts.db.hasName(name):
+            raise InputError(f"-{name}: not with the -phys_ options: {why}")
+    if "rms" in given and opts.choice("adh_roughness") == "measured":
+        raise InputError("-phys_rms: not with -adh_roughness measured, whose heights set sigma")
+    bodies = Bodies(**given)
+    if not 0 <= bodies.mu <= TABLE["adh_mu"].hi:
+        raise InputError(f"-phys_radius: with the other -phys_ options gives mu = {bodies.mu:.3g} by eq. (9), "
+                         f"outside [0, {TABLE['adh_mu'].hi:g}]")
+    if bodies.sigma is not None and not bodies.sigma <= TABLE["adh_sigma"].hi:
+        raise InputError(f"-phys_rms: gives sigma = rms / epsilon = {bodies.sigma:.3g}, above "
+                         f"{TABLE['adh_sigma'].hi:g}")
+    return bodies
 
 
 def read_model(opts: AppOptions) -> Model:
-    """The model of -adh_mu (or -adh_physical), -adh_sigma, -adh_rmax and the roughness rule."""
+    """The model of -adh_mu (or the -phys_ options), -adh_sigma (or -phys_rms), -adh_rmax and the roughness
+    rule."""
     phys = read_physical(opts)
-    mu = tabor(*phys) if phys else opts.real("adh_mu")
-    if phys and not 0 <= mu <= TABLE["adh_mu"].hi:
-        raise InputError(f"-adh_physical: gives mu = {mu:.3g}, outside [0, {TABLE['adh_mu'].hi:g}]")
+    mu = phys.mu if phys else opts.real("adh_mu")
     rmax = opts.real("adh_rmax")
     if rmax is None:
         rmax = RMAX if opts.choice("grid_type") == "edge" else Model.rmax
     rough, sigma, heights = opts.choice("adh_roughness"), opts.real("adh_sigma"), None
+    if phys and phys.sigma is not None:
+        sigma = phys.sigma
     if rough == "measured":
-        heights = read_measured(opts, phys[3] if phys else None)
+        heights = read_measured(opts, phys.epsilon if phys else None)
         sigma = Measured(heights).rms
     model = Model(mu=mu, sigma=sigma, rmax=rmax, roughness=rough, hermite_points=opts.int("adh_hermite_points"),
                   roughness_cutoff=opts.real("adh_roughness_cutoff"),
@@ -373,7 +423,7 @@ def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
         heights = read_heights(path, epsilon, opts.real("adh_roughness_unit"))
         Measured(heights)
     except HeightFileError as e:
-        why = str(e).replace("need epsilon (> 0, in metres) for units of epsilon", "need -adh_physical's epsilon")
+        why = str(e).replace("need epsilon (> 0, in metres) for units of epsilon", "need -phys_epsilon")
         raise InputError(f"-adh_roughness_file: {printable(why)}") from None
     if not np.sqrt(np.mean((heights - heights.mean()) ** 2)) <= TABLE["adh_sigma"].hi:
         raise InputError(f"-adh_roughness_file: heights of rms above {TABLE['adh_sigma'].hi:g} epsilon")

@@ -13,6 +13,7 @@ import os
 import numpy as np
 
 from .files import PLOT_FORMATS, ResultSet
+from .physical import in_units
 
 __all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve", "write_solve", "study_table",
            "write_study", "CRITICAL_KEYS", "critical_table", "write_critical"]
@@ -21,7 +22,9 @@ __all__ = ["write_h5", "write_json", "curve_summary", "curve_tree", "write_curve
 # Units of the dimensionless results (docs/model.md)
 _EPS, _LOAD, _RAD, _PRES = "epsilon", "2 pi R gamma", "sqrt(epsilon R)", "8 gamma / (3 epsilon)"
 _STATE = f"lambda, H0: {_EPS}; F: {_LOAD}"
-_ERRORS = f"lambda_err, lambda_grid: {_EPS}; F_err, F_grid, F_beyond: {_LOAD}"
+_ERRORS = f"lambda_err, lambda_grid: {_EPS}; F_err, F_grid, F_beyond: {_LOAD}; contact_radius: {_RAD}"
+_PHYS = ("R_m, epsilon_m: m; E_Pa: Pa; gamma_J_m2: J/m^2; mu: 1; sigma: epsilon; force_nN: nN per 2 pi R gamma; "
+         "approach_nm: nm per epsilon; radius_nm: nm per sqrt(epsilon R); pressure_MPa: MPa per 8 gamma / (3 epsilon)")
 #: path pattern (numbered groups as *) -> (units, one-line description), for every group and dataset
 DESCRIBE = {
     "": ("", "petsc-adhesion result: adhesive contact of an elastic sphere with a flat (Cheng, Dunn and Brach "
@@ -29,8 +32,11 @@ DESCRIBE = {
     "options": ("", "every option of the run as given (name without the dash: value)"),
     "model": (f"mu: 1; sigma: {_EPS}; rmax: {_RAD}", "the model: Tabor parameter mu (eq. 9), roughness sigma "
               "(with its averaging rule when sigma > 0), end r_m of the domain"),
-    "scales": ("force_N: N; approach_m: m; radius_m: m; pressure_Pa: Pa",
-               "the SI values of the units, from -adh_physical R,gamma,E,epsilon"),
+    "physical": (_PHYS, "the physical inputs (-phys_, SI) as given (inputs), the combined radius and modulus "
+                 "(eq. 2), the work of adhesion, epsilon, the mu (eq. 9) and sigma they make, and the value of each "
+                 "unit of the model in nN, nm and MPa"),
+    "physical/inputs": ("radius*: m; young*: Pa; poisson*: 1; gamma: J/m^2; hamaker: J; hamaker_cutoff: m; "
+                        "epsilon: m; rms: m", "the -phys_ options as given (SI)"),
     "grid": ("", "the collocation grid (of the last segment when the grid followed the contact edge)"),
     "grid/r": (_RAD, "the nodes r_i on [0, r_m]"),
     "grid/lambda": (_EPS, "approach where each segment of the curve, on its own grid, starts"),
@@ -60,7 +66,8 @@ DESCRIBE = {
     "events/*/landing/r": (_RAD, "the nodes of the grid the landing was located on (-profiles)"),
     "events/*/landing/H": (_EPS, "separation at the nodes after the jump (-profiles)"),
     "events/*/landing/P": (_PRES, "pressure at the nodes after the jump (-profiles)"),
-    "summary": (f"{_STATE}; {_ERRORS}; *_s: s", "the JSON summary (docs/output.md)"),
+    "summary": (f"{_STATE}; {_ERRORS}; *_s: s; *_nm: nm; *_nN: nN", "the JSON summary (docs/output.md); "
+                "physical: its events in nm and nN"),
     "study": ("", "a study (kind: study): what its cases compute, the options swept, ranks per case, the figure"),
     "cases": ("", "the cases of a study that ran, in their order; each holds a curve's layout and its values"),
     "cases/*": ("", "one case: the options it sets (values), its model, grid, curve, events and summary"),
@@ -143,14 +150,15 @@ def write_json(path: str, summary: dict) -> None:
 
 
 # -- layout ---------------------------------------------------------------------
-_BRIEF = ("kind", "lambda", "F", "H0", "stable", "lambda_err", "F_err", "lambda_grid", "F_grid", "F_beyond",
+_BRIEF = ("kind", "lambda", "F", "H0", "contact_radius", "stable", "lambda_err", "F_err", "lambda_grid", "F_grid", "F_beyond",
           "levels", "target_met", "error_note")
 
 
 def _brief(e: dict) -> dict:
     out = {k: v for k, v in e.items() if k in _BRIEF}
     if "landing" in e:
-        out["landing"] = {k: v for k, v in e["landing"].items() if k in ("lambda", "F", "H0", "F_err", "F_grid")}
+        out["landing"] = {k: v for k, v in e["landing"].items()
+                          if k in ("lambda", "F", "H0", "contact_radius", "F_err", "F_grid")}
     return out
 
 
@@ -179,9 +187,8 @@ def curve_summary(res: dict, head: dict) -> dict:
          "lambda_start": res["lambda_start"], "wall_time_s": res["wall_time_s"]}
     if "error_estimate" in res:
         s["error_estimate"] = res["error_estimate"]
-    if "scales" in head and s["pull_off"]:
-        sc = head["scales"]
-        s["pull_off"] |= {"F_N": s["pull_off"]["F"] * sc["force_N"], "lambda_m": s["pull_off"]["lambda"] * sc["approach_m"]}
+    if "physical" in head:
+        s["physical"] = in_units(s, head["physical"])
     return s
 
 
@@ -218,6 +225,10 @@ def write_solve(res: dict, head: dict, files: ResultSet) -> dict:
     """The files of a fixed-approach solve, committed together; returns the summary."""
     brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
     summ = {**_common(head), **brief}
+    if "physical" in head:
+        d = head["physical"]
+        summ["physical"] = {**d, "lambda_nm": res["lambda"] * d["approach_nm"], "F_nN": res["F"] * d["force_nN"],
+                            "H0_nm": res["H0"] * d["approach_nm"]}
     if "out" in files.targets:
         write_h5(files.temp("out"), {**head, "kind": "solve", "solution": {"H": res["H"], "P": res["P"], **brief}})
     if "summary" in files.targets:

@@ -24,7 +24,7 @@ from .continuation import Continuation, Settings
 from .events import jumps
 from .files import PLOT_FORMATS, check_targets, printable, written
 from .influence import create_influence
-from .model import Model, scales
+from .model import Model
 from .optionsfile import options_files
 from .options import (TABLE, AppOptions, InputError, check_consistency, check_memory, check_petsc_values,
                       check_unused, collective, print_help, read_grid, read_guess, read_model, read_physical,
@@ -211,14 +211,14 @@ def program(comm, opts: AppOptions) -> dict:
 
 
 def head(comm, opts: AppOptions, model, grid: dict) -> dict:
-    """What every result file says about its run: the program, model, grid, SI scales."""
+    """What every result file says about its run: the program, model, grid, the physical inputs."""
     phys = read_physical(opts)
     rough = pressure_law(model).describe()
     return {**program(comm, opts),
             "model": {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **rough,
                       "domain": "half-infinite (the rigid sphere's attraction beyond r_m added)" if model.farfield
                       else "truncated at r_m (the paper's model)"},
-            "grid": grid, **({"scales": scales(*phys)} if phys else {})}
+            "grid": grid, **({"physical": phys.describe()} if phys else {})}
 
 
 def main(argv: list[str] | None = None, keep: dict | None = None) -> int:
@@ -290,7 +290,7 @@ def main(argv: list[str] | None = None, keep: dict | None = None) -> int:
             else:
                 summary = write_solve(res, about, files)
                 if keep is None:
-                    results.report_solve(res)
+                    results.report_solve(res, summary.get("physical"))
         if keep is not None:
             keep |= {"result": res, "head": about, "summary": summary}
     if ck:

@@ -163,7 +163,7 @@ def _run(c: Case, study: dict, argv: list[str], comm, compute: str, keep: tuple)
         about = head(comm, opts, p.model, grid)
         summary = curve_summary(res, about)
         tree = {k: v for k, v in curve_tree(res, about, summary).items() if k in ("model", "grid", "curve", "events",
-                                                                               "summary", "scales")}
+                                                                               "summary", "physical")}
         return {"case": c.index, "values": c.values, "summary": summary, "tree": tree,
                 "incomplete": bool(res["incomplete"])}
 

@@ -214,11 +214,12 @@ class Generator:
             case.add("-grid_type", "uniform", "-grid_n", int(self.rng.integers(21, 62)))
 
     def model(self, case: Case, curve: bool) -> tuple:
-        """-adh_mu (or -adh_physical) in [0, 3], -adh_sigma in [0, 1]; returns (mu, sigma)."""
+        """-adh_mu (or the -phys_ options) in [0, 3], -adh_sigma in [0, 1]; returns (mu, sigma)."""
         if curve and self.chance(0.08):             # SI inputs: mu from eq. (9), about 0.1 to 3
             R, mu = 10 ** self.rng.uniform(-7, -5), self.rng.uniform(0.1, 3.0)
             E = (R * 0.05**2 / (mu ** 3 * (4e-10) ** 3)) ** 0.5
-            case.add("-adh_physical", f"{R:.4g},0.05,{E:.4g},4e-10")
+            case.add("-phys_radius", f"{R:.4g}", "-phys_gamma", "0.05", "-phys_young1", f"{E:.4g}",
+                     "-phys_poisson1", "0", "-phys_epsilon", "4e-10")
         else:
             mu = 0.0 if self.chance(0.1) else round(float(self.rng.uniform(0, 3)), 3)
             case.add("-adh_mu", _num(mu))
@@ -585,8 +586,8 @@ class Generator:
             if "-adh_mu" in case["args"]:                   # the command line would override the file
                 i = case["args"].index("-adh_mu")
                 del case["args"][i:i + 2]
-            if "-adh_physical" in case["args"]:
-                i = case["args"].index("-adh_physical")
+            while any(a.startswith("-phys_") for a in case["args"] if isinstance(a, str)):
+                i = next(k for k, a in enumerate(case["args"]) if isinstance(a, str) and a.startswith("-phys_"))
                 del case["args"][i:i + 2]
         pos = int(self.rng.integers(0, len(case["args"]) // 2 + 1)) * 2
         case["args"][pos:pos] = ["-options_file", name]

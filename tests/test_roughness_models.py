@@ -127,14 +127,15 @@ def test_files_say_which_model(runs):
 
 
 def test_height_map_in_metres(tmp_path, cli):
-    """A Gwyddion ASCII map in metres with -adh_physical's epsilon: sigma is the levelled map's rms / epsilon."""
+    """A Gwyddion ASCII map in metres with -phys_epsilon: sigma is the levelled map's rms / epsilon."""
     rng = np.random.default_rng(5)
     i, j = np.indices((40, 50))
     Z = 0.08e-9 * rng.standard_normal((40, 50)) + 1e-11 * i - 2e-11 * j + 3e-9   # a tilt and an offset
     path = tmp_path / "map.txt"
     np.savetxt(path, Z, header="Channel: Height\nValue units: m")
-    phys = "1e-6,0.05,1e10,4e-10"
-    p = cli(*GRID[2:8], "-adh_physical", phys, "-adh_roughness", "measured", "-adh_roughness_file", path,
+    phys = ("-phys_radius", 1e-6, "-phys_gamma", 0.05, "-phys_young1", 1e10, "-phys_poisson1", 0, "-phys_epsilon",
+            4e-10)
+    p = cli(*GRID[2:8], *phys, "-adh_roughness", "measured", "-adh_roughness_file", path,
             "-adh_lambda", "-1", "-summary", tmp_path / "s.json")
     assert p.returncode == 0, p.stderr
     A = np.column_stack([np.ones(Z.size), i.ravel(), j.ravel()])
@@ -142,4 +143,4 @@ def test_height_map_in_metres(tmp_path, cli):
     sigma = json.load(open(tmp_path / "s.json"))["sigma"]
     assert sigma == pytest.approx(np.sqrt(np.mean(level ** 2)) / 4e-10, rel=1e-12)
     bad = cli(*GRID[2:8], "-adh_roughness", "measured", "-adh_roughness_file", path, "-adh_lambda", "-1")
-    assert "-adh_roughness_file" in plain_error(bad) and "-adh_physical" in plain_error(bad)
+    assert "-adh_roughness_file" in plain_error(bad) and "-phys_epsilon" in plain_error(bad)
