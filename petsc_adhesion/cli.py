@@ -1,4 +1,5 @@
-"""Command line entry: ``petsc-adhesion [PETSc and application options]``.
+"""Command line entry: ``petsc-adhesion [PETSc and application options]``, or
+``petsc-adhesion plot RESULT.h5 [-o OUT]`` (:func:`petsc_adhesion.plot.command`).
 
     mpiexec -n 2 petsc-adhesion -options_file options/fig5_mu1.opts -arc_snes_monitor
 
@@ -56,6 +57,9 @@ def main(argv: list[str] | None = None) -> int:
     PETSc's start-up would, and the caller's options come back afterwards.
     """
     argv = list(sys.argv if argv is None else argv)
+    if argv[1:2] == ["plot"]:                       # a figure from a result file: no MPI, no PETSc
+        from .plot import command
+        return command(argv[2:])
     old = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
         return _main(argv)
