@@ -7,6 +7,10 @@ elasticity, Gaussian roughness averaged over the gap, solved with PETSc.
 From Python (docs/python.md): :func:`curve` traces a load-approach curve,
 :func:`solve` solves at one approach; PETSc starts on the first call, not on import.
 """
+from .singleton import singleton_defaults
+
+singleton_defaults()   # before any MPI_Init in this process: see petsc_adhesion.singleton
+
 from .api import Curve, Event, Solution, curve, solve
 from .errors import InputError
 

@@ -42,7 +42,6 @@ from contextlib import contextmanager
 from dataclasses import asdict, fields
 
 import numpy as np
-from petsc4py import PETSc
 
 from . import __version__
 from .continuation import Point, Settings

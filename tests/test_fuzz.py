@@ -415,7 +415,7 @@ class Generator:
             elif kind == "dashes":
                 case.add(f"--{name}", "1")
             elif kind == "unicode":
-                case.add(f"-adh_\u03bc", "1")
+                case.add("-adh_\u03bc", "1")
             elif kind == "empty":
                 case.add(self.pick(["", "-", " ", "--"]))
             elif kind == "prefixed_app":

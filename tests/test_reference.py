@@ -13,7 +13,6 @@ from scipy.integrate import IntegrationWarning, quad
 from scipy.optimize import brentq, minimize_scalar
 from scipy.special import ellipkm1
 
-from petsc_adhesion import reference
 from petsc_adhesion.model import tabor
 from petsc_adhesion.reference import (
     DMT_PULL_OFF, JKR_PULL_OFF, RIGID_EQUILIBRIUM, disk_deflection, hertz_deflection,

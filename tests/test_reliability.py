@@ -6,7 +6,6 @@ their special files in a temporary folder.
 """
 import json
 import os
-import re
 import signal
 import stat
 import subprocess
