@@ -103,6 +103,9 @@ def fingerprint(opts, comm, inputs: dict | None = None) -> dict:
 
 def _difference(saved: dict, now: dict) -> str | None:
     """The first difference of two fingerprints, in words, or None."""
+    if ("mpi_ranks" in saved) != ("mpi_ranks" in now):    # only a curve's fingerprint has the ranks
+        return "is a curve's, this run is a study" if "mpi_ranks" in saved else \
+            "is a study's, this run traces one curve"
     for key in list(saved) + [k for k in now if k not in saved]:
         a, b = saved.get(key), now.get(key)
         if a == b:
@@ -388,6 +391,23 @@ class Checkpoint:
             b.linearize(True)
         cont.bordered.reuse.stale = bordered["pending"]
 
+    # -- a study: its finished cases ---------------------------------------------------------------------
+    def cases(self) -> tuple[set, list]:
+        """A study's restart: (the numbers of the cases done, their records on rank 0, [] elsewhere)."""
+        if self.saved is None:
+            return set(), []
+        records = self.saved["cases"]          # a curve's checkpoint was refused by its fingerprint
+        return {r["case"] for r in records}, records if self.rank0 else []
+
+    def save_cases(self, records: list[dict]) -> None:
+        """Rank 0: save a study's finished cases (``records``) if the interval has passed (not collective:
+        the cases reach rank 0 at their own times)."""
+        if not self.path or not self.rank0 or time.perf_counter() - self.last < self.interval:
+            return
+        write_file(self.path, {"program": "petsc-adhesion", "version": __version__, "fingerprint": self.fp,
+                               "phase": "study", "cases": len(records)}, {"phase": "study", "cases": records})
+        self.last = time.perf_counter()
+
     # -- the end ----------------------------------------------------------------------------------------
     @contextmanager
     def on_interrupt(self):
@@ -412,17 +432,20 @@ class Checkpoint:
                     os.remove(path)
 
 
-def open_checkpoint(opts, targets: dict, inputs: dict, comm) -> Checkpoint:
-    """The checkpoint a curve's options ask for, and the state of ``-cont_restart`` read and checked
-    (collective; an InputError on every rank, before any work, for a bad one).
+def open_checkpoint(opts, targets: dict, inputs: dict, comm, study: bool = False) -> Checkpoint:
+    """The checkpoint a curve's (a ``study``'s) options ask for, and the state of ``-cont_restart`` read
+    and checked (collective; an InputError on every rank, before any work, for a bad one).
 
     The file saved into: ``-cont_checkpoint``; else the one restarted from; else
-    :func:`default_path` of the outputs; ``-cont_checkpoint none`` saves nothing.
+    :func:`default_path` of the outputs; ``-cont_checkpoint none`` saves nothing.  A study's cases
+    are each traced on ``-study_ranks`` ranks, whatever the run's number: it may restart on another.
     """
     from .files import check_targets
     from .options import collective
 
     fp = fingerprint(opts, comm, inputs)
+    if study:
+        del fp["mpi_ranks"]
     restart = opts.string("cont_restart")
     path = opts.string("cont_checkpoint")
     path = None if path == "none" else path or restart or default_path(targets)

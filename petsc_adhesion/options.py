@@ -162,13 +162,14 @@ TABLE = {o.name: o for o in [
     Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
     Option("cont_event_tol", "real", EVENT_TOL, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
     Option("cont_monitor", "flag", _S.monitor, "one line a continuation step"),
-    Option("cont_checkpoint", "string", None, "save the curve's state into this file as it goes, for "
-           "-cont_restart (default: .NAME.checkpoint beside -out, else -summary or -plot; the file restarted "
-           "from; none: no checkpoint); a finished run removes it"),
+    Option("cont_checkpoint", "string", None, "save the curve's state (a study's: its finished cases) into "
+           "this file as it goes, for -cont_restart (default: .NAME.checkpoint beside -out, else -summary or "
+           "-plot; the file restarted from; none: no checkpoint); a finished run removes it"),
     Option("cont_checkpoint_interval", "real", checkpoint.INTERVAL, "least seconds between two checkpoint saves "
            "(0: before every step)", 0.0, 1e6),
     Option("cont_restart", "string", None, "go on from this checkpoint of an interrupted run with the same "
-           "options (output and printing options aside): the same steps, events and error bars"),
+           "options (output and printing options aside): the same steps, events and error bars; a study runs "
+           "only the cases not in it"),
     Option("cont_error_estimate", "flag", True, "give every event its best value and error bar: located again "
            "on its grid's coarser (or finer) nested levels, Richardson-extrapolated"),
     Option("target_error", "real", None, "refine each event's levels until its error bars (lambda and F) are "

@@ -240,9 +240,6 @@ def main(argv: list[str] | None = None, keep: dict | None = None) -> int:
         if keep is not None:
             raise InputError("-study_mu, -study_sigma, -study_option: a study of many cases runs from the "
                              "command line (petsc-adhesion -options_file FILE); the Python API traces one curve")
-        own = [n for n in ("cont_checkpoint", "cont_checkpoint_interval", "cont_restart") if opts.db.hasName(n)]
-        if own:
-            raise InputError(f"-{own[0]}: applies to a single curve, not to a study of many cases; remove it")
         return sweep.main(opts, argv, helping)
     stray = [n for n in TABLE if n.startswith("study_") and opts.db.hasName(n)]
     if stray and not helping:

@@ -21,6 +21,12 @@ files hold them (exit status 3 when any case is missing).  One HDF5 file (a
 group per case and a table of every case's events with their error bars), one
 JSON summary (``cases``: each case's ``mu``, ``sigma`` and the keys of a single
 curve's summary) and the figure of ``-study_plot`` are written together.
+
+Rank 0 saves the finished cases into a checkpoint as they reach it (at most
+every ``-cont_checkpoint_interval`` seconds; by default beside ``-out``):
+after a kill, ``-cont_restart FILE`` with the same options (on any number of
+ranks) runs only the cases not in it, and the study's files equal an
+uninterrupted run's.  A case cut off mid-way runs again from its start.
 """
 from __future__ import annotations
 
@@ -33,12 +39,14 @@ from dataclasses import dataclass, field, replace
 from petsc4py import PETSc
 
 from . import capi, preconditioning
+from .checkpoint import open_checkpoint
 from .errors import InputError
 from .files import check_targets, written
 from .options import TABLE, AppOptions, check_unused, collective, read_model
 from .optionsfile import options_files
 from .output import curve_summary, curve_tree, write_critical, write_study
 from .problem import far_approach
+from .progress import clock
 from .study import curve, head, plan, program
 
 __all__ = ["Case", "cases", "cost", "assign", "spread", "main", "KINDS"]
@@ -49,6 +57,9 @@ KINDS = {"curve": (None, False), "events": (None, True), "pull_off": (("F_min", 
 #: Options a study sets for its cases or writes itself; a -study_option cannot be one of them.
 _OWN = ("adh_mu", "adh_sigma", "adh_lambda", "out", "summary", "plot")
 _TAG = 17
+#: Options of the study as a whole, not of its cases
+_STUDY_FILES = ("out", "summary", "plot", "options_file", "cont_checkpoint", "cont_checkpoint_interval",
+                "cont_restart")
 
 
 @dataclass
@@ -65,9 +76,9 @@ class Case:
         return ", ".join(f"{names.get(k, k)} = {v:g}" for k, v in self.values.items())
 
     def options(self, study: dict) -> dict:
-        """The options of this case: the study's (``study``: name -> value), less the study's own files,
-        with its values."""
-        keep = {k: v for k, v in study.items() if k not in ("out", "summary", "plot", "options_file")}
+        """The options of this case: the study's (``study``: name -> value), less the study's own files
+        and checkpoint, with its values."""
+        keep = {k: v for k, v in study.items() if k not in _STUDY_FILES}
         return keep | {k: f"{v:.17g}" for k, v in self.values.items()}
 
 
@@ -178,45 +189,49 @@ def _failures(records: list[dict]) -> list[dict]:
 
 
 class _Progress:
-    """Rank 0's line per finished case: which, how long, elapsed, and the time left by the cases' costs."""
+    """Rank 0's line per finished case: which, how long, elapsed, and the time left by the cases' costs;
+    rank 0 also keeps every finished case's record (``records``, those of a restart first) and saves them
+    into the ``journal`` as they come."""
 
-    def __init__(self, comm, todo: list[Case]):
+    def __init__(self, comm, todo: list[Case], records: list[dict], journal):
         self.mpi, self.t0, self.total = comm.tompi4py(), time.perf_counter(), sum(cost(c) for c in todo)
-        self.done, self.count, self.n, self.sent = 0.0, 0, len(todo), []
+        self.done, self.count, self.n, self.sent = 0.0, len(records), len(records) + len(todo), []
+        self.records, self.journal = list(records), journal
 
-    def finished(self, c: Case, brief: dict, leader: bool) -> None:
-        """A case is done (``brief``: its label, cost and what to say): rank 0 says so, another group's
-        leader tells rank 0."""
+    def finished(self, rec: dict, brief: dict) -> None:
+        """A group leader's case is done: rank 0 keeps and says it, another leader sends it to rank 0."""
         if self.mpi.Get_rank() == 0:
-            self._say(c.index, brief)
-        elif leader:
-            self.sent.append(self.mpi.isend((c.index, brief), dest=0, tag=_TAG))
+            self._keep(rec, brief)
+        else:
+            self.sent.append(self.mpi.isend((rec, brief), dest=0, tag=_TAG))
 
-    def poll(self, block: int = 0) -> None:
-        """Rank 0: say what the other groups finished (waiting for ``block`` more of them)."""
+    def poll(self, block: bool = False) -> None:
+        """Rank 0: keep and say what the other groups finished (``block``: wait for all of them, polling,
+        so that a signal is taken at once)."""
         if self.mpi.Get_rank():
             return
-        while block > 0 or self.mpi.iprobe(tag=_TAG):
-            index, brief = self.mpi.recv(tag=_TAG)
-            self._say(index, brief)
-            block -= 1
+        while True:
+            if self.mpi.iprobe(tag=_TAG):
+                self._keep(*self.mpi.recv(tag=_TAG))
+            elif block and self.count < self.n:
+                time.sleep(0.01)
+            else:
+                return
 
     def close(self) -> None:
         for req in self.sent:
             req.wait()
 
-    def _say(self, index: int, record: dict) -> None:
+    def _keep(self, rec: dict, record: dict) -> None:
+        self.records.append(rec)
+        self.journal.save_cases(self.records)
         self.count += 1
         self.done += record["cost"]
         elapsed = time.perf_counter() - self.t0
-        left = elapsed * (self.total - self.done) / self.done if self.done else float("nan")
+        left = elapsed * max(self.total - self.done, 0.0) / self.done if self.done else float("nan")
         what = record.get("error") or record.get("what", "")
-        print(f"petsc-adhesion: case {index + 1} ({record['label']}) {what}; {self.count}/{self.n} done, "
-              f"{_clock(elapsed)} elapsed, about {_clock(left)} left", file=sys.stderr, flush=True)
-
-
-def _clock(s: float) -> str:
-    return "?" if s != s else f"{s:.0f} s" if s < 100 else f"{s / 60:.1f} min"
+        print(f"petsc-adhesion: case {rec['case'] + 1} ({record['label']}) {what}; {self.count}/{self.n} done, "
+              f"{clock(elapsed)} elapsed, about {clock(left)} left", file=sys.stderr, flush=True)
 
 
 def _brief(record: dict) -> dict:
@@ -248,7 +263,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
                          "one of curves, folds, profiles, pull_off, reduction")
     keep = opts.choices("study_profiles")
     todo = cases(axes)
-    targets = _targets(opts, argv)
+    targets, journal = _files(opts, argv)
     given = opts.given()
     _validate(todo, given, argv)
     bad = [c for c in todo if c.error]
@@ -259,44 +274,53 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
             print(f"petsc-adhesion: case {c.index + 1} ({c.label}) left out: {c.error}", file=sys.stderr, flush=True)
     if helping:
         return 0
-    records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
-                     lambda c, comm: _run(c, given, argv, comm, compute, keep), _brief)
-    status = 0
-    if mpi.Get_rank() == 0:
-        failed = [_failure(c, c.error) for c in bad] + _failures(records)
-        done = [r for r in records if "error" not in r]
-        study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
-                 "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
-        with written(targets) as files:
-            write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
-        status = 3 if failed or any(r["incomplete"] for r in done) else 0
+    with journal.on_interrupt():
+        records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
+                         lambda c, comm: _run(c, given, argv, comm, compute, keep), _brief, journal)
+        status = 0
+        if mpi.Get_rank() == 0:
+            failed = [_failure(c, c.error) for c in bad] + _failures(records)
+            done = [r for r in records if "error" not in r]
+            study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
+                     "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
+            with written(targets) as files:
+                write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
+            status = 3 if failed or any(r["incomplete"] for r in done) else 0
+    journal.remove()
     return mpi.bcast(status, root=0)
 
 
-def _targets(opts: AppOptions, argv: list[str]) -> dict:
-    """The study's files (-out, -summary, -plot), checked writable and apart from its inputs (collective)."""
+def _files(opts: AppOptions, argv: list[str]):
+    """The study's files (-out, -summary, -plot), checked writable and apart from its inputs, and its
+    checkpoint (:func:`~petsc_adhesion.checkpoint.open_checkpoint`; collective)."""
     targets = {k: opts.string(k) for k in ("out", "summary", "plot") if opts.string(k)}
+    inputs = {"options_file": options_files(argv), "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     world = PETSc.COMM_WORLD
-    collective(world, lambda: check_targets(targets, {"options_file": options_files(argv)})
-               if world.getRank() == 0 else None)
-    return targets
+    collective(world, lambda: check_targets(targets, inputs) if world.getRank() == 0 else None)
+    return targets, open_checkpoint(opts, targets, inputs, world, study=True)
 
 
-def spread(todo: list[Case], ranks: int, work, brief) -> list[dict] | None:
+def spread(todo: list[Case], ranks: int, work, brief, journal) -> list[dict] | None:
     """``work(case, comm)`` for each case, the cases spread over groups of ``ranks`` ranks (LPT by
     :func:`cost`); a progress line on rank 0 for each finished case (``brief(record)``).
 
     ``work`` returns the case's record on its group's rank 0; a case that raises is recorded with its
-    one-line error.  Returns every record on rank 0, in case order (None elsewhere).
+    one-line error.  ``journal`` (a study's :class:`~petsc_adhesion.checkpoint.Checkpoint`): the cases
+    of its restart are not run again, rank 0 saves the finished ones into it.  Returns every record on
+    rank 0, in case order (None elsewhere).
     """
     world = PETSc.COMM_WORLD
     mpi = world.tompi4py()
+    done, records = journal.cases()
+    todo = [c for c in todo if c.index not in done]
+    if done and mpi.Get_rank() == 0:
+        print(f"petsc-adhesion: going on from the checkpoint {journal.restart}: {len(done)} case"
+              f"{'s' * (len(done) != 1)} done, {len(todo)} to run", file=sys.stderr, flush=True)
     color = mpi.Get_rank() // ranks
     plan_of = assign(todo, mpi.Get_size() // ranks)
     sub = mpi.Split(color, mpi.Get_rank())
     comm = PETSc.Comm(sub)
-    progress = _Progress(world, todo)
-    mine = []
+    progress = _Progress(world, todo, records, journal)
     try:
         for c in plan_of[color]:
             t0 = time.perf_counter()
@@ -304,18 +328,15 @@ def spread(todo: list[Case], ranks: int, work, brief) -> list[dict] | None:
                 rec = work(c, comm)
             except (InputError, RuntimeError, FloatingPointError, PETSc.Error) as e:
                 rec = _failure(c, _one_line(e))
-            leader = sub.Get_rank() == 0
-            if leader:
+            if sub.Get_rank() == 0:
                 rec |= {"label": c.label, "cost": cost(c), "wall_s": time.perf_counter() - t0}
-                mine.append(rec)
-                progress.finished(c, brief(rec), leader)
+                progress.finished(rec, brief(rec))
             progress.poll()
-        progress.poll(block=progress.n - progress.count)
+        progress.poll(block=True)
     finally:
         sub.Free()
-    gathered = mpi.gather(mine, root=0)
     progress.close()
-    return sorted((r for part in gathered for r in part), key=lambda r: r["case"]) if mpi.Get_rank() == 0 else None
+    return sorted(progress.records, key=lambda r: r["case"]) if mpi.Get_rank() == 0 else None
 
 
 def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool) -> int:
@@ -332,19 +353,21 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
                          f"draws 'critical'")
     model = collective(world, read_model, opts)
     todo = [Case(i, {name: v}) for i, (name, v) in enumerate((n, v) for n, vals in axes for v in vals)]
-    targets = _targets(opts, argv)
+    targets, journal = _files(opts, argv)
     if helping:
         return 0
-    records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, comm), _cusp_brief)
-    status = 0
-    if mpi.Get_rank() == 0:
-        failed = _failures(records)
-        done = [r for r in records if "error" not in r]
-        study = {"compute": "critical", "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
-                 "cases": len(todo), "plot": "critical"}
-        with written(targets) as files:
-            write_critical(program(world, opts), study, done, failed, files)
-        status = 3 if failed else 0
+    with journal.on_interrupt():
+        records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, comm), _cusp_brief, journal)
+        status = 0
+        if mpi.Get_rank() == 0:
+            failed = _failures(records)
+            done = [r for r in records if "error" not in r]
+            study = {"compute": "critical", "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
+                     "cases": len(todo), "plot": "critical"}
+            with written(targets) as files:
+                write_critical(program(world, opts), study, done, failed, files)
+            status = 3 if failed else 0
+    journal.remove()
     check_unused()
     return mpi.bcast(status, root=0)
 

@@ -343,3 +343,103 @@ def test_clock_examples():
 
     result = doctest.testmod(progress)
     assert result.attempted > 0 and result.failed == 0
+
+
+# -- a study: its finished cases kept, the rest run on restart ---------------------------------------------
+STUDY = ("-grid_type", "uniform", "-grid_n", "101", "-study_mu", "0.001,0.3,0.6,1", "-study_sigma", "0,0.3",
+         "-study_compute", "events", "-cont_checkpoint_interval", "0", "-out", "s.h5", "-summary", "s.json")
+
+
+def _cases(folder) -> list[dict]:
+    """A study's cases from its JSON summary, without their run times."""
+    def bare(d):
+        return {k: bare(v) for k, v in d.items() if k != "wall_time_s"} if isinstance(d, dict) else d
+    return [bare(c) for c in json.loads((folder / "s.json").read_text())["cases"]]
+
+
+def _table(folder) -> dict:
+    import h5py
+
+    with h5py.File(folder / "s.h5") as f:
+        return {k: f["table"][k][()] for k in f["table"] if "time" not in k}
+
+
+def _saved_cases(path) -> int:
+    try:
+        with open(path, "rb") as f:
+            f.readline()
+            return json.loads(f.readline())["cases"]
+    except (OSError, ValueError, KeyError):
+        return 0
+
+
+@pytest.fixture(scope="module")
+def whole_study(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("study")
+    proc = run_cli(*STUDY, cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(os.listdir(folder)) == ["s.h5", "s.json"], "a finished study leaves its results only"
+    return folder
+
+
+@pytest.mark.parametrize("np_, sig", [(1, "TERM"), (2, "KILL")])
+def test_killed_study_runs_only_the_rest(tmp_path, whole_study, np_, sig):
+    """Killed once a case is saved (SIGTERM to the run; SIGKILL to the whole mpiexec job, ranks and all), the
+    study restarted on one rank runs only the cases not saved, and its files hold the uninterrupted
+    study's numbers: bit for bit on one rank, to 1e-10 from two (the study equals its serial run there)."""
+    if np_ > 1 and shutil.which("mpiexec") is None:
+        pytest.skip("mpiexec not found")
+    proc = _start(np_, tmp_path, *STUDY, *(("-study_ranks", "1") if np_ > 1 else ()))
+    ck = tmp_path / ".s.h5.checkpoint"
+    while _saved_cases(ck) < 1 and proc.poll() is None:
+        time.sleep(0.002)
+    ranks = _ranks(proc.pid) if np_ > 1 else {}
+    if sig == "KILL":
+        os.killpg(proc.pid, signal.SIGKILL)
+    else:
+        os.kill(proc.pid, signal.SIGTERM)
+    status, stderr = _wait(proc, ranks)
+    saved = _saved_cases(ck)
+    assert 1 <= saved < 8 and status != 0, (status, saved, stderr)
+    assert sorted(os.listdir(tmp_path)) == [".s.h5.checkpoint"], "a killed study writes no result"
+    if sig == "TERM":
+        assert stderr.splitlines()[-1] == (f"{PREFIX}interrupted by SIGTERM; nothing written; go on with "
+                                           f"-cont_restart .s.h5.checkpoint"), stderr
+    again = run_cli(*STUDY, "-cont_restart", ".s.h5.checkpoint", cwd=tmp_path)
+    assert again.returncode == 0, again.stderr
+    m = re.search(r"going on from the checkpoint \.s\.h5\.checkpoint: (\d+) cases? done, (\d+) to run", again.stderr)
+    assert m and int(m[1]) == saved and int(m[2]) == 8 - saved, again.stderr
+    assert len(re.findall(r"\bdone in ", again.stderr)) == 8 - saved, "only the rest are run"
+    assert sorted(os.listdir(tmp_path)) == ["s.h5", "s.json"], "the checkpoint goes with the study's end"
+    got, want = _cases(tmp_path), _cases(whole_study)
+    if np_ == 1:
+        assert got == want
+        for k, v in _table(whole_study).items():
+            assert np.array_equal(_table(tmp_path)[k], v), k
+    else:
+        for a, b in zip(got, want):
+            assert (a["mu"], a["sigma"]) == (b["mu"], b["sigma"])
+            close = {k: v for k, v in _numbers(a["pull_off"]).items() if not abs(v - _numbers(b["pull_off"])[k]) <= 1e-10}
+            assert not close, (a["mu"], a["sigma"], close)
+            assert [e["kind"] for e in _events(a)] == [e["kind"] for e in _events(b)]
+
+
+def test_study_restart_refuses_another_study_and_a_curve(tmp_path, saved):
+    proc = _start(1, tmp_path, *STUDY)
+    while _saved_cases(tmp_path / ".s.h5.checkpoint") < 1 and proc.poll() is None:
+        time.sleep(0.002)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.communicate()
+    (tmp_path / "curve.ck").write_bytes(saved)
+    before = sorted(os.listdir(tmp_path))
+    other = list(STUDY)
+    other[other.index("-study_sigma") + 1] = "0,0.4"
+    for args, line in ((other + ["-cont_restart", ".s.h5.checkpoint"],
+                        "was written with -study_sigma (0.0, 0.3); this run has -study_sigma (0.0, 0.4)"),
+                       (STUDY + ("-cont_restart", "curve.ck"), "'curve.ck' is a curve's, this run is a study"),
+                       (CASE + ("-cont_restart", ".s.h5.checkpoint", "-summary", "c.json"),
+                        "is a study's, this run traces one curve")):
+        p = run_cli(*args, cwd=tmp_path)
+        assert p.returncode == 2 and p.stderr.startswith(PREFIX) and p.stderr.count("\n") == 1, p.stderr
+        assert line in p.stderr, p.stderr
+    assert sorted(os.listdir(tmp_path)) == before, "nothing written"
