@@ -145,9 +145,14 @@ class Bordered:
         self.K = PETSc.Mat().createNest([[pb.jacobian, self.column], [self.row, self.corner]], comm=comm)
         self.pmat = pb.create_pmat(bordered=True)
         self.reuse = PCReuse(pc_reuse_its)
-        self.snes = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R, self.form_jacobian,
-                                self.K, self.pmat or self.K, pb.setup_pc, self.precheck, full_steps=True,
-                                bordered=True)
+        self.snes = None
+        try:
+            self.snes = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R, self.form_jacobian,
+                                    self.K, self.pmat or self.K, pb.setup_pc, self.precheck, full_steps=True,
+                                    bordered=True)
+        except BaseException:           # a solver option refused: free what is made
+            self.destroy()
+            raise
         # the hyperplane Q of eq. (24): through (x0, p0), normal (xdot, pdot), at distance ds
         self.x0, self.p0, self.xdot, self.pdot, self.ds = None, 0.0, None, 1.0, 0.0
         self.p = 0.0
@@ -272,7 +277,11 @@ class Continuation:
     def __init__(self, problem, settings: Settings | None = None, index0: int = 0):
         self.pb, self.set, self.index0 = problem, settings or Settings(), index0
         self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its)
-        self.bordered = Bordered(problem, self.set.pc_reuse_its)
+        try:
+            self.bordered = Bordered(problem, self.set.pc_reuse_its)
+        except BaseException:           # a solver option refused: free the Newton solver made
+            self.newton.destroy()
+            raise
         self._x, self._xt, self._rhs, self._phi, self._r = (problem.create_vec() for _ in range(5))
         self._gp = np.zeros(self._x.getLocalSize())
         self.points: list[Point] = []

@@ -62,19 +62,23 @@ def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, ja
         Whether J is the bordered matrix of the arclength corrector (for ``setup_pc``).
     """
     snes = PETSc.SNES().create(comm)
-    snes.setOptionsPrefix(prefix)
-    snes.setFunction(function, residual)
-    snes.setJacobian(jacobian, J, P)
-    snes.setType("newtonls")
-    if full_steps:
-        capi.set_linesearch_type(snes, "basic")
-    snes.setTolerances(rtol=tol.snes_rtol, atol=tol.snes_atol, stol=tol.snes_stol, max_it=tol.snes_max_it)
-    ksp = snes.getKSP()
-    ksp.setType("gmres")
-    ksp.setTolerances(rtol=tol.ksp_rtol, atol=tol.ksp_atol, max_it=tol.ksp_max_it)
-    setup_pc(ksp.getPC(), bordered)
-    snes.setLineSearchPreCheck(precheck)
-    snes.setFromOptions()
+    try:            # an option refused (a type name PETSc does not know): the SNES would outlive the call
+        snes.setOptionsPrefix(prefix)
+        snes.setFunction(function, residual)
+        snes.setJacobian(jacobian, J, P)
+        snes.setType("newtonls")
+        if full_steps:
+            capi.set_linesearch_type(snes, "basic")
+        snes.setTolerances(rtol=tol.snes_rtol, atol=tol.snes_atol, stol=tol.snes_stol, max_it=tol.snes_max_it)
+        ksp = snes.getKSP()
+        ksp.setType("gmres")
+        ksp.setTolerances(rtol=tol.ksp_rtol, atol=tol.ksp_atol, max_it=tol.ksp_max_it)
+        setup_pc(ksp.getPC(), bordered)
+        snes.setLineSearchPreCheck(precheck)
+        snes.setFromOptions()
+    except BaseException:
+        snes.destroy()
+        raise
     return snes
 
 
@@ -185,13 +189,19 @@ class Newton:
     """
 
     def __init__(self, problem, prefix: str = "", full_steps: bool = False, pc_reuse_its: int = PC_REUSE_ITS):
-        self.pb, self.p = problem, 0.0
+        self.pb, self.p, self.snes = problem, 0.0, None
         self.pmat = problem.create_pmat(bordered=False)
         self.reuse = PCReuse(pc_reuse_its)
-        self.work = problem.create_vec()
-        self.snes = create_snes(problem.comm, prefix, self._function, problem.create_vec(), self._jacobian,
-                                problem.jacobian, self.pmat or problem.jacobian, problem.setup_pc,
-                                self._precheck, full_steps)
+        self.work, residual = problem.create_vec(), problem.create_vec()
+        try:
+            self.snes = create_snes(problem.comm, prefix, self._function, residual, self._jacobian,
+                                    problem.jacobian, self.pmat or problem.jacobian, problem.setup_pc,
+                                    self._precheck, full_steps)
+        except BaseException:           # a solver option refused: free what is made
+            self.destroy()
+            raise
+        finally:
+            residual.destroy()          # the SNES holds its own reference
 
     def _function(self, snes, x, G):
         self.pb.residual(x, self.p, G)

@@ -199,7 +199,8 @@ for i in range(2):
     out["solves"].append([s.H.tolist(), s.P.tolist(), s.F])
     out["after"].append(live())
 for call, bad in ((pa.curve, {"arc_snes_rtoll": 1}), (pa.curve, {"cont_ds_min": 2}),
-                  (pa.solve, {"snes_max_it": 1}), (pa.solve, {"snes_rtoll": 1})):
+                  (pa.curve, {"nat_pc_type": "nonesuch"}), (pa.curve, {"arc_ksp_type": "nonesuch"}),
+                  (pa.solve, {"snes_max_it": 1}), (pa.solve, {"snes_rtoll": 1}), (pa.solve, {"pc_type": "nonesuch"})):
     try:
         call(*([-2.0] if call is pa.solve else []), mu=1.0, grid_type="uniform", grid_n=101,
              **({} if call is pa.solve else {"cont_F_max": 0}), **bad)
@@ -217,7 +218,7 @@ def test_repeated_calls_are_identical_and_free_their_objects(tmp_path):
                           cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout.splitlines()[-1])
-    assert out["before"] == [] and out["after"] == [[]] * 6, out["after"]
+    assert out["before"] == [] and out["after"] == [[]] * 9, out["after"]
     for first, second in (out["curves"], out["solves"]):
         for a, b in zip(first, second):
             np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
