@@ -258,6 +258,11 @@ def _pm(e: dict, key: str, digits: int = 8) -> str:
     return f"{key} = {e[key]:.{digits}f}" + ("" if bar is None or bar == 0 else f" +- {bar:.1e}")
 
 
+def _note(e: dict) -> str:
+    """Why an event has no bar, when it has none."""
+    return "  (no error bar: not found again on the nested levels)" if e.get("error_note") else ""
+
+
 def report_curve(s: dict) -> None:
     """The console lines of a curve's summary (rank 0)."""
     out = []
@@ -266,15 +271,15 @@ def report_curve(s: dict) -> None:
     out.append(f"mu = {s['mu']:g}  sigma = {s['sigma']:g}  N = {s['n_nodes']}  steps {s['steps']} "
                f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s{extra}; stopped: {s['stop_reason']}")
     if po:
-        out.append(f"  pull-off (load control)  {_pm(po, 'lambda')}  {_pm(po, 'F')}")
+        out.append(f"  pull-off (load control)  {_pm(po, 'lambda')}  {_pm(po, 'F')}{_note(po)}")
     for f in s["folds"]:
         land = f.get("landing")
         to = f"  -> lands at {_pm(land, 'F')}" if land else ""
-        out.append(f"  {f['kind']:<23}  {_pm(f, 'lambda')}  {_pm(f, 'F')}{to}")
+        out.append(f"  {f['kind']:<23}  {_pm(f, 'lambda')}  {_pm(f, 'F')}{to}{_note(f)}")
     for e in s["equilibria"]:
-        out.append(f"  equilibrium F = 0       {_pm(e, 'lambda')}")
+        out.append(f"  equilibrium F = 0       {_pm(e, 'lambda')}{_note(e)}")
     for e in s["at_lambda"]:
-        out.append(f"  at lambda               {_pm(e, 'lambda')}  {_pm(e, 'F')}")
+        out.append(f"  at lambda               {_pm(e, 'lambda')}  {_pm(e, 'F')}{_note(e)}")
     if "physical" in s:
         out += _physical_lines(s["physical"])
     for w in s["warnings"]:

@@ -585,3 +585,34 @@ def test_lambda_max_stops_there(lambda_max, lmax):
     # nothing beyond is reported: the equilibrium (2.07) lies past both limits
     assert s["equilibria"] == []
     assert all(e["lambda"] <= lmax for e in s["folds"] + s["load_extrema"])
+
+
+def test_secondary_fold_pair_is_born_between_mu_3_5_and_4(tmp_path):
+    """At mu = 4 a secondary fold pair sits on the unstable branch near lambda = -4.02, less than 1e-3 wide;
+    an independent grid (uniform, spacing 0.01 on r_m = 5) has it too, and mu = 3.5 has none on either
+    (the paper shows it from mu = 5).  Its snap-on is not found again on the nested levels: no bar, and
+    the file and the console say why."""
+    window = ("-cont_F_max", "0", "-cont_lambda_max", "-3.0")
+    uniform = ("-grid_type", "uniform", "-grid_n", "501", "-adh_rmax", "5", "-cont_error_estimate", "false")
+    runs = [(mu, kind) for mu in (3.5, 4) for kind in ("default", "uniform")]
+
+    def one(key):
+        mu, kind = key
+        summary = tmp_path / f"{mu}_{kind}.json"
+        proc = run_cli("-adh_mu", mu, *window, *(uniform if kind == "uniform" else ()), "-summary", summary)
+        assert proc.returncode == 0, proc.stderr
+        return json.loads(summary.read_text()), proc.stdout
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        got = dict(zip(runs, pool.map(one, runs)))
+    for kind in ("default", "uniform"):
+        assert [f["kind"] for f in got[(3.5, kind)][0]["folds"]] == ["snap_on", "snap_off"], kind
+        folds = got[(4, kind)][0]["folds"]
+        assert [f["kind"] for f in folds] == ["snap_on", "snap_off", "snap_on", "snap_off"], kind
+        pair = folds[1:3]
+        assert 0 < abs(pair[0]["lambda"] - pair[1]["lambda"]) < 1e-3, (kind, pair)
+        assert -4.04 < pair[0]["lambda"] < -4.0, (kind, pair)
+    summary, stdout = got[(4, "default")]
+    bare = [f for f in summary["folds"] if "lambda_err" not in f]
+    assert all(f.get("error_note", "").startswith("no error bar") for f in bare)
+    assert stdout.count("(no error bar: not found again on the nested levels)") == len(bare)
