@@ -424,12 +424,10 @@ class Checkpoint:
         """Whether there is a saved state to restart from (rank 0 knows; False elsewhere)."""
         return bool(self.path) and self.rank0 and os.path.isfile(self.path)
 
-    def remove(self) -> None:
-        """The run is done: its checkpoint goes (rank 0), and the one it restarted from."""
-        if self.rank0:
-            for path in {self.path, self.restart} - {None}:
-                if os.path.isfile(path):
-                    os.remove(path)
+    def paths(self) -> list[str]:
+        """What the run's results replace (rank 0; none elsewhere): its checkpoint and the one it restarted
+        from, removed as they are put in place (:class:`~petsc_adhesion.files.ResultSet`)."""
+        return sorted({self.path, self.restart} - {None, ""}) if self.rank0 else []
 
 
 def open_checkpoint(opts, targets: dict, inputs: dict, comm, study: bool = False) -> Checkpoint:

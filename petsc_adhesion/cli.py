@@ -6,7 +6,9 @@
 Exit status: 0 done; 1 failed (no result); 2 bad input (one line naming the
 option, nothing written); 3 result written but not what was asked for
 (a stalled curve, an event not reached: its warnings say why); 130 and 143
-interrupted by SIGINT or SIGTERM (nothing written).  Every error is one line
+interrupted by SIGINT or SIGTERM (nothing written; one that comes once the
+results are in place is said in one line, and the run ends with its own
+status).  Every error is one line
 on stderr from rank 0; no traceback reaches the user.
 """
 from __future__ import annotations
@@ -16,7 +18,7 @@ import sys
 from contextlib import nullcontext
 
 from .errors import Interrupted
-from .files import printable
+from .files import printable, said_after
 from .optionsfile import environment_error, file_error, options_files, stray_word
 
 __all__ = ["main", "input_error", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
@@ -64,6 +66,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return _main(argv)
     except Interrupted as e:
+        if e.done is not None:                     # rank 0's results were in place
+            said_after(e.signum)
+            return e.done
         _say(f"interrupted by {signal.Signals(e.signum).name}; nothing written"
              + (f"; go on with -cont_restart {printable(e.restart)}" if e.restart else ""))
         return 128 + e.signum

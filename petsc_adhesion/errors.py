@@ -15,3 +15,4 @@ class Interrupted(BaseException):
         super().__init__(signum)
         self.signum = signum
         self.restart = None          # the checkpoint to go on from (-cont_restart), once one is saved
+        self.done = None             # the run's exit status when the signal came after its results were written

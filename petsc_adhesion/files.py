@@ -4,7 +4,7 @@ Each output is written to a temporary beside its target, ``.NAME.partial-HOST-PI
 created with the umask's mode.  When every output of the run is complete, a
 journal ``.NAME.commit`` (next to the first output) lists the renames; the
 temporaries are renamed into place with SIGINT and SIGTERM held, and the
-journal is removed.  A run that fails or is killed before the journal leaves
+journal is removed, and with it what the set replaces (the run's checkpoint).  A run that fails or is killed before the journal leaves
 the earlier set untouched; one killed (kill -9) within the microseconds of
 the renames leaves its journal, and the next run that writes any of those
 names completes them first (roll forward).  Temporaries of dead runs on this
@@ -26,7 +26,8 @@ from contextlib import contextmanager
 
 from .errors import InputError, Interrupted
 
-__all__ = ["check_targets", "ResultSet", "written", "atomic_write", "PLOT_FORMATS", "printable", "JOURNAL"]
+__all__ = ["check_targets", "ResultSet", "written", "mark_done", "said_after", "atomic_write", "PLOT_FORMATS", "printable",
+           "JOURNAL"]
 
 #: Figure formats by file extension.
 PLOT_FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
@@ -167,8 +168,9 @@ class ResultSet:
     >>> rs.commit()                                             # doctest: +SKIP
     """
 
-    def __init__(self, targets: dict):
+    def __init__(self, targets: dict, drop=()):
         self.targets = {k: v for k, v in targets.items() if v}
+        self.drop = [p for p in drop if p]         # what the set replaces: gone once it is in place
         self.temps = {}
         self.committed = False
         self.recover()
@@ -211,8 +213,6 @@ class ResultSet:
     def commit(self) -> None:
         """Rename every written temporary into place, together (see the module's docstring)."""
         renames = [(self.temps[k], os.path.abspath(self.targets[k])) for k in self.targets if k in self.temps]
-        if not renames:
-            return
         journals = {}                              # one beside the first output of each folder
         for _, final in renames:
             journals.setdefault(os.path.dirname(final), _journal(final))
@@ -228,6 +228,9 @@ class ResultSet:
             self.committed = True
             for journal in journals.values():
                 os.remove(journal)
+            for path in self.drop:
+                if os.path.isfile(path):
+                    os.remove(path)
         self.temps = {}
 
     def discard(self) -> None:
@@ -238,19 +241,32 @@ class ResultSet:
         self.temps = {}
 
 
-@contextmanager
-def written(targets: dict):
-    """A :class:`ResultSet` for the block, discarded after it.  A signal held during the renames
-    that comes once the set is complete is said in one line, and the run ends as done."""
+def mark_done(e: Interrupted, files: ResultSet | None, status: int) -> None:
+    """A signal that came once ``files`` were in place ends the run as done with ``status``
+    (:attr:`~petsc_adhesion.errors.Interrupted.done`; the command line says so)."""
+    if files is not None and files.committed:
+        e.done = status
+
+
+def said_after(signum: int) -> None:
+    """One line: a signal came once the run's results were in place (the run ends as done)."""
     import sys
 
-    files = ResultSet(targets)
+    print(f"petsc-adhesion: {signal.Signals(signum).name} came after the results were written", file=sys.stderr,
+          flush=True)
+
+
+@contextmanager
+def written(targets: dict, drop=()):
+    """A :class:`ResultSet` for the block (``drop``: the files it replaces), discarded after it.  A
+    signal held during the renames that comes once the set is complete is said in one line, and the run
+    ends as done; one that comes after the block is the caller's (:attr:`Interrupted.done`)."""
+    files = ResultSet(targets, drop)
     try:
         yield files
     except Interrupted as e:
         if not files.committed:
             raise
-        print(f"petsc-adhesion: {signal.Signals(e.signum).name} came after the results were written",
-              file=sys.stderr, flush=True)
+        said_after(e.signum)
     finally:
         files.discard()

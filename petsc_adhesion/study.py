@@ -22,7 +22,8 @@ from .adaptive import Tracer, grid_for
 from .checkpoint import open_checkpoint
 from .continuation import Continuation, Settings
 from .events import jumps
-from .files import PLOT_FORMATS, check_targets, printable, written
+from .errors import Interrupted
+from .files import PLOT_FORMATS, check_targets, mark_done, printable, written
 from .influence import create_influence
 from .model import Model
 from .optionsfile import options_files
@@ -277,20 +278,23 @@ def main(argv: list[str] | None = None, keep: dict | None = None) -> int:
         grid = {"r": r}
     check_unused()
     status = 3 if p.lam is None and res["incomplete"] else 0
-    if comm.getRank() == 0:
-        about = head(comm, opts, p.model, grid)
-        with ck.on_interrupt() if ck else nullcontext(), written(p.targets) as files:
-            if p.lam is None:
-                summary = write_curve(res, about, files)
-                if keep is None:
-                    results.report_curve(summary)
-            else:
-                summary = write_solve(res, about, files)
-                if keep is None:
-                    results.report_solve(res, summary.get("physical"))
-        if keep is not None:
-            keep |= {"result": res, "head": about, "summary": summary}
-    if ck:
-        ck.remove()
-    PETSc.garbage_cleanup()
+    files = None
+    try:
+        if comm.getRank() == 0:
+            about = head(comm, opts, p.model, grid)
+            with ck.on_interrupt() if ck else nullcontext(), written(p.targets, ck.paths() if ck else ()) as files:
+                if p.lam is None:
+                    summary = write_curve(res, about, files)
+                    if keep is None:
+                        results.report_curve(summary)
+                else:
+                    summary = write_solve(res, about, files)
+                    if keep is None:
+                        results.report_solve(res, summary.get("physical"))
+            if keep is not None:
+                keep |= {"result": res, "head": about, "summary": summary}
+        PETSc.garbage_cleanup()
+    except Interrupted as e:
+        mark_done(e, files, status)
+        raise
     return status

@@ -40,8 +40,8 @@ from petsc4py import PETSc
 
 from . import capi, preconditioning
 from .checkpoint import open_checkpoint
-from .errors import InputError
-from .files import check_targets, written
+from .errors import InputError, Interrupted
+from .files import check_targets, mark_done, written
 from .options import TABLE, AppOptions, check_unused, collective, read_model
 from .optionsfile import options_files
 from .output import curve_summary, curve_tree, write_critical, write_study
@@ -274,20 +274,23 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
             print(f"petsc-adhesion: case {c.index + 1} ({c.label}) left out: {c.error}", file=sys.stderr, flush=True)
     if helping:
         return 0
-    with journal.on_interrupt():
-        records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
-                         lambda c, comm: _run(c, given, argv, comm, compute, keep), _brief, journal)
-        status = 0
-        if mpi.Get_rank() == 0:
-            failed = [_failure(c, c.error) for c in bad] + _failures(records)
-            done = [r for r in records if "error" not in r]
-            study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
-                     "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
-            with written(targets) as files:
-                write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
-            status = 3 if failed or any(r["incomplete"] for r in done) else 0
-    journal.remove()
-    return mpi.bcast(status, root=0)
+    files, status = None, 0
+    try:
+        with journal.on_interrupt():
+            records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
+                             lambda c, comm: _run(c, given, argv, comm, compute, keep), _brief, journal)
+            if mpi.Get_rank() == 0:
+                failed = [_failure(c, c.error) for c in bad] + _failures(records)
+                done = [r for r in records if "error" not in r]
+                study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
+                         "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
+                status = 3 if failed or any(r["incomplete"] for r in done) else 0
+                with written(targets, journal.paths()) as files:
+                    write_study(program(world, opts), study, done, sorted(failed, key=lambda r: r["case"]), files)
+        return mpi.bcast(status, root=0)
+    except Interrupted as e:
+        mark_done(e, files, status)
+        raise
 
 
 def _files(opts: AppOptions, argv: list[str]):
@@ -356,20 +359,24 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
     targets, journal = _files(opts, argv)
     if helping:
         return 0
-    with journal.on_interrupt():
-        records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, comm), _cusp_brief, journal)
-        status = 0
-        if mpi.Get_rank() == 0:
-            failed = _failures(records)
-            done = [r for r in records if "error" not in r]
-            study = {"compute": "critical", "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
-                     "cases": len(todo), "plot": "critical"}
-            with written(targets) as files:
-                write_critical(program(world, opts), study, done, failed, files)
-            status = 3 if failed else 0
-    journal.remove()
-    check_unused()
-    return mpi.bcast(status, root=0)
+    files, status = None, 0
+    try:
+        with journal.on_interrupt():
+            records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, comm), _cusp_brief,
+                             journal)
+            if mpi.Get_rank() == 0:
+                failed = _failures(records)
+                done = [r for r in records if "error" not in r]
+                study = {"compute": "critical", "axes": [n for n, _ in axes],
+                         "ranks_per_case": opts.int("study_ranks"), "cases": len(todo), "plot": "critical"}
+                status = 3 if failed else 0
+                with written(targets, journal.paths()) as files:
+                    write_critical(program(world, opts), study, done, failed, files)
+        check_unused()
+        return mpi.bcast(status, root=0)
+    except Interrupted as e:
+        mark_done(e, files, status)
+        raise
 
 
 def _cusp(c: Case, model, comm) -> dict | None:
