@@ -40,14 +40,19 @@ FLOOR = 6e-4
 def relocate(tracer, seg, found, level: int, target=None):
     """The event ``found`` of segment ``seg`` located on ``seg``'s grid at refinement ``level``.
 
-    Starts from the step's first point, carried to that level, and traces with
-    steps no longer than the step that found the event until the event's test
-    function changes sign.  ``target``: for a landing, the approach to find
-    (the fold's own at that level).  Returns the located point, or None.
+    Starts from the point before the step that found it (an extremum of F, flat
+    about itself, may move on another level by more than a step's part: mu = 3,
+    sigma = 0.2, the pull-off moved back past the step's first point), carried
+    to that level, and traces with steps no longer than the step that found the
+    event until the event's test function changes sign; of several such events,
+    the one nearest in lambda.  ``target``: for a landing, the approach to find
+    (the fold's own at that level), from the step's first point.  Returns the
+    located point, or None.
     """
     j = found.segment if target is None else found.landing_step
     owner = seg if target is None else next(s for s in tracer.segments if s.finder is found.landing_by)
     a, b = owner.cont.points[j], owner.cont.points[j + 1]
+    back = owner.cont.points[j - 1] if target is None and j > 0 else a
     event = found.event if target is None else ParameterValue(target, "landing")
     length = max(b.ds, 1e-3) if b.ds else 0.05
     settings = replace(tracer.set, ds=length / 2, ds_max=length, max_steps=LOCAL_STEPS, max_folds=10**6,
@@ -56,22 +61,23 @@ def relocate(tracer, seg, found, level: int, target=None):
     new = tracer.segment(owner.kind, at, level=level, settings=settings,
                          band=owner.grid.band if owner.kind == "scaled" else None)
     try:
-        start = _carry_start(owner, new, a)
+        start = _carry_start(owner, new, back)
         if start is None:
             return None
         finder = EventFinder(new.cont, [event], tracer.tol or 1e-10)
         if target is not None and (a.p - target) * (b.p - target) > 0 and abs(a.p - target) > 2 * length:
             return None
-        direction = 1 if target is None else 1
-        travelled = [0.0]
+        behind = a.ds if back is not a and a.ds else 0.0        # an event found there may be another
 
         def far(u, v):
             travelled[0] += v.ds
-            return bool(finder.found) or travelled[0] > 4 * length * direction
+            return bool(finder.found) and travelled[0] > behind or travelled[0] > 4 * length + behind
+
+        travelled = [0.0]
 
         new.cont.run(start, on_step=finder, until=far)
         hits = [f for f in finder.found if f.label == found.label] if target is None else finder.found
-        return hits[0].point if hits else None
+        return min(hits, key=lambda f: abs(f.point.p - found.point.p)).point if hits else None
     finally:
         new.destroy()
 

@@ -66,3 +66,17 @@ def test_bars_cover_a_refined_truth(tmp_path, refined, target):
             assert abs(e[q] - t[q]) <= e[f"{q}_err"] + t[f"{q}_err"], (kind, q, e[q], t[q], e[f"{q}_err"])
             if target:
                 assert e[f"{q}_err"] <= target, (kind, q)
+
+
+def test_a_flat_pull_off_gets_its_bar(tmp_path):
+    """mu = 3, sigma = 0.2: F is so flat about the pull-off (2e-6 over 0.01 in lambda) that on the finer
+    levels its lambda lies 0.024 back, behind the first point of the step that found it.  Its levels'
+    traces start a step further back: it has a bar (before: none, 'not found again'), and the bars cover
+    a run refined to 1e-6 (measured: lambda 2.7e-3 off with a bar of 6.8e-3, F 1.1e-6 with 2.8e-6)."""
+    args = ("-adh_mu", 3, "-adh_sigma", 0.2, "-cont_F_max", 0)
+    po, ref = (summary(tmp_path, name, *args, *extra)["pull_off"]
+               for name, extra in (("run", ()), ("refined", ("-target_error", 1e-6))))
+    assert "error_note" not in po and ref["lambda_err"] <= 1e-6 and ref["F_err"] <= 1e-6
+    for q in ("lambda", "F"):
+        assert abs(po[q] - ref[q]) <= po[f"{q}_err"] + ref[f"{q}_err"], (q, po[q], ref[q], po[f"{q}_err"])
+        assert abs(po[f"{q}_grid"] - ref[q]) > ref[f"{q}_err"]         # a grid value that needs its bar
