@@ -21,7 +21,8 @@ log10 error against log10 median wall time, one marked line per method.
   numpy/scipy implementation (:func:`numpy_curve`, mu = 1, paper grid) and the
   stored ContactMechanics + Adhesion runs (mu = 1, docs/data/peer_contactmechanics.json).
 * Speed (item 7): the mu = 1 default curve with and without bars, the whole process,
-  the pull-off to 1e-6 and 1e-8, against the issue's targets.
+  the pull-off to 1e-6 and 1e-8, against the issue's targets; where the curve's time
+  goes (:func:`profile`: cProfile's own time of every function, summed by where it runs).
 * Scaling (item 8): a fixed-approach solve and continuation steps on uniform grids
   N = 100 .. 8000, 1 and 2 ranks, dense and band, each in its own process
   (``python -m petsc_adhesion.workprecision scale N PMAT STEPS``), with its peak
@@ -478,6 +479,58 @@ def speed(quick: bool = False, log=print) -> dict:
     return out
 
 
+#: stages of a curve with bars, each the cumulative time of one function (file, name); they nest
+PROFILE_STAGES = (("influence matrices (17 grids and their nested levels)", "influence.py", "create_influence"),
+                  ("event location (roots along the arcs)", "events.py", "_root"),
+                  ("error bars (events located again on the nested levels)", "error_estimate.py", "event_errors"))
+
+
+def _where(path: str, name: str) -> str:
+    """Where a profiled function runs: PETSc's or numpy's or scipy's compiled code, a module of ours, or
+    other Python."""
+    if path == "~":                                   # compiled: said by its name
+        for lib, label in (("petsc4py", "PETSc, compiled (LU, triangular solves, GMRES, vector operations)"),
+                           ("numpy", "numpy, compiled (the dense products of the operator, array arithmetic)"),
+                           ("scipy", "scipy, compiled (Brent's method, elliptic integrals)")):
+            if lib in name:
+                return label
+        return "Python's built-ins"
+    if "/petsc_adhesion/" in path:
+        return f"petsc_adhesion.{os.path.basename(path)[:-3]} (Python)"
+    for lib in ("numpy", "scipy", "petsc4py"):
+        if f"/{lib}/" in path:
+            return f"{lib} (its Python)"
+    return "other Python"
+
+
+def profile(log=print) -> dict:
+    """Where the mu = 1 curve with bars spends its time (issue 9, item 7): one run under cProfile after a
+    warm one, the own time of every function summed by :func:`_where`, and the cumulative time of
+    :data:`PROFILE_STAGES`.  cProfile slows the Python side, so shares, not times, are the measurement."""
+    import cProfile
+    import pstats
+
+    model = Model(mu=1.0, rmax=RMAX)
+    _trace(model, None, errors=True)
+    prof = cProfile.Profile()
+    prof.enable()
+    _trace(model, None, errors=True)
+    prof.disable()
+    stats = pstats.Stats(prof).stats                  # (file, line, name) -> (cc, nc, own, cumulative, callers)
+    own = {}
+    for (path, _, name), (_, _, tt, _, _) in stats.items():
+        where = _where(path, name)
+        own[where] = own.get(where, 0.0) + tt
+    total = sum(own.values())
+    stages = {label: sum(ct for (path, _, name), (_, _, _, ct, _) in stats.items()
+                         if path.endswith("/" + file) and name == fn) for label, file, fn in PROFILE_STAGES}
+    solves = sum(v[1] for (path, _, name), v in stats.items() if path == "~" and "PETSc.SNES" in name
+                 and "solve" in name)
+    log(f"[profile] {total:.3g} s under cProfile, {solves} SNES solves")
+    return {"total_s": total, "snes_solves": solves, "stages": stages,
+            "own": dict(sorted(own.items(), key=lambda kv: -kv[1]))}
+
+
 #: What a start-up costs, stage by stage: each a fresh interpreter running only that code, with
 #: petsc-adhesion's Open MPI singleton defaults (:mod:`petsc_adhesion.singleton`) unless the third item is False.
 STARTUP = (("Python interpreter", "pass", True), ("numpy", "import numpy", True),
@@ -724,6 +777,26 @@ def _speed_table(rows: dict) -> str:
         lines.append(f"| {r['quantity']} | {_t(r['median_s'])} | {_t(r['min_s'])} | {_t(r['max_s'])} | {r['repeats']} | "
                      f"{'-' if r['target_s'] is None else _t(r['target_s'])} | {met} |")
     return "\n".join(lines)
+
+
+def _profile_lines(pr: dict, bars: dict) -> list[str]:
+    """Where the curve's time goes, from :func:`profile`, against the curve-with-bars row ``bars``."""
+    total = pr["total_s"]
+    rows = [(k, v) for k, v in pr["own"].items() if v >= 0.01 * total]
+    rest = total - sum(v for _, v in rows)
+    table = "| where | own time | share |\n|---|---|---|\n" + "\n".join(
+        f"| {k} | {_t(v)} | {100 * v / total:.0f}% |" for k, v in rows) + \
+        f"\n| everything else (each below 1%) | {_t(rest)} | {100 * rest / total:.0f}% |"
+    top, share = rows[0][0], rows[0][1] / total
+    stages = "; ".join(f"{k} {_t(v)} ({100 * v / total:.0f}%)" for k, v in pr["stages"].items())
+    return ["Where the curve's time goes: the mu = 1 curve with error bars once under cProfile "
+            f"(`petsc_adhesion.workprecision.profile`, after a warm run; the profiler slows the Python side, so "
+            f"the shares are the measurement): {_t(total)} in all, {pr['snes_solves']} SNES solves.  Own time of "
+            f"every function, summed by where it runs:", "", table, "",
+            f"Stages (cumulative, they nest): {stages}.  The largest single place is {top} with "
+            f"{100 * share:.0f}% (under the profiler, which inflates the Python places); the curve with bars "
+            f"({_t(bars['median_s'])}) is {100 * (bars['median_s'] / bars['target_s'] - 1):+.0f}% from its target "
+            f"({_t(bars['target_s'])}).", ""]
 
 
 def _startup_lines(data: dict) -> list[str]:
@@ -1057,6 +1130,8 @@ def render(data: dict) -> str:
           f"The whole process minus the in-process curve with bars (medians): "
           f"{_t(data['speed']['speed_process']['median_s'] - data['speed']['speed_curve_bars']['median_s'])} of "
           f"start-up (Python, numpy, petsc4py and MPI initialisation, imports, option checks) and output files.", ""]
+    if "profile" in data:
+        L += _profile_lines(data["profile"], data["speed"]["speed_curve_bars"])
     if "startup" in data:
         L += _startup_lines(data)
     sc = data["scaling"]
@@ -1113,11 +1188,12 @@ def run(quick: bool = False, write: bool = True, log=print, dump: str | None = D
     load0 = os.getloadavg()
     cases = [measure(c, quick, log) for c in CASES]
     rows = speed(quick, log)
+    prof = profile(log)
     start = startup(1 if quick else REPEATS)
     scale = scaling((100, 200, 500) if quick else SCALE_N, quick, log)
     data = {"machine": machine(), "load_before": load0, "load_after": os.getloadavg(),
             "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "total_s": time.perf_counter() - t0,
-            "quick": quick, "cases": cases, "speed": rows, "startup": start, "scaling": scale}
+            "quick": quick, "cases": cases, "speed": rows, "profile": prof, "startup": start, "scaling": scale}
     if dump:
         with open(dump, "w") as f:
             json.dump(data, f)
@@ -1135,5 +1211,12 @@ if __name__ == "__main__":
     elif len(sys.argv) >= 3 and sys.argv[1] == "docs":      # re-render the documents from a dump of run()
         with open(sys.argv[2]) as f:
             write_docs(json.load(f))
+    elif len(sys.argv) >= 3 and sys.argv[1] == "profile":   # profile() measured again into a dump, re-rendered
+        with open(sys.argv[2]) as f:
+            kept = json.load(f)
+        kept["profile"] = profile()
+        with open(sys.argv[2], "w") as f:
+            json.dump(kept, f)
+        write_docs(kept)
     else:
         print(__doc__)
