@@ -13,8 +13,8 @@ They are checked as the command line checks them (the same one-line
 and PETSc's options (``arc_snes_rtol=1e-10``, ``pc_type="lu"``) reach its solvers;
 ``PETSC_OPTIONS`` and ``.petscrc`` are read as at the command line's start.  Each run
 has an options database of its own, so runs in one process do not see each other's
-options, nor the caller's; a run destroys the PETSc objects it makes, failed runs too (but
-for the few of a solver whose PETSc type name does not exist, ``pc_type="nonesuch"``).
+options, nor the caller's; a run destroys the PETSc objects it makes, failed runs too (a
+PETSc type name that does not exist, ``pc_type="nonesuch"``, included).
 ``out=``, ``summary=`` and ``plot=`` write the command line's files, all or nothing.
 
 PETSc is initialised on the first call, not on ``import petsc_adhesion``.  Under
