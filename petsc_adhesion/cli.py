@@ -17,7 +17,7 @@ import signal
 import sys
 from contextlib import nullcontext
 
-from .errors import Interrupted
+from .errors import Interrupted, say
 from .files import printable, said_after
 from .optionsfile import environment_error, file_error, options_files, stray_word
 
@@ -35,7 +35,7 @@ def _say(msg: str) -> None:
     from mpi4py import MPI
 
     if MPI.COMM_WORLD.Get_rank() == 0:
-        print(f"petsc-adhesion: error: {printable(msg)}", file=sys.stderr, flush=True)
+        say(f"error: {printable(msg)}")
 
 
 def _first_line(e: BaseException) -> str:
@@ -141,8 +141,7 @@ def _main(argv: list[str]) -> int:
         _say(what)
         return EXIT_FAILED
     except Exception as e:                                  # a defect: still one line, no hang
-        print(f"petsc-adhesion: internal error on rank {MPI.COMM_WORLD.Get_rank()}: "
-              f"{type(e).__name__}: {printable(_first_line(e))}", file=sys.stderr, flush=True)
+        say(f"internal error on rank {MPI.COMM_WORLD.Get_rank()}: {type(e).__name__}: {printable(_first_line(e))}")
         if MPI.COMM_WORLD.Get_size() > 1:
             MPI.COMM_WORLD.Abort(EXIT_FAILED)
         return EXIT_FAILED

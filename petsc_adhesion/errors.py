@@ -1,6 +1,19 @@
-"""The program's exception for bad input, shared by every module that checks input."""
+"""The program's exceptions for bad input and for signals, and its one-line messages."""
+import sys
 
-__all__ = ["InputError", "Interrupted"]
+__all__ = ["InputError", "Interrupted", "say"]
+
+
+def say(text: str, stream=None) -> None:
+    """``petsc-adhesion: TEXT`` as one line on ``stream`` (stderr), text and newline in one write.
+
+    ``print`` writes them apart, and a SIGTERM between the two (its handler raises
+    :class:`Interrupted` from inside the write) left a progress line without its
+    newline, so the run's last line, which names the checkpoint, was joined to it.
+    """
+    stream = stream or sys.stderr
+    stream.write(f"petsc-adhesion: {text}\n")
+    stream.flush()
 
 
 class InputError(Exception):

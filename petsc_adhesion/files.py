@@ -24,7 +24,7 @@ import socket
 import stat
 from contextlib import contextmanager
 
-from .errors import InputError, Interrupted
+from .errors import InputError, Interrupted, say
 
 __all__ = ["check_targets", "ResultSet", "written", "mark_done", "said_after", "atomic_write", "PLOT_FORMATS", "printable",
            "JOURNAL"]
@@ -250,10 +250,7 @@ def mark_done(e: Interrupted, files: ResultSet | None, status: int) -> None:
 
 def said_after(signum: int) -> None:
     """One line: a signal came once the run's results were in place (the run ends as done)."""
-    import sys
-
-    print(f"petsc-adhesion: {signal.Signals(signum).name} came after the results were written", file=sys.stderr,
-          flush=True)
+    say(f"{signal.Signals(signum).name} came after the results were written")
 
 
 @contextmanager

@@ -185,7 +185,7 @@ def command(args: list[str]) -> int:
     """
     import os
 
-    from .errors import InputError
+    from .errors import InputError, say
     from .files import PLOT_FORMATS, check_targets, written
 
     if args in (["-h"], ["-help"], ["--help"]):
@@ -205,7 +205,7 @@ def command(args: list[str]) -> int:
             _draw(kind, src, files.temp("o"), PLOT_FORMATS[ext])
             files.commit()
     except InputError as e:
-        print(f"petsc-adhesion: error: {e}", file=sys.stderr, flush=True)
+        say(f"error: {e}")
         return 2
     return 0
 

@@ -23,6 +23,7 @@ import time
 
 from scipy.optimize import brentq
 
+from .errors import say
 from .reference import jkr_approach, jkr_load
 
 __all__ = ["Progress", "clock", "curve_end", "curve_status", "INTERVAL"]
@@ -90,7 +91,7 @@ class Progress:
         elapsed = now - self.t0
         done = min(max(done, 0.0), 1.0)
         left = f", about {clock(elapsed * (1.0 - done) / done)} left" if done > 0 else ""
-        print(f"petsc-adhesion: {text}, {clock(elapsed)} elapsed{left}", file=self.stream, flush=True)
+        say(f"{text}, {clock(elapsed)} elapsed{left}", self.stream)
 
 
 def curve_end(model, settings) -> float:

@@ -31,7 +31,6 @@ uninterrupted run's.  A case cut off mid-way runs again from its start.
 from __future__ import annotations
 
 import itertools
-import sys
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -40,7 +39,7 @@ from petsc4py import PETSc
 
 from . import capi, preconditioning
 from .checkpoint import open_checkpoint
-from .errors import InputError, Interrupted
+from .errors import InputError, Interrupted, say
 from .files import check_targets, mark_done, written
 from .options import TABLE, AppOptions, check_unused, collective, read_model
 from .optionsfile import options_files
@@ -230,8 +229,8 @@ class _Progress:
         elapsed = time.perf_counter() - self.t0
         left = elapsed * max(self.total - self.done, 0.0) / self.done if self.done else float("nan")
         what = record.get("error") or record.get("what", "")
-        print(f"petsc-adhesion: case {rec['case'] + 1} ({record['label']}) {what}; {self.count}/{self.n} done, "
-              f"{clock(elapsed)} elapsed, about {clock(left)} left", file=sys.stderr, flush=True)
+        say(f"case {rec['case'] + 1} ({record['label']}) {what}; {self.count}/{self.n} done, "
+            f"{clock(elapsed)} elapsed, about {clock(left)} left")
 
 
 def _brief(record: dict) -> dict:
@@ -271,7 +270,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
         raise InputError(bad[0].error)
     if mpi.Get_rank() == 0:
         for c in bad:
-            print(f"petsc-adhesion: case {c.index + 1} ({c.label}) left out: {c.error}", file=sys.stderr, flush=True)
+            say(f"case {c.index + 1} ({c.label}) left out: {c.error}")
     if helping:
         return 0
     files, status = None, 0
@@ -317,8 +316,8 @@ def spread(todo: list[Case], ranks: int, work, brief, journal) -> list[dict] | N
     done, records = journal.cases()
     todo = [c for c in todo if c.index not in done]
     if done and mpi.Get_rank() == 0:
-        print(f"petsc-adhesion: going on from the checkpoint {journal.restart}: {len(done)} case"
-              f"{'s' * (len(done) != 1)} done, {len(todo)} to run", file=sys.stderr, flush=True)
+        say(f"going on from the checkpoint {journal.restart}: {len(done)} case"
+            f"{'s' * (len(done) != 1)} done, {len(todo)} to run")
     color = mpi.Get_rank() // ranks
     plan_of = assign(todo, mpi.Get_size() // ranks)
     sub = mpi.Split(color, mpi.Get_rank())

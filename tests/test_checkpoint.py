@@ -329,6 +329,30 @@ def test_progress_lines(reference):
     assert steps == sorted(steps) and steps[-1] <= reference[1]["summary"]["steps"]
 
 
+def test_a_signal_inside_a_line_leaves_it_whole():
+    """SIGTERM's handler raises from inside a write once the text is taken (a run killed as it printed a
+    case's progress line): the line still ends where it should, so the run's last line, which names the
+    checkpoint, stands alone.  ``print`` wrote text and newline apart: the line came out without its end."""
+    from petsc_adhesion.errors import Interrupted, say
+
+    class Signalled(io.StringIO):
+        hit = False
+
+        def write(self, text):
+            n = super().write(text)
+            if not self.hit:
+                self.hit = True
+                raise Interrupted(signal.SIGTERM)
+            return n
+
+    stream = Signalled()
+    with pytest.raises(Interrupted):
+        say("case 8 (mu = 1, sigma = 0.3) done in 0.1 s; 1/8 done", stream)
+    say("error: interrupted by SIGTERM; nothing written", stream)
+    assert stream.getvalue().splitlines() == ["petsc-adhesion: case 8 (mu = 1, sigma = 0.3) done in 0.1 s; 1/8 done",
+                                              "petsc-adhesion: error: interrupted by SIGTERM; nothing written"]
+
+
 def test_progress_says_the_time_left_from_the_fraction_done(monkeypatch):
     """A clock run by hand: lines at most every interval; the time left is elapsed (1 - done) / done."""
     from mpi4py import MPI
