@@ -14,13 +14,15 @@ one place.  The problem supplies its Jacobian's local rows, dense
 ==========  ======================================  ====================================
 kind        matrix                                  default PC (1 rank / more)
 ==========  ======================================  ====================================
-dense       G_x assembled, dense                    LU / block Jacobi, dense LU blocks
-band        |i - j| <= band of G_x, AIJ             LU / block Jacobi + ILU; any PC
+dense       G_x assembled, dense                    LU / LU on each rank, block Jacobi
+band        |i - j| <= band of G_x, AIJ             LU / LU on each rank, block Jacobi; any PC
 shell       none: the operator itself               none
 ==========  ======================================  ====================================
 
-On a dense block PETSc's default sub-preconditioner of block Jacobi, ILU(0),
-has the full pattern and is the LU factorization itself.
+On several ranks the whole matrix is factored on every rank (PCREDUNDANT) up to
+REDUNDANT_MAX unknowns, block Jacobi beyond.  On a dense block PETSc's default
+sub-preconditioner of block Jacobi, ILU(0), has the full pattern and is the LU
+factorization itself.
 """
 from __future__ import annotations
 
@@ -29,10 +31,15 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["Border", "Layout", "Dense", "Band", "Shell", "KINDS", "BAND", "create"]
+__all__ = ["Border", "Layout", "Dense", "Band", "Shell", "KINDS", "BAND", "REDUNDANT_MAX", "create"]
 
 #: Half bandwidth of the near field kept by ``band``.
 BAND = 64
+#: Up to this many unknowns a preconditioner on several ranks is the LU of the whole matrix on every rank
+#: (PCREDUNDANT): exact as on one rank, so regular at the folds, where block Jacobi's blocks of a singular G_x
+#: are not (mu = 5, and mu = 10 with sigma = 0.2, stopped at their snap-off on two ranks: GMRES could not
+#: pass it).  A dense LU of 2000 takes about 0.2 s; beyond that block Jacobi's cheaper blocks win.
+REDUNDANT_MAX = 2000
 
 
 @dataclass
@@ -76,8 +83,10 @@ def _preallocation(ai: np.ndarray, aj: np.ndarray, lo: int, hi: int):
     return d, (np.diff(ai) - d).astype(PETSc.IntType)
 
 
-def _lu_or_block_jacobi(pc: PETSc.PC, bordered: bool = False) -> None:
-    pc.setType("lu" if pc.getComm().getSize() == 1 else "bjacobi")
+def _lu_or_block_jacobi(pc: PETSc.PC, bordered: bool = False, n: int = 0) -> None:
+    """LU on one rank; on several, LU of the whole matrix of ``n`` unknowns on each rank (PCREDUNDANT) up to
+    REDUNDANT_MAX, block Jacobi beyond."""
+    pc.setType("lu" if pc.getComm().getSize() == 1 else "redundant" if n <= REDUNDANT_MAX else "bjacobi")
 
 
 class Dense:
@@ -182,7 +191,7 @@ class Shell:
         """Nothing to fill."""
 
     @staticmethod
-    def setup_pc(pc: PETSc.PC, bordered: bool = False) -> None:
+    def setup_pc(pc: PETSc.PC, bordered: bool = False, n: int = 0) -> None:
         """No preconditioner (-pc_type jacobi reads the shell's diagonal)."""
         pc.setType("none")
 

@@ -209,7 +209,7 @@ class Problem:
 
     def setup_pc(self, pc: PETSc.PC, bordered: bool = False) -> None:
         """Default preconditioner for the kind of P."""
-        self.pc.setup_pc(pc, bordered)
+        self.pc.setup_pc(pc, bordered, self.layout.N)
 
     def destroy(self) -> None:
         """Free the PETSc objects held here, the influence matrix included."""

@@ -243,9 +243,14 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
         if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):
             short.append(f"-cont_at_lambda {t:g} not reached: the curve spans lambda in "
                          f"[{min(p.p for p in pts):.4g}, {max(p.p for p in pts):.4g}]")
-    edge = mpi.allreduce(max((abs(float(law(seg.problem.separation(p.x)[-1:])[0][0])) for seg in segments
-                              for p in seg.cont.points if seg.problem.hi == seg.problem.layout.N), default=0.0),
-                         op=MPI.MAX)
+    edge = 0.0
+    for seg in segments:
+        last = seg.problem.hi == seg.problem.layout.N
+        for p in seg.cont.points:
+            H = seg.problem.separation(p.x)           # collective in the frame of the edge: on every rank
+            if last:
+                edge = max(edge, abs(float(law(H[-1:])[0][0])))
+    edge = mpi.allreduce(edge, op=MPI.MAX)
     if edge > EDGE_SHARE * PEAK_ATTRACTION:
         short.append(f"the contact reaches the end of the domain r_m = {problem.r[-1]:g} (|P(r_m)| up to "
                      f"{edge:.2g}): give a larger -adh_rmax")

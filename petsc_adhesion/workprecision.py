@@ -58,7 +58,7 @@ from .adaptive import RMAX
 from .influence import create_influence
 from .model import Model
 from .options import AppOptions, read_settings
-from .preconditioning import create as create_pmat
+from .preconditioning import REDUNDANT_MAX, create as create_pmat
 from .problem import far_approach
 from .singleton import OPENMPI_SINGLETON
 
@@ -615,13 +615,13 @@ def scale_worker(n: int, kind: str, steps: int) -> dict:
     return out
 
 
-def scaling(sizes=SCALE_N, quick: bool = False, log=print, budget_s: float = 450.0) -> list[dict]:
+def scaling(sizes=SCALE_N, quick: bool = False, log=print, budget_s: float = 450.0, ranks_list=(1, 2)) -> list[dict]:
     """Issue 9, item 8: :func:`scale_worker` for each N, pmat and rank count, each in its own process.
     A size whose predicted time (the last one's scaled by N^3 for dense, N^2 for band) exceeds what is
     left of ``budget_s`` for its (ranks, pmat) is skipped, and said so."""
     rows = []
     env = {**os.environ, **ENV}
-    for ranks in (1, 2):
+    for ranks in ranks_list:
         for kind in ("dense", "band"):
             last, prev, left, power = None, None, budget_s, 3 if kind == "dense" else 2
             for n in sizes:
@@ -856,6 +856,15 @@ def _rank_statement(rows: list) -> str:
                        f"one (speed-up {a['step_s'] / b['step_s']:.2f}), the influence matrix "
                        f"{_t(b['build_s'])} against {_t(a['build_s'])}, peak memory per rank "
                        f"{b['rss_max_mib']:.0f} MiB against {a['rss_max_mib']:.0f} MiB")
+    got = {(r["n"], r["ranks"]): r for r in rows if r.get("pmat") == "dense" and "step_s" in r}
+    small = [n for n, k in got if k == 1 and (n, 2) in got and n <= REDUNDANT_MAX]
+    if small:
+        n = max(small)
+        a, b = got[(n, 1)], got[(n, 2)]
+        out.append(f"up to N = {REDUNDANT_MAX}, where each rank factors the whole matrix, two ranks are no faster "
+                   f"for one curve (dense at N = {n}: {_t(b['step_s'])} a step against {_t(a['step_s'])} on one "
+                   f"rank): the price of a preconditioner that stays exact at the folds; a study spreads its "
+                   f"cases over the ranks instead")
     return ("Two ranks (one a core): " + "; ".join(out) + ".") if out else ""
 
 
@@ -1143,8 +1152,9 @@ def render(data: dict) -> str:
           f"{SCALE_STEPS} continuation steps from there towards the snap-on (the time per step includes rejected "
           f"steps and refactorizations), and the peak resident memory of each rank (VmHWM of /proc/self/status; "
           f"getrusage's ru_maxrss is carried across exec by Linux and reported the benchmark process's own peak).  One "
-          f"run each.  Dense on two ranks is block Jacobi with one dense LU block per rank (PETSc's dense LU is "
-          f"sequential), so it does more GMRES iterations than on one rank.  A size whose predicted time exceeds "
+          f"run each.  On two ranks the preconditioner is the LU of the whole matrix on each rank (PCREDUNDANT) up to "
+          f"N = {REDUNDANT_MAX}, and block Jacobi with one LU block per rank beyond (PETSc's dense LU is "
+          f"sequential), which does more GMRES iterations than one rank's LU.  A size whose predicted time exceeds "
           f"100 s for its (ranks, pmat) is skipped by the command; rows marked \"run separately\" were measured "
           f"after the command by the same worker, `python -m petsc_adhesion.workprecision scale N PMAT "
           f"{SCALE_STEPS}`, and merged (`python -m petsc_adhesion.workprecision docs DUMP` re-renders this page "

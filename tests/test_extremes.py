@@ -130,3 +130,23 @@ def test_stiff_end_bars_cover_a_refined_reference(tmp_path):
             assert abs(f["lambda"] - lam) <= f["lambda_err"] + 3e-8 and f["lambda_err"] < 1e-5
             assert abs(f["F"] - F) <= f["F_err"] + 3e-9 and f["F_err"] < 1e-6
             assert abs(f["lambda_grid"] - lam) > 100 * abs(f["lambda"] - lam)
+
+
+@pytest.mark.parametrize("case", [(5.0, 0.0), (10.0, 0.2)], ids=["mu5", "mu10-sigma0.2"])
+def test_two_ranks_pass_the_stiff_folds_as_one_does(tmp_path, case):
+    """Two ranks trace one rank's curve through every fold.  With block Jacobi on two ranks (the default
+    before), GMRES could not converge beside the primary snap-off, where G_H is singular: both cases stopped
+    there ("step below -cont_ds_min" at lambda = -8.19 and -12.58) with one fold pair found."""
+    args = ("-adh_mu", case[0], "-adh_sigma", case[1], "-cont_F_max", 0.2, "-cont_error_estimate", "false")
+    runs = []
+    for np_ in (1, 2):
+        js = tmp_path / f"np{np_}.json"
+        proc = run_cli(*args, "-summary", js, np=np_)
+        assert proc.returncode == 0, (np_, proc.stderr)
+        runs.append(json.loads(js.read_text()))
+    one, two = runs
+    assert two["complete"] and two["steps"] == one["steps"]
+    assert [f["kind"] for f in two["folds"]] == [f["kind"] for f in one["folds"]] and len(one["folds"]) == 4
+    for a, b in zip(one["folds"] + [one["pull_off"]] + one["equilibria"], two["folds"] + [two["pull_off"]]
+                    + two["equilibria"]):
+        assert all(abs(a[q] - b[q]) <= 1e-8 for q in ("lambda", "F") if q in a), (a, b)
