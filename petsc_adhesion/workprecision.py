@@ -843,24 +843,25 @@ def _scaling_table(rows: list) -> str:
     return "\n".join(lines)
 
 
+def _one_and_two(rows: list, kind: str, most: float = math.inf):
+    """(N, one rank's row, two ranks' row) at the largest N up to ``most`` measured on both, or None."""
+    got = {(r["n"], r["ranks"]): r for r in rows if r.get("pmat") == kind and "step_s" in r}
+    both = [n for n, k in got if k == 1 and (n, 2) in got and n <= most]
+    return (max(both), got[(max(both), 1)], got[(max(both), 2)]) if both else None
+
+
 def _rank_statement(rows: list) -> str:
-    """Two ranks against one at the largest N measured on both, per pmat."""
+    """Two ranks against one at the largest N measured on both, per pmat, and where the whole LU is factored."""
     out = []
     for kind in ("dense", "band"):
-        got = {(r["n"], r["ranks"]): r for r in rows if r.get("pmat") == kind and "step_s" in r}
-        both = [n for n, k in got if k == 1 and (n, 2) in got]
-        if both:
-            n = max(both)
-            a, b = got[(n, 1)], got[(n, 2)]
+        if pair := _one_and_two(rows, kind):
+            n, a, b = pair
             out.append(f"{kind} at N = {n}: a step takes {_t(b['step_s'])} on two ranks against {_t(a['step_s'])} on "
                        f"one (speed-up {a['step_s'] / b['step_s']:.2f}), the influence matrix "
                        f"{_t(b['build_s'])} against {_t(a['build_s'])}, peak memory per rank "
                        f"{b['rss_max_mib']:.0f} MiB against {a['rss_max_mib']:.0f} MiB")
-    got = {(r["n"], r["ranks"]): r for r in rows if r.get("pmat") == "dense" and "step_s" in r}
-    small = [n for n, k in got if k == 1 and (n, 2) in got and n <= REDUNDANT_MAX]
-    if small:
-        n = max(small)
-        a, b = got[(n, 1)], got[(n, 2)]
+    if pair := _one_and_two(rows, "dense", REDUNDANT_MAX):
+        n, a, b = pair
         out.append(f"up to N = {REDUNDANT_MAX}, where each rank factors the whole matrix, two ranks are no faster "
                    f"for one curve (dense at N = {n}: {_t(b['step_s'])} a step against {_t(a['step_s'])} on one "
                    f"rank): the price of a preconditioner that stays exact at the folds; a study spreads its "
