@@ -4,15 +4,49 @@ The self-consistent model of Cheng, Dunn and Brach (J. Adhesion 78, 2002):
 Lennard-Jones surface stress (Derjaguin approximation) coupled to half-space
 elasticity, Gaussian roughness averaged over the gap, solved with PETSc.
 
-From Python (docs/python.md): :func:`curve` traces a load-approach curve,
-:func:`solve` solves at one approach; PETSc starts on the first call, not on import.
+From Python (docs/python.md): the library's calls take typed objects,
+:func:`trace_curve` (a :class:`Model`, a :class:`GridChoice`, a
+:class:`SolverChoice`, :class:`Settings`, a :class:`CurveRequest`) returns a
+:class:`Curve`, :func:`solve_at` a :class:`Solution`; :func:`curve` and
+:func:`solve` take the command line's options as keywords.  PETSc starts on
+the first call, not on import (the library's modules are loaded on first use,
+so that a program can hand PETSc its command line first).
+
+=====================  ==============================================================
+package                what
+=====================  ==============================================================
+``core``               continuation of G(x, p) = 0 through turning points, events, fold system
+``model``              parameters and units, pressure laws and roughness, closed forms
+``discretization``     grids, the influence operator, the problem in each frame
+``tracing``            the curve over grids that follow the edge, error bars, results
+``io``                 result files, their layout, the report, figures
+``app``                options, one run, studies over MPI, checkpoints, command line, API
+``benchmarks``         measurements and the docs' figures (the library never imports it)
+=====================  ==============================================================
 """
 from .singleton import singleton_defaults
 
 singleton_defaults()   # before any MPI_Init in this process: see petsc_adhesion.singleton
 
-from .api import Curve, Event, Solution, curve, solve
-from .errors import InputError
+from .app.api import curve, solve  # noqa: E402  (after the singleton's defaults)
+from .errors import InputError  # noqa: E402
+from .tracing.curve import Curve, Event, Solution  # noqa: E402
+from .version import __version__  # noqa: E402
 
-__version__ = "0.1.0"
-__all__ = ["__version__", "curve", "solve", "Curve", "Event", "Solution", "InputError"]
+__all__ = ["__version__", "curve", "solve", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
+           "SolverChoice", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError"]
+
+#: Names loaded on first use (their modules import petsc4py.PETSc, which starts PETSc).
+_LAZY = {"trace_curve": "tracing.trace", "solve_at": "tracing.trace", "GridChoice": "tracing.trace",
+         "SolverChoice": "tracing.trace", "CurveRequest": "tracing.trace", "curve_settings": "tracing.trace",
+         "Settings": "core.continuation", "Model": "model.parameters", "Bodies": "model.physical"}
+
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'petsc_adhesion' has no attribute '{name}'")
+    import importlib
+
+    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    globals()[name] = value
+    return value

@@ -1,7 +1,11 @@
-"""The program's exceptions for bad input and for signals, and its one-line messages."""
+"""The program's exceptions for bad input and for signals, and its one-line messages.
+
+Every module may import this one; it imports nothing of the package.  :func:`collective` makes a
+check's refusal every rank's, so that no rank is left waiting in a collective call.
+"""
 import sys
 
-__all__ = ["InputError", "Interrupted", "say"]
+__all__ = ["InputError", "Interrupted", "say", "first_line", "printable", "collective"]
 
 
 def say(text: str, stream=None) -> None:
@@ -14,6 +18,12 @@ def say(text: str, stream=None) -> None:
     stream = stream or sys.stderr
     stream.write(f"petsc-adhesion: {text}\n")
     stream.flush()
+
+
+def first_line(e: BaseException) -> str:
+    """The first line of an exception's message, or its type's name when it has none."""
+    text = str(e).strip()
+    return text.splitlines()[0] if text else type(e).__name__
 
 
 class InputError(Exception):
@@ -29,3 +39,28 @@ class Interrupted(BaseException):
         self.signum = signum
         self.restart = None          # the checkpoint to go on from (-cont_restart), once one is saved
         self.done = None             # the run's exit status when the signal came after its results were written
+
+
+def printable(text) -> str:
+    """``text`` (str or bytes) with control characters and undecodable bytes escaped, for one line."""
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", errors="backslashreplace")
+    text = text.encode("utf-8", errors="surrogateescape").decode("utf-8", errors="backslashreplace")
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def collective(comm, check, *args):
+    """Run ``check(*args)`` on every rank; an InputError on any rank is raised on all (rank order).
+
+    Keeps a check that fails on one rank only (a file part, a path) from
+    leaving the others waiting in a collective call.
+    """
+    try:
+        out, why = check(*args), None
+    except InputError as e:
+        out, why = None, str(e)
+    whys = comm.tompi4py().allgather(why)
+    first = next((w for w in whys if w), None)
+    if first:
+        raise InputError(first)
+    return out

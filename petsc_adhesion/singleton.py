@@ -9,7 +9,7 @@ shared-memory point-to-point layer (``pml ob1``) and no daemon
 the user set wins, a process launched by ``mpiexec``, ``srun`` or any PMI
 launcher is left alone, and other MPI libraries ignore Open MPI's variables.
 Processes this one starts inherit the variables (harmless on one machine;
-:mod:`petsc_adhesion.leaveout` strips them before its own ``mpiexec``).
+:mod:`petsc_adhesion.benchmarks.leaveout` strips them before its own ``mpiexec``).
 """
 from __future__ import annotations
 

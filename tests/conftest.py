@@ -10,6 +10,8 @@ import pytest
 petsc4py.init([sys.argv[0]])
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# the benchmarks read docs/ and options/ of this checkout, wherever pytest runs from
+os.environ.setdefault("PETSC_ADHESION_CHECKOUT", ROOT)
 
 
 def _env():
@@ -39,11 +41,11 @@ def cli():
 
 def make_problem(mu=1.0, sigma=0.0, r=None, pmat="dense", **model):
     """A Problem and its fixed-approach Newton solver on grid r (default: uniform, 201 nodes)."""
-    from petsc_adhesion import grid, preconditioning
-    from petsc_adhesion.influence import create_influence
-    from petsc_adhesion.model import Model
-    from petsc_adhesion.problem import Problem
-    from petsc_adhesion.solver import Newton
+    from petsc_adhesion.discretization import grid, preconditioning
+    from petsc_adhesion.discretization.influence import create_influence
+    from petsc_adhesion.model.parameters import Model
+    from petsc_adhesion.discretization.problem import Problem
+    from petsc_adhesion.core.newton import Newton
 
     r = grid.uniform(201, 10.0) if r is None else r
     pb = Problem(Model(mu=mu, sigma=sigma, **model), r, create_influence(r), preconditioning.create(pmat))

@@ -21,7 +21,7 @@ import pytest
 import conftest
 import petsc_adhesion as pa
 from conftest import ROOT, run_cli
-from petsc_adhesion.reference import DMT_PULL_OFF, rigid_load
+from petsc_adhesion.model.reference.rigid import DMT_PULL_OFF, rigid_load
 
 h5py = pytest.importorskip("h5py")
 

@@ -14,7 +14,7 @@ from conftest import ROOT, _env
 
 def test_bench_json(tmp_path):
     path = tmp_path / "bench.json"
-    cmd = [sys.executable, "-m", "petsc_adhesion.bench", "-bench_only", "curve",
+    cmd = [sys.executable, "-m", "petsc_adhesion.benchmarks", "-bench_only", "curve",
            "-bench_repeats", "1", "-bench_json", str(path)]
     run = subprocess.run(cmd, cwd=ROOT, env=_env(), capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
@@ -25,7 +25,7 @@ def test_bench_json(tmp_path):
     assert q["repeats"] == 1 and math.isfinite(q["median_s"]) and q["median_s"] > 0
     assert q["target_s"] == 1.0 and isinstance(q["met"], bool)
     # the curve timed is the default study: the paper's mu = 1 landmarks (its text has
-    # -1.63, -1.74, 2.07; NOTES 4 on the swapped labels), and the pull-off of the half-infinite
+    # -1.63, -1.74, 2.07; paper note 4 of docs/model.md on the swapped labels), and the pull-off of the half-infinite
     # domain that ContactMechanics + Adhesion give at n = 256 (-0.83524, docs/data/peer_contactmechanics.json;
     # its lambda_p scatters by 5e-3 between its grids)
     assert abs(q["snap_on_lambda"] + 1.63) < 0.01 and abs(q["snap_off_lambda"] + 1.74) < 0.01

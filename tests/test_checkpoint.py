@@ -249,7 +249,7 @@ def test_a_signal_once_the_results_are_in_place_ends_the_run_as_done(tmp_path):
     one line that says so, the run's own exit status, the results alone.  Before: 'interrupted by SIGTERM;
     nothing written' and exit 143 beside the written results, seen when a batch system's signal met a
     two-rank run in its last milliseconds."""
-    code = ("import os, signal; from petsc4py import PETSc; from petsc_adhesion.cli import main; "
+    code = ("import os, signal; from petsc4py import PETSc; from petsc_adhesion.app.cli import main; "
             "fired = []; PETSc.garbage_cleanup = lambda *a: fired or fired.append(1) or os.kill(os.getpid(), signal.SIGTERM); "
             "raise SystemExit(main(['x', '-adh_mu', '0.5', '-grid_type', 'uniform', '-grid_n', '101', "
             "'-cont_checkpoint', 'ck', '-cont_checkpoint_interval', '0', '-summary', 's.json']))")
@@ -357,7 +357,7 @@ def test_progress_says_the_time_left_from_the_fraction_done(monkeypatch):
     """A clock run by hand: lines at most every interval; the time left is elapsed (1 - done) / done."""
     from mpi4py import MPI
 
-    from petsc_adhesion import progress
+    from petsc_adhesion.app import progress
 
     now = [100.0]
     monkeypatch.setattr(progress.time, "perf_counter", lambda: now[0])
@@ -385,7 +385,7 @@ def test_progress_says_the_time_left_from_the_fraction_done(monkeypatch):
 def test_clock_examples():
     import doctest
 
-    from petsc_adhesion import progress
+    from petsc_adhesion.app import progress
 
     result = doctest.testmod(progress)
     assert result.attempted > 0 and result.failed == 0

@@ -18,10 +18,10 @@ import pytest
 from petsc4py import PETSc
 
 import petsc_adhesion
-from petsc_adhesion.reference import load_beyond
+from petsc_adhesion.model.reference.rigid import load_beyond
 import conftest
 from conftest import run_cli
-from petsc_adhesion.options import TABLE
+from petsc_adhesion.app.options.table import TABLE
 
 h5py = pytest.importorskip("h5py")
 
@@ -474,7 +474,7 @@ def test_parallel_band_with_external_solvers(tmp_path, pc):
 def test_scene_leaves_out_what_it_does_not_need(tmp_path):
     """No plotting import when nothing is drawn, no profiles not asked for."""
     h5 = tmp_path / "c.h5"
-    code = ("import sys; from petsc_adhesion.cli import main; "
+    code = ("import sys; from petsc_adhesion.app.cli import main; "
             f"rc = main(['x', '-adh_mu', '0.5', '-grid_type', 'uniform', '-grid_n', '101', '-out', '{h5}']); "
             "assert rc == 0; print('matplotlib' in sys.modules)")
     env = conftest._env()

@@ -7,7 +7,7 @@ cores), and a run asked for by several groups is made once (``_DONE``).
 
 The checks compare with independent truth only: the closed form of mu = 0
 (eq. 28), the numbers the paper quotes (within the digits it gives; see
-/work/shared/paper/NOTES.md for its typos), a Jacobian and a residual built
+docs/model.md for its typos), a Jacobian and a residual built
 here from the influence matrix and the pressure law, the order of
 convergence under refinement, and invariance under the corrector, the event
 tolerance and the number of ranks.
@@ -23,10 +23,10 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from petsc_adhesion.grid import load_weights
-from petsc_adhesion.influence import influence_rows
-from petsc_adhesion.reference import RIGID_EQUILIBRIUM, load_beyond, rigid_load
-from petsc_adhesion.pressure import PressureLaw
+from petsc_adhesion.discretization.grid import load_weights
+from petsc_adhesion.discretization.influence import influence_rows
+from petsc_adhesion.model.reference.rigid import RIGID_EQUILIBRIUM, load_beyond, rigid_load
+from petsc_adhesion.model.pressure import PressureLaw
 
 h5py = pytest.importorskip("h5py")
 
@@ -203,7 +203,7 @@ PAPER = {
     (2.0, 0.4): dict(Fp=-0.167, unit=0.001, lp=-2.31, le=-0.364, folds=()),
     (2.0, 1.0): dict(Fp=-0.03, unit=0.01, lp=-5.91, le=-5.28, folds=()),
     (0.01, 0.2): dict(Fp=-0.64, unit=0.01, lp=-0.42, le=None, folds=()),
-    (0.01, 0.4): dict(Fp=-0.18, unit=0.01, lp=None, le=None, folds=()),     # printed "0.18" (NOTES 5)
+    (0.01, 0.4): dict(Fp=-0.18, unit=0.01, lp=None, le=None, folds=()),     # printed "0.18" (paper note 5, docs/model.md)
     (0.01, 1.0): dict(Fp=-0.03, unit=0.01, lp=-5.78, le=-5.71, folds=()),
 }
 
@@ -245,7 +245,7 @@ def test_small_mu_follows_rigid_closed_form(dmt):
     # pull-off of eq. (28): F = -1 at lambda = 0
     assert abs(s["pull_off"]["F"] + 1.0) < 0.005
     assert abs(s["pull_off"]["lambda"]) < 0.01
-    # one equilibrium, near 1 - 2^(-1/3) = 0.2063 (moved by elasticity, NOTES 7), and the
+    # one equilibrium, near 1 - 2^(-1/3) = 0.2063 (moved by elasticity, paper note 7), and the
     # paper's "lambda_e = 0.21" for the smooth surface
     (eq,) = s["equilibria"]
     assert abs(eq["lambda"] - RIGID_EQUILIBRIUM) < 0.01
@@ -287,7 +287,7 @@ def test_mu1_folds_and_landings(mu1):
     assert [f["kind"] for f in s["folds"]].count("snap_off") == 1
     assert len(s["folds"]) == 2
     on, off = folds_of(s)["snap_on"], folds_of(s)["snap_off"]
-    # hysteresis: the jump-in on approach comes at the larger lambda (NOTES 4: the paper's
+    # hysteresis: the jump-in on approach comes at the larger lambda (paper note 4: the paper's
     # mu = 1 text swaps the labels of -1.63 and -1.74)
     assert on["lambda"] > off["lambda"]
     assert abs(on["lambda"] - (-1.63)) <= 0.01
@@ -337,7 +337,7 @@ def test_paper_values(paper, key):
     assert len(s["folds"]) == 2
     assert abs(on["lambda"] - ref["folds"][0]) <= 0.01
     assert abs(off["lambda"] - ref["folds"][1]) <= 0.01
-    # NOTES 6: the loads the paper prints at the folds cannot be on the curve, whose most
+    # paper note 6 (docs/model.md): the loads the paper prints at the folds cannot be on the curve, whose most
     # tensile load is the pull-off; they are ten times ours (typo by a factor 10):
     # -0.1834 / -0.4544 (sigma 0) and -0.1818 / -0.3176 (sigma 0.2)
     for f, printed in zip((on, off), ref["loads"]):

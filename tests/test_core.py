@@ -21,9 +21,9 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from petsc_adhesion.continuation import Continuation, Settings
-from petsc_adhesion.events import EventFinder, Extremum, Fold, ParameterValue, Zero
-from petsc_adhesion.solver import Newton, guard
+from petsc_adhesion.core.continuation import Continuation, Settings
+from petsc_adhesion.core.events import EventFinder, Extremum, Fold, ParameterValue, Zero
+from petsc_adhesion.core.newton import Newton, guard
 from toy_problems import (BRATU_LAMBDA_STAR, BRATU_MID_STAR, Barrier, Bratu, Cusp, Outside, ScalarFold,
                           bratu_discrete_fold, bratu_mid, bratu_theta)
 

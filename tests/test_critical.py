@@ -1,4 +1,4 @@
-"""The critical roughness and Tabor parameter (petsc_adhesion.critical, -study_compute critical).
+"""The critical roughness and Tabor parameter (petsc_adhesion.tracing.critical, -study_compute critical).
 
 The cusp is checked against what it claims: ordinary load-approach curves (the
 command line's own tracing, independent of the fold continuation) have the fold
@@ -53,8 +53,8 @@ def test_failed_case_is_one_line_and_the_rest_stands(study):
 def test_sigma_c_grid_converged(study):
     """The values on the nested levels converge at second order, and one level finer (levels 1-3
     instead of 0-2) moves the best values by less than their bars."""
-    from petsc_adhesion import critical
-    from petsc_adhesion.model import Model
+    from petsc_adhesion.tracing import critical
+    from petsc_adhesion.model.parameters import Model
 
     c = study[1]["critical_roughness"][0]
     g = np.array(c["sigma_c_grid"])

@@ -44,8 +44,9 @@ def test_every_options_file_sets_up(tmp_path):
 def test_usage_md_is_the_option_table():
     """docs/usage.md is what its command makes from the option table now, and lists every option
     once, in the group -help shows it in."""
-    from petsc_adhesion import usage
-    from petsc_adhesion.options import TABLE, help_groups
+    from petsc_adhesion.benchmarks import usage
+    from petsc_adhesion.app.options.table import TABLE
+    from petsc_adhesion.app.options.help import help_groups
 
     text = open(os.path.join(ROOT, "docs", "usage.md")).read()
     assert text == usage.markdown(), f"docs/usage.md is stale: regenerate it with {usage.COMMAND}"
@@ -54,3 +55,40 @@ def test_usage_md_is_the_option_table():
     for title, members in help_groups():
         section = text.split(f"## {title[0].upper()}{title[1:]}\n")[1].split("\n## ")[0]
         assert re.findall(r"^\| `-(\w+)` \|", section, re.M) == [o.name for o in members]
+
+
+def test_architecture_md_names_every_module():
+    """docs/architecture.md gives every module its one job: each file of the package is named there (by its
+    path in its part, or its name in a part's list)."""
+    text = open(os.path.join(ROOT, "docs", "architecture.md")).read()
+    missing = []
+    for folder, _, files in os.walk(os.path.join(ROOT, "petsc_adhesion")):
+        for name in files:
+            if not name.endswith(".py") or name == "__init__.py" and folder.endswith("petsc_adhesion"):
+                continue
+            rel = os.path.relpath(os.path.join(folder, name), os.path.join(ROOT, "petsc_adhesion"))
+            parts = rel.split(os.sep)
+            shown = {f"`{rel}`", f"`{'/'.join(parts[1:])}`", f"`{parts[-1]}`", f"`{parts[-2]}/`" if len(parts) > 1 else ""}
+            if name == "__init__.py":
+                shown |= {f"**`{parts[0]}/`**", f"`{parts[-2]}/`"}
+            if not any(s and s in text for s in shown):
+                missing.append(rel)
+    assert not missing, missing
+
+
+def test_nothing_cites_a_file_outside_the_repository():
+    """The docs, the code and the tests cite the repository's own documents, never the notes or paths of the
+    machine the project was built on."""
+    bad = []
+    for top in ("petsc_adhesion", "tests", "docs", "options"):
+        for folder, _, files in os.walk(os.path.join(ROOT, top)):
+            for name in files:
+                if name.endswith((".py", ".md", ".opts")) and name != "test_docs.py":
+                    text = open(os.path.join(folder, name), encoding="utf-8").read()
+                    for pattern in (r"\bNOTES\b", r"/work/", r"\.\./shared", r"\bissue \d+"):
+                        if re.search(pattern, text):
+                            bad.append(f"{top}/{os.path.relpath(os.path.join(folder, name), os.path.join(ROOT, top))}: {pattern}")
+    for name in ("README.md",):
+        text = open(os.path.join(ROOT, name)).read()
+        bad += [f"{name}: {p}" for p in (r"\bNOTES\b", r"/work/", r"\.\./shared") if re.search(p, text)]
+    assert not bad, bad

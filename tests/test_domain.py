@@ -1,7 +1,8 @@
 """Newton never leaves the domain: every gap H - sqrt(2) sigma x_l + 1 stays positive."""
 import numpy as np
 
-from petsc_adhesion import problem, solver
+from petsc_adhesion.discretization import problem
+from petsc_adhesion.core import newton as solver
 from conftest import make_problem
 
 
@@ -60,7 +61,7 @@ def test_newton_through_the_wall_region_converges(monkeypatch):
 
 def test_continuation_step_leaving_the_domain_is_retried_smaller():
     """A predictor beyond the wall is refused before any evaluation (step retried at half)."""
-    from petsc_adhesion.continuation import Continuation, Settings
+    from petsc_adhesion.core.continuation import Continuation, Settings
     pb, _ = make_problem(mu=1.0, sigma=0.5)
     cont = Continuation(pb, Settings(observable="F"))
     a = cont.start(pb.rigid(-3.0, pb.create_vec()), -3.0)

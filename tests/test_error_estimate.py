@@ -12,7 +12,7 @@ import json
 import pytest
 
 from conftest import run_cli
-from petsc_adhesion.reference import RIGID_EQUILIBRIUM, rigid_load
+from petsc_adhesion.model.reference.rigid import RIGID_EQUILIBRIUM, rigid_load
 
 
 def summary(tmp_path, name, *args):

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from petsc_adhesion.reference import RIGID_EQUILIBRIUM
+from petsc_adhesion.model.reference.rigid import RIGID_EQUILIBRIUM
 from conftest import run_cli
 
 

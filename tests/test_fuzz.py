@@ -1,7 +1,7 @@
 """Fuzz: random option sets, deterministic by seed, each ending in one line and a non-zero exit or in a valid,
 complete result set.
 
-About 1000 option sets are drawn from the real option table (petsc_adhesion.options.TABLE) and PETSc's solver
+About 1000 option sets are drawn from the real option table (petsc_adhesion.app.options.TABLE) and PETSc's solver
 options under the three prefixes, with valid, out-of-range, mistyped, empty, non-finite, huge and list values,
 misspelt and unknown names, words without a dash, duplicates, and files: outputs at a missing directory, a
 directory, /dev/null, a FIFO, a symbolic link, an input of the run, another output; options files and guesses
@@ -19,7 +19,7 @@ docs/output.md, JSON, PNG/PDF/SVG magic bytes), no NaN in any dataset, attribute
 journal left, the JSON and the HDF5 of one run consistent, and for 3 ``complete: false`` with a warning; never
 "Traceback" or "PETSC ERROR"; no case slower than HANG seconds.
 
-Most cases run in process (``petsc_adhesion.cli.main``, repeatable in one process) in a worker subprocess that
+Most cases run in process (``petsc_adhesion.app.cli.main``, repeatable in one process) in a worker subprocess that
 takes one case at a time and captures the file descriptors 1 and 2, so that a hang or a crash of the
 interpreter is caught by a time-out; 30 more run as real command lines (options files are checked before
 PETSc starts there), 10 of them under ``mpiexec -n 2`` (checks that could fail on one rank only).
@@ -71,7 +71,7 @@ def _worker() -> None:
     petsc4py.init([sys.argv[0]])
     from petsc4py import PETSc  # noqa: F401  (PETSc is initialised: every case gets its own options)
 
-    from petsc_adhesion.cli import main
+    from petsc_adhesion.app.cli import main
     libc = ctypes.CDLL(None)
 
     def flush():
@@ -123,7 +123,8 @@ import pytest  # noqa: E402
 
 import conftest  # noqa: E402
 from conftest import run_cli  # noqa: E402
-from petsc_adhesion.options import TABLE, petsc_names  # noqa: E402
+from petsc_adhesion.app.options.table import TABLE
+from petsc_adhesion.app.options.checks import petsc_names
 
 h5py = pytest.importorskip("h5py")
 

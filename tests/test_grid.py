@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from petsc_adhesion import grid
+from petsc_adhesion.discretization import grid
 
 
 def test_paper_grid_is_531_nodes_refined_at_the_centre():

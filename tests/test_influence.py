@@ -16,9 +16,9 @@ import pytest
 from scipy.integrate import IntegrationWarning, quad
 from scipy.special import ellipkm1
 
-from petsc_adhesion import grid, influence
-from petsc_adhesion.influence import influence_rows
-from petsc_adhesion.reference import disk_deflection, hertz_deflection
+from petsc_adhesion.discretization import grid, influence
+from petsc_adhesion.discretization.influence import influence_rows
+from petsc_adhesion.model.reference.elastic import disk_deflection, hertz_deflection
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -172,8 +172,8 @@ MPI_SCRIPT = """
     import petsc4py
     petsc4py.init()
     from petsc4py import PETSc
-    from petsc_adhesion import grid
-    from petsc_adhesion.influence import create_influence
+    from petsc_adhesion.discretization import grid
+    from petsc_adhesion.discretization.influence import create_influence
 
     r = grid.paper(3.0)
     A = create_influence(r)

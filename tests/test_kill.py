@@ -294,13 +294,13 @@ def test_killed_runs_leave_the_old_set_or_the_new_one(tmp_path, sets):
 # ======================================================================================================
 _COMMIT_THEN_TERM = """
 import os, signal, sys
-from petsc_adhesion import files
+from petsc_adhesion.io import resultset as files
 commit = files.ResultSet.commit
 def commit_then_term(self):          # SIGTERM arrives just after the renames (or while they are held)
     commit(self)
     os.kill(os.getpid(), signal.SIGTERM)
 files.ResultSet.commit = commit_then_term
-from petsc_adhesion.cli import main
+from petsc_adhesion.app.cli import main
 sys.exit(main(["petsc-adhesion", *sys.argv[1:]]))
 """
 
@@ -317,7 +317,7 @@ def test_sigterm_after_the_commit_says_so(tmp_path):
 
 
 def test_journal_is_found_from_any_name_of_its_set(tmp_path):
-    from petsc_adhesion.files import JOURNAL, ResultSet
+    from petsc_adhesion.io.resultset import JOURNAL, ResultSet
 
     host = os.uname().nodename
     final = {"out": tmp_path / "r.h5", "summary": tmp_path / "r.json"}
@@ -334,7 +334,7 @@ def test_journal_is_found_from_any_name_of_its_set(tmp_path):
 
 
 def test_a_file_that_is_no_journal_is_left_alone(tmp_path):
-    from petsc_adhesion.files import ResultSet
+    from petsc_adhesion.io.resultset import ResultSet
 
     mine = tmp_path / ".s.h5.commit"
     mine.write_text('{"mine": 1}\n')

@@ -43,7 +43,7 @@ def _axes(path):
     """The figure's axes, from the function the command calls (in-process, same code)."""
     import matplotlib.pyplot as plt
 
-    from petsc_adhesion import plot as p
+    from petsc_adhesion.io.plot import command as p
 
     captured = {}
     real = plt.Figure.savefig

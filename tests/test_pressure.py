@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy.integrate import IntegrationWarning, quad
 
-from petsc_adhesion.pressure import HistogramLaw, PressureLaw, WallLaw, law_for
-from petsc_adhesion.roughness import Measured, TruncatedGaussian, Weibull
+from petsc_adhesion.model.pressure import HistogramLaw, PressureLaw, WallLaw, law_for
+from petsc_adhesion.model.roughness import Measured, TruncatedGaussian, Weibull
 
 
 def test_smooth_law_is_lennard_jones():
@@ -48,12 +48,12 @@ def test_small_roughness_is_second_order_correction():
 
 
 def test_rule_and_its_wall():
-    """The outermost node is a hard wall: 6.63 sigma for 16 points, 14.9 for 64 (NOTES)."""
+    """The outermost node is a hard wall: 6.63 sigma for 16 points, 14.9 for 64 (docs/model.md)."""
     law = PressureLaw(1.0, "hermite", 16)
     assert law.weights.sum() == pytest.approx(1.0, rel=1e-14)
     assert law.wall + 1 == pytest.approx(6.63, abs=0.005)
     assert PressureLaw(1.0, "hermite", 64).wall + 1 == pytest.approx(14.9, abs=0.05)
-    # the outermost node's normalized weight (NOTES: 1.5e-10)
+    # the outermost node's normalized weight (docs/model.md: 1.5e-10)
     assert law.weights.max() > 0.2 and law.weights.min() == pytest.approx(1.5e-10, rel=0.1)
 
 

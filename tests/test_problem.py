@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from petsc_adhesion import preconditioning
+from petsc_adhesion.discretization import preconditioning
 from conftest import make_problem
 
 #: (model, smallest gap above the wall of the roughness rule): both with a repulsive centre
@@ -97,7 +97,7 @@ def test_jacobi_preconditioner_on_the_shell():
     H0 = ref.rigid(-2.0, ref.create_vec())
     assert newton.solve(-2.0, H0)
     pb, _ = make_problem(mu=1.0, pmat="shell")
-    from petsc_adhesion.solver import Newton
+    from petsc_adhesion.core.newton import Newton
     opts = PETSc.Options()
     opts.setValue("jacobitest_pc_type", "jacobi")
     try:

@@ -1,4 +1,4 @@
-"""petsc_adhesion.reference against independent truth.
+"""petsc_adhesion.model.reference against independent truth.
 
 Every check goes another way than the module: adaptive quadrature of the
 integral the closed form evaluates, a numerical extremum or root of a curve,
@@ -13,11 +13,11 @@ from scipy.integrate import IntegrationWarning, quad
 from scipy.optimize import brentq, minimize_scalar
 from scipy.special import ellipkm1
 
-from petsc_adhesion.model import tabor
-from petsc_adhesion.reference import (
-    DMT_PULL_OFF, JKR_PULL_OFF, RIGID_EQUILIBRIUM, disk_deflection, hertz_deflection,
-    jkr_approach, jkr_fixed_grip_pull_off, jkr_load, jkr_zero_load, load_beyond,
-    maugis_dugdale_curve, maugis_dugdale_pull_off, maugis_parameter, rigid_load)
+from petsc_adhesion.model.parameters import tabor
+from petsc_adhesion.model.reference.rigid import DMT_PULL_OFF, RIGID_EQUILIBRIUM, load_beyond, rigid_load
+from petsc_adhesion.model.reference.jkr import JKR_PULL_OFF, jkr_approach, jkr_fixed_grip_pull_off, jkr_load, jkr_zero_load
+from petsc_adhesion.model.reference.elastic import disk_deflection, hertz_deflection
+from petsc_adhesion.model.reference.maugis_dugdale import maugis_dugdale_curve, maugis_dugdale_pull_off, maugis_parameter
 
 
 # --- rigid sphere, eqs. (26)-(28) --------------------------------------------
@@ -71,7 +71,7 @@ def test_load_beyond_matches_quadrature(rmax):
 
 
 def test_load_beyond_size_at_paper_domain():
-    # the figure quoted in NOTES.md for r_m = 10: about 5.13e-4 of attraction
+    # the figure docs/model.md quotes for r_m = 10: about 5.13e-4 of attraction
     assert load_beyond(10.0, 0.0) == pytest.approx(-5.13e-4, abs=5e-7)
 
 

@@ -161,7 +161,7 @@ def test_non_utf8_file_name(tmp_path):
 
 @pytest.mark.parametrize("umask", [0o022, 0o077])
 def test_files_get_the_umask_mode(tmp_path, umask):
-    code = (f"import os, sys; os.umask({umask}); from petsc_adhesion.cli import main; "
+    code = (f"import os, sys; os.umask({umask}); from petsc_adhesion.app.cli import main; "
             f"sys.exit(main(['petsc-adhesion', *{list(SOLVE)!r}, '-out', '{tmp_path}/r.h5', "
             f"'-summary', '{tmp_path}/r.json']))")
     proc = subprocess.run([sys.executable, "-c", code], env=conftest._env(), cwd=ROOT, capture_output=True,
@@ -219,7 +219,7 @@ def test_signal_ends_cleanly(tmp_path, signum):
 def test_journal_of_a_killed_commit_is_finished_by_the_next_run(tmp_path):
     """A run killed between the journal and its renames: the next run writing those names completes
     the set it was committing (roll forward) and removes dead runs' temporaries."""
-    from petsc_adhesion.files import JOURNAL, ResultSet
+    from petsc_adhesion.io.resultset import JOURNAL, ResultSet
     old = {"out": tmp_path / "r.h5", "summary": tmp_path / "r.json"}
     for p in old.values():
         p.write_text("old")
@@ -338,7 +338,7 @@ def test_missed_load_minimum_is_judged_per_grid():
     another part of the curve are not (results._missed_minimum)."""
     from types import SimpleNamespace as NS
 
-    from petsc_adhesion.results import _missed_minimum
+    from petsc_adhesion.tracing.results import _missed_minimum
 
     def seg(Fs, located=()):
         """points with loads Fs; located: (step, F) of each F_min found on step [step, step + 1]."""
@@ -365,7 +365,7 @@ def test_next_run_removes_a_journal_killed_while_being_written(tmp_path):
     import subprocess
     import sys
 
-    from petsc_adhesion.files import ResultSet
+    from petsc_adhesion.io.resultset import ResultSet
 
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
                           text=True).stdout.strip()

@@ -8,8 +8,8 @@ and by the O(h^2) interpolation error.
 import numpy as np
 import pytest
 
-from petsc_adhesion import grid
-from petsc_adhesion.reference import RIGID_EQUILIBRIUM, load_beyond, rigid_load
+from petsc_adhesion.discretization import grid
+from petsc_adhesion.model.reference.rigid import RIGID_EQUILIBRIUM, load_beyond, rigid_load
 from conftest import make_problem
 
 RMAX = 10.0
@@ -47,7 +47,7 @@ def test_load_converges_to_truncated_closed_form(lam, order):
 
 
 def test_truncation_error_of_paper_domain():
-    """At lambda = 0 the attraction beyond r_m = 10 is -5.1e-4 (NOTES: some 5e-4)."""
+    """At lambda = 0 the attraction beyond r_m = 10 is -5.1e-4 (docs/model.md: some 5e-4)."""
     assert truncation(0.0) == pytest.approx(-5.13e-4, rel=2e-3)
     # on the paper grid the discrete load sits off eq. (28) by the truncation and an O(h^2) rest
     pb, newton = make_problem(mu=0.0, r=grid.paper(RMAX), farfield=False)

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy.integrate import IntegrationWarning, quad
 
-from petsc_adhesion.roughness import (DISTRIBUTIONS, HeightFileError, Measured, TruncatedGaussian, Weibull,
-                                      WallQuadrature, read_heights)
+from petsc_adhesion.model.roughness import DISTRIBUTIONS, Measured, TruncatedGaussian, Weibull, WallQuadrature
+from petsc_adhesion.model.heights import HeightFileError, read_heights
 
 # quad warns when it meets rounding, i.e. when the reference is as good as it gets
 pytestmark = pytest.mark.filterwarnings("ignore", category=IntegrationWarning)
@@ -56,7 +56,7 @@ def test_truncated_gaussian_moments(cutoff):
     assert moment(dist, lambda S: S ** 3) == pytest.approx(0.0, abs=1e-12)
     assert dist.top == dist.cutoff * 0.7 == -dist.bottom
     assert dist.pdf(dist.top) > 0 and dist.pdf(dist.top * (1 + 1e-12)) == 0
-    # the weight of eq. (3) with NOTES item 1: exp(-S^2 / (2 sigma^2))
+    # the weight of eq. (3) with paper note 1 of docs/model.md: exp(-S^2 / (2 sigma^2))
     assert dist.pdf(0.7) / dist.pdf(0.0) == pytest.approx(math.exp(-0.5), rel=1e-14)
 
 

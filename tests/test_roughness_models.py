@@ -1,4 +1,4 @@
-"""Roughness models through the program: -adh_roughness truncated_gaussian, weibull, measured (issue 12).
+"""Roughness models through the program: -adh_roughness truncated_gaussian, weibull, measured.
 
 The pull-off of each converges as its quadrature is refined, unlike the
 Gauss-Hermite rule; at small sigma every model approaches the smooth one as

@@ -1,4 +1,4 @@
-"""Studies (petsc_adhesion.sweep): cases from options, spread over ranks, written as one file.
+"""Studies (petsc_adhesion.app.study): cases from options, spread over ranks, written as one file.
 
 A case must be exactly the single curve its options describe: compared with the
 single run itself (to round-off), serial against ``mpiexec -n 2`` (one and two
@@ -101,7 +101,7 @@ def test_two_ranks_equal_serial(serial, tmp_path, ranks):
 
 
 def test_pull_off_only_leaves_out_the_rest(serial, tmp_path):
-    code = ("import sys; from petsc_adhesion.cli import main; "
+    code = ("import sys; from petsc_adhesion.app.cli import main; "
             f"rc = main(['x', *{list(TINY)!r}, '-study_mu', '0.001,1', '-study_sigma', '0,0.3', "
             f"'-study_compute', 'pull_off', '-study_profiles', 'equilibrium', '-out', '{tmp_path}/p.h5', "
             f"'-summary', '{tmp_path}/p.json']); print(rc, 'matplotlib' in sys.modules)")
@@ -153,7 +153,7 @@ def test_bad_study_input(tmp_path, args, line):
 
 
 def test_ranges():
-    from petsc_adhesion.options import AppOptions
+    from petsc_adhesion.app.options.reading import AppOptions
     assert AppOptions._range("0.01:20:16:log")[-1] == 20.0
     assert np.allclose(np.diff(np.log(AppOptions._range("0.01:20:16:log"))), np.log(2000) / 15)
     assert AppOptions._range("0:1.2:13")[3] == 0.3
@@ -161,7 +161,7 @@ def test_ranges():
 
 @pytest.mark.parametrize("kind", ["curves", "folds", "profiles", "pull_off", "reduction"])
 def test_figures_from_the_file(serial, tmp_path, kind):
-    from petsc_adhesion.studyplot import pull_offs, read_study, study_figure
+    from petsc_adhesion.io.plot.study import pull_offs, read_study, study_figure
     _, s, out = serial
     tree = read_study(str(out))
     assert {c: v[0] for c, v in pull_offs(tree["table"]).items()} == {c["case"]: c["pull_off"]["F"] for c in s["cases"]}

@@ -15,8 +15,8 @@ import h5py
 import pytest
 
 from conftest import run_cli
-from petsc_adhesion.model import scales, tabor
-from petsc_adhesion.physical import Bodies
+from petsc_adhesion.model.parameters import scales, tabor
+from petsc_adhesion.model.physical import Bodies
 
 #: R = 1 um, E = 1 GPa (rigid flat), gamma = 0.05 J/m^2, epsilon = 0.4 nm: mu = 3.393
 SOFT = ("-phys_radius", 1e-6, "-phys_young1", 1e9, "-phys_poisson1", 0, "-phys_gamma", 0.05, "-phys_epsilon", 4e-10)

@@ -1,4 +1,4 @@
-"""The work-precision benchmark (petsc_adhesion/workprecision.py) measures what it says.
+"""The work-precision benchmark (petsc_adhesion/benchmarks/workprecision) measures what it says.
 
 Numbers against independent truth, never timings (the cores are shared):
 
@@ -17,9 +17,11 @@ import pytest
 
 from conftest import ROOT, _env
 
-from petsc_adhesion import grid, workprecision as wp
-from petsc_adhesion.model import Model
-from petsc_adhesion.problem import far_approach
+from petsc_adhesion.discretization import grid
+from petsc_adhesion.benchmarks.workprecision import accuracy as wp
+from petsc_adhesion.benchmarks.workprecision.render import table_case
+from petsc_adhesion.model.parameters import Model
+from petsc_adhesion.discretization.problem import far_approach
 
 #: the half-infinite model at mu = 1, default run (README; error bars about 1e-6 and below)
 PULL_OFF_F, SNAP_ON, SNAP_OFF = -0.8353323, -1.6292167, -1.7434298
@@ -89,12 +91,12 @@ def test_table_and_errors(paper_mu1):
     rec = wp._record("paper grid, extrapolated", [1.0, 2.0, 3.0], wp.quantities(ours, True), None, 531)
     err = wp.errors(rec, truth)
     assert rec["median_s"] == 2.0 and all(e is not None and e < 2e-4 for e in err.values())
-    text = wp.table_case({"case": "mu1", "mu": 1.0, "sigma": 0.0, "truth": truth, "records": [rec]})
+    text = table_case({"case": "mu1", "mu": 1.0, "sigma": 0.0, "truth": truth, "records": [rec]})
     assert "| paper grid, extrapolated |" in text and "Domain truncation" in text
 
 
 def test_scale_worker_runs_in_its_own_process():
-    cmd = [sys.executable, "-m", "petsc_adhesion.workprecision", "scale", "100", "band", "2"]
+    cmd = [sys.executable, "-m", "petsc_adhesion.benchmarks.workprecision", "scale", "100", "band", "2"]
     run = subprocess.run(cmd, cwd=ROOT, env=_env(), capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stderr
     out = json.loads(run.stdout.strip().splitlines()[-1])

@@ -1,6 +1,6 @@
 """Small problems with known answers for the continuation core (no adhesion model).
 
-Each class implements the problem protocol of :mod:`petsc_adhesion.continuation`
+Each class implements the problem protocol of :mod:`petsc_adhesion.core.continuation`
 with petsc4py on one rank (PETSc.COMM_SELF by default, or COMM_WORLD of size 1):
 
 ===================  ===========================================  =====================================
@@ -16,9 +16,9 @@ class                G(x, p)                                      known answer
 
 The operator ``jacobian`` is a MatPython (``jacobian="python"``, the default)
 or an assembled dense Mat (``"dense"``).  The preconditioning matrix is the
-core's :class:`~petsc_adhesion.preconditioning.Dense` strategy (``pmat="dense"``,
+core's :class:`~petsc_adhesion.discretization.preconditioning.Dense` strategy (``pmat="dense"``,
 through ``jacobian_rows``), this module's own :class:`OwnDense` (created and
-filled here, border included), :class:`~petsc_adhesion.preconditioning.Band`
+filled here, border included), :class:`~petsc_adhesion.discretization.preconditioning.Band`
 (``"band"``, half bandwidth 1: exact for all of them, through ``band_values``) or none
 (``"none"``: GMRES on the operator, enough for one or two unknowns).
 
@@ -38,7 +38,7 @@ import numpy as np
 from petsc4py import PETSc
 from scipy.optimize import brentq
 
-from petsc_adhesion.preconditioning import Band, Border, Dense, Layout, Shell
+from petsc_adhesion.discretization.preconditioning import Band, Dense, Layout, Shell
 
 __all__ = ["Outside", "OwnDense", "Toy", "ScalarFold", "Cusp", "Barrier", "Bratu", "BRATU_THETA_STAR",
            "BRATU_LAMBDA_STAR", "BRATU_MID_STAR", "bratu_theta", "bratu_mid", "bratu_discrete_fold"]
@@ -172,11 +172,11 @@ class Toy:
         rows = np.repeat(np.arange(self.n), np.diff(ai))
         return self.Gx(self.x_lin, self.p_lin)[rows, aj]
 
-    def create_pmat(self, bordered: bool):
-        return self.pc.create(self.layout, self.comm, int(bordered))
+    def create_pmat(self, borders: int):
+        return self.pc.create(self.layout, self.comm, borders)
 
-    def fill_pmat(self, P, border: Border | None = None) -> None:
-        self.pc.fill(P, self, self.layout, [border] if border is not None else [])
+    def fill_pmat(self, P, borders=()) -> None:
+        self.pc.fill(P, self, self.layout, list(borders))
 
     def setup_pc(self, pc: PETSc.PC, bordered: bool = False) -> None:
         self.pc.setup_pc(pc, bordered)

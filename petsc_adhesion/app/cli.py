@@ -1,0 +1,161 @@
+"""Command line entry: ``petsc-adhesion [PETSc and application options]``, or
+``petsc-adhesion plot RESULT.h5 [-o OUT]`` (:func:`petsc_adhesion.io.plot.command`).
+
+    mpiexec -n 2 petsc-adhesion -options_file options/fig5_mu1.opts -arc_snes_monitor
+
+Exit status: 0 done; 1 failed (no result); 2 bad input (one line naming the
+option, nothing written); 3 result written but not what was asked for
+(a stalled curve, an event not reached: its warnings say why); 130 and 143
+interrupted by SIGINT or SIGTERM (nothing written; one that comes once the
+results are in place is said in one line, and the run ends with its own
+status).  Every error is one line
+on stderr from rank 0; no traceback reaches the user.
+"""
+from __future__ import annotations
+
+import signal
+import sys
+from contextlib import nullcontext
+
+from ..errors import Interrupted, first_line, printable, say
+from ..io.resultset import said_after
+from .optionsfile import environment_error, file_error, options_files, stray_word
+
+__all__ = ["main", "input_error", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
+
+EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INCOMPLETE = 0, 1, 2, 3
+
+
+def _on_signal(signum, frame):
+    raise Interrupted(signum)
+
+
+def _say(msg: str) -> None:
+    """One line on rank 0's stderr."""
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.Get_rank() == 0:
+        say(f"error: {printable(msg)}")
+
+
+
+def _version() -> str:
+    from petsc4py import PETSc
+
+    from ..version import __version__
+
+    return f"petsc-adhesion {__version__} (PETSc {'%d.%d.%d' % PETSc.Sys.getVersion()})"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the program on ``argv`` (default: sys.argv) and return its exit status (see the module).
+
+    Repeatable in one process: after the first run (or where PETSc is already
+    initialised) each run reads its options into a database of its own, as
+    PETSc's start-up would, and the caller's options come back afterwards.
+    """
+    argv = list(sys.argv if argv is None else argv)
+    if argv[1:2] == ["plot"]:                       # a figure from a result file: no MPI, no PETSc
+        from ..io.plot.command import command
+        return command(argv[2:])
+    old = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        return _main(argv)
+    except Interrupted as e:
+        if e.done is not None:                     # rank 0's results were in place
+            said_after(e.signum)
+            return e.done
+        _say(f"interrupted by {signal.Signals(e.signum).name}; nothing written"
+             + (f"; go on with -cont_restart {printable(e.restart)}" if e.restart else ""))
+        return 128 + e.signum
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+
+
+def _undecodable(argv: list[str]) -> str | None:
+    """The first argument that is not UTF-8 (PETSc cannot take it), said with its option."""
+    for i, a in enumerate(argv[1:], 1):
+        try:
+            a.encode("utf-8")
+        except UnicodeEncodeError:
+            option = argv[i - 1] if argv[i - 1].startswith("-") else "argument"
+            return f"{option}: the file name '{printable(a)}' is not valid UTF-8"
+    return None
+
+
+def input_error(argv: list[str]) -> str | None:
+    """What is wrong with ``argv`` (or the options files and environment it reads) that must be said
+    before PETSc reads it, in one line; None when nothing is."""
+    bad = _undecodable(argv)
+    word = stray_word(argv[1:])
+    if word is not None and not bad:
+        bad = f"'{printable(word)}' is neither an option (they start with '-') nor an option's value"
+    if bad:
+        return bad
+    # PETSc aborts with a page of text on a bad options file: say it in one line first
+    for path in options_files(argv):
+        bad = file_error(path)
+        if bad:
+            return bad
+    return environment_error(argv)
+
+
+def _program(argv: list[str]) -> int:
+    """The run or the study of the options database; its exit status (errors raise)."""
+    from petsc4py import PETSc
+
+    from ..errors import collective
+    from . import run, study
+    from .options.help import print_help
+    from .options.reading import AppOptions
+
+    opts = AppOptions()
+    helping = opts.db.hasName("help")
+    if helping and PETSc.COMM_WORLD.getRank() == 0:
+        print_help(sys.stdout)
+    if collective(PETSc.COMM_WORLD, run.is_study, opts):
+        return study.main(opts, argv, helping)
+    return run.main(opts, argv, helping)
+
+
+def _main(argv: list[str]) -> int:
+    bad = input_error(argv)
+    if bad:
+        _say(bad)
+        return EXIT_INPUT
+    import petsc4py
+    fresh = "petsc4py.PETSc" not in sys.modules
+    if fresh:
+        petsc4py.init(argv)
+    from mpi4py import MPI
+    from petsc4py import PETSc
+
+    from ..core import capi
+    from ..errors import InputError
+    from .options.checks import petsc_error
+
+    if "-version" in argv:
+        PETSc.Sys.Print(_version())
+        return EXIT_OK
+    try:
+        # PETSc runs already in this process (a notebook, a test): the run's own options database
+        with nullcontext() if fresh else capi.options_from(argv):
+            return _program(argv)
+    except InputError as e:
+        _say(str(e))
+        return EXIT_INPUT
+    except PETSc.Error as e:
+        bad = petsc_error(e)
+        _say(str(bad) if isinstance(bad, InputError) else bad)
+        return EXIT_INPUT if isinstance(bad, InputError) else EXIT_FAILED
+    except (RuntimeError, FloatingPointError, OSError) as e:
+        what = f"cannot write '{e.filename}': {e.strerror}" if isinstance(e, OSError) and e.filename \
+            else first_line(e)
+        _say(what)
+        return EXIT_FAILED
+    except Exception as e:                                  # a defect: still one line, no hang
+        say(f"internal error on rank {MPI.COMM_WORLD.Get_rank()}: {type(e).__name__}: {printable(first_line(e))}")
+        if MPI.COMM_WORLD.Get_size() > 1:
+            MPI.COMM_WORLD.Abort(EXIT_FAILED)
+        return EXIT_FAILED

@@ -1,0 +1,206 @@
+"""Checks of the options before any work: contradictions and options the run would ignore, unused and
+misspelled options, PETSc's values and errors in one line, the memory a grid needs."""
+from __future__ import annotations
+
+import difflib
+import math
+import os
+
+from petsc4py import PETSc
+
+from ... import brent
+from ...core import capi
+from ...errors import InputError
+from ...model.parameters import Model
+from ...model.reference.jkr import jkr_zero_load
+from ...model.reference.rigid import load_beyond
+from .reading import _NUMBER, AppOptions, _strict_float, _strict_int
+from .table import ROUGHNESS_OPTIONS, SOLVER_PREFIXES, TABLE, Option
+
+__all__ = ["DOMAIN_SHARE", "smallest_domain", "check_consistency", "check_memory", "petsc_error", "PETSC_GLOBAL", "petsc_names", "check_unused", "check_petsc_values"]
+
+
+#: The attraction beyond r_m may carry at most this share of the DMT pull-off at contact.
+DOMAIN_SHARE = 0.05
+
+
+def smallest_domain(mu: float) -> float:
+    """The smallest r_m that holds the contact: the JKR contact radius at zero load, and the
+    radius beyond which the rigid sphere's attraction carries at most DOMAIN_SHARE of F = -1."""
+    reach = brent.root(lambda r: abs(load_beyond(r, 0.0)) - DOMAIN_SHARE, 0.1, 100.0)
+    return max(reach, jkr_zero_load(mu)[0] if mu > 0 else 0.0)
+
+
+def _given(opts: AppOptions, names) -> list[str]:
+    return [n for n in names if opts.db.hasName(n)]
+
+
+def check_consistency(opts: AppOptions, model: Model) -> None:
+    """Refuse contradictions and options the chosen run ignores, before any work."""
+    fixed = opts.real("adh_lambda") is not None
+    ignored = []
+    if fixed:
+        ignored += [(n, "applies to a curve, not with -adh_lambda") for n in
+                    _given(opts, [n for n in TABLE if n.startswith(("cont_", "progress"))] + ["profiles", "plot",
+                                                                                     "target_error"])]
+    elif not opts.flag("cont_error_estimate"):
+        ignored += [(n, "refines error bars, which -cont_error_estimate false turns off") for n in
+                    _given(opts, ["target_error"])]
+    kind = opts.choice("grid_type")
+    if kind == "paper":
+        ignored += [(n, "is a -grid_type uniform option") for n in _given(opts, ["grid_n"])]
+    else:
+        ignored += [(n, "is a -grid_type paper option") for n in _given(opts, [n for n in TABLE
+                                                                                if n.startswith("grid_paper_")])]
+    for name, kinds in ROUGHNESS_OPTIONS.items():
+        if opts.db.hasName(name):
+            if model.roughness not in kinds:
+                ignored.append((name, f"applies to -adh_roughness {' or '.join(kinds)}"))
+            elif model.sigma == 0:
+                ignored.append((name, "sets the roughness average, not used at -adh_sigma 0"))
+    if opts.choice("adh_pmat") != "band":
+        ignored += [(n, "applies to -adh_pmat band") for n in _given(opts, ["adh_pmat_band"])]
+    if ignored:
+        name, why = ignored[0]
+        raise InputError(f"-{name}: {why}; remove it")
+    start, stop = opts.real("cont_lambda_start"), opts.real("cont_lambda_max")
+    if start is not None and stop is not None and start >= stop:
+        raise InputError(f"-cont_lambda_start: {start:g} is not below -cont_lambda_max {stop:g}")
+    ds, lo, hi = opts.real("cont_ds"), opts.real("cont_ds_min"), opts.real("cont_ds_max")
+    if lo > hi:
+        raise InputError(f"-cont_ds_min: {lo:g} is above -cont_ds_max {hi:g}")
+    if not lo <= ds <= hi:
+        raise InputError(f"-cont_ds: {ds:g} is outside [-cont_ds_min, -cont_ds_max] = [{lo:g}, {hi:g}]")
+    for t in opts.reals("cont_at_lambda"):
+        if (start is not None and t < start) or (stop is not None and t > stop):
+            raise InputError(f"-cont_at_lambda: {t:g} is outside the traced range "
+                             f"[{'-inf' if start is None else f'{start:g}'}, {'inf' if stop is None else f'{stop:g}'}]")
+    if opts.db.hasName("adh_rmax") and model.rmax < smallest_domain(model.mu):
+        raise InputError(f"-adh_rmax: {model.rmax:g} leaves out part of the contact at mu = {model.mu:g}: "
+                         f"expected at least {smallest_domain(model.mu):.3g} (the JKR contact radius, or the "
+                         f"reach of {DOMAIN_SHARE:.0%} of the attraction)")
+
+
+def check_memory(n: int, pmat: str, curve: bool, ranks: int) -> None:
+    """Refuse a grid whose dense matrices cannot fit: A, and G_H and the bordered
+    matrix when assembled densely, N^2 doubles each, split over the ranks."""
+    import os
+
+    dense = 1 + (pmat == "dense") * (1 + curve)
+    need = 8.0 * n * n * dense / ranks
+    have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    if need > 0.8 * have:
+        raise InputError(f"-grid_n: N = {n} needs {need / 2**30:.0f} GiB a rank for {dense} dense N x N "
+                         f"matrices, this machine has {have / 2**30:.0f} GiB; use fewer nodes, more ranks, "
+                         f"or -adh_pmat band")
+
+
+# -- PETSc's errors and options ------------------------------------------------------
+#: PETSc error codes that mean a bad option value: unknown type, wrong argument, out of range, no support.
+_INPUT_CODES = (56, 62, 63, 86, 92)
+
+
+#: Words of option names too common to say which option a PETSc message is about.
+_GENERIC = {"type", "snes", "ksp", "view", "monitor", "options", "file", "grid", "cont", "adh"}
+
+
+def petsc_error(err: PETSc.Error) -> InputError | str:
+    """What a PETSc error means for the user: the option behind it (an InputError), or one line.
+
+    PETSc keeps the specific message of its last error (PetscErrorMessage); the
+    option is the one whose value the message quotes, else one whose name's
+    words it uses ("Restart must be positive": -ksp_gmres_restart).
+    """
+    detail = capi.error_message(err.ierr) or f"PETSc error {err.ierr}"
+    # the application's options are checked before PETSc sees them; a number quoted is no one's name
+    given = {k: v for k, v in AppOptions().given().items() if k not in TABLE}
+    words = set(detail.lower().replace("'", " ").replace('"', " ").replace(",", " ").replace(":", " ").split())
+    by_value = [k for k, v in given.items() if v and v.lower() in words and not _NUMBER.fullmatch(v.strip())]
+    by_name = [k for k in given if any(len(w) >= 3 and w not in _GENERIC and w in words for w in k.lower().split("_"))]
+    named = by_value or by_name
+    if named:
+        value = f" {given[named[0]]}" if given[named[0]] else ""
+        return InputError(f"-{named[0]}{value}: {detail}")
+    if err.ierr in _INPUT_CODES:
+        return InputError(detail)
+    return f"PETSc error {err.ierr}: {detail}"
+
+
+#: Options PETSc itself reads at start-up or at the end of every program: never unknown.
+PETSC_GLOBAL = ("options_left", "options_view", "get_total_flops", "checkstack", "nox", "viewer_binary_skip_info",
+                "options_suppress_deprecated_warnings", "options_monitor", "memory_view", "malloc_view",
+                "malloc_dump", "objects_dump", "log_view", "log_view_memory", "help", "version", "skip_petscrc",
+                "options_file", "info", "malloc_debug", "malloc_test", "fp_trap", "on_error_abort",
+                "no_signal_handler", "history", "log_trace", "log_all", "log_exclude", "log_sync")
+
+
+_SOLVER_OPTIONS = ("snes_", "ksp_", "pc_", "sub_", "mat_")
+
+
+#: PETSc option names from PETSc's own -help (see :func:`petsc_names`), for the did-you-mean hint.
+_NAMES_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "petsc_options.txt")
+
+
+def petsc_names() -> list[str]:
+    """PETSc's option names (without prefix) that this program's solvers can read.
+
+    The list is PETSc's own -help output over the solver configurations the
+    program offers, made by ``python -m petsc_adhesion.benchmarks.petsc_names``.
+    """
+    with open(_NAMES_FILE) as f:
+        return [ln.strip() for ln in f if ln.strip() and not ln.startswith("#")]
+
+
+def _prefixes() -> tuple:
+    return tuple(p for p, _ in SOLVER_PREFIXES)
+
+
+def check_unused(judged=lambda name: True) -> None:
+    """Raise :class:`InputError` for an option that nobody read.
+
+    ``judged`` picks the options to judge: the application's own, which are
+    all read up front, before any work; or all of them once the solvers are
+    set up, when PETSc has read its own.
+    """
+    left = [n for n in capi.options_left() if judged(n) and n not in PETSC_GLOBAL]
+    if not left:
+        return
+    name = left[0]
+    bare = next((name[len(p):] for p in _prefixes() if p and name.startswith(p)), name)
+    names = petsc_names()
+    if bare in names and bare.startswith(_SOLVER_OPTIONS):
+        where = ", ".join(f"-{p}{bare} for {what}" for p, what in SOLVER_PREFIXES)
+        block = " (and a sub-PC option needs a block PC)" if bare.startswith("sub_") else ""
+        raise InputError(f"-{name}: not used by the solvers this run configures{block}; use {where}")
+    candidates = list(TABLE) + [p + n for p in _prefixes() for n in names]
+    near = difflib.get_close_matches(name, candidates, n=1, cutoff=0.75)
+    hint = f" (did you mean -{near[0]}?)" if near else ""
+    raise InputError(f"-{name}: unknown option{hint}; -help lists the options")
+
+
+#: PETSc's solver options whose values PETSc accepts out of range or takes as "default"
+#: without a word: name -> (kind, lowest, highest, lowest open, highest open).
+_PETSC_RANGES = {
+    "snes_rtol": ("real", 0.0, 1.0, False, True), "snes_atol": ("real", 0.0, math.inf, False, False),
+    "snes_stol": ("real", 0.0, 1.0, False, True), "snes_max_it": ("int", 1, 10**9, False, False),
+    "snes_max_funcs": ("int", 1, 10**12, False, False), "ksp_rtol": ("real", 0.0, 1.0, False, True),
+    "ksp_atol": ("real", 0.0, math.inf, False, False), "ksp_max_it": ("int", 1, 10**9, False, False),
+    "ksp_divtol": ("real", 1.0, math.inf, True, False), "snes_linesearch_damping": ("real", 0.0, 1.0, True, False),
+    "snes_linesearch_max_it": ("int", 1, 10**6, False, False), "ksp_gmres_restart": ("int", 1, 10**6, False, False),
+}
+
+
+def check_petsc_values(db: PETSc.Options | None = None) -> None:
+    """Raise :class:`InputError` for a solver tolerance or count out of its range, under any prefix,
+    or a Python solver type (it needs a context this program does not give)."""
+    db = db or PETSc.Options()
+    for name, value in db.getAll().items():        # getAll does not mark options used, getString would
+        if name.endswith("_type") and value == "python":
+            raise InputError(f"-{name} python: a Python type needs its context, which this program does not "
+                             f"set; choose one of PETSc's own types")
+    for prefix in _prefixes():
+        for name, (kind, lo, hi, lo_open, hi_open) in _PETSC_RANGES.items():
+            if not db.hasName(prefix + name):
+                continue
+            o = Option(prefix + name, kind, None, "", lo, hi, lo_open, hi_open=hi_open)
+            AppOptions(db)._number(o, db.getString(prefix + name, ""), _strict_float if kind == "real" else _strict_int)

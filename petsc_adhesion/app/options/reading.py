@@ -1,0 +1,291 @@
+"""Options into the library's typed objects: the model, the grid and solver choices, the continuation settings
+and what a curve reports, each checked as it is read (one line naming the option for a bad value)."""
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+from petsc4py import PETSc
+
+from ...errors import InputError, printable
+from ...model.heights import HeightFileError, read_heights
+from ...model.parameters import Model
+from ...model.physical import Bodies
+from ...model.roughness import Measured
+from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings
+from .table import TABLE, Option
+
+__all__ = ["AppOptions", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
+           "read_request", "read_settings"]
+
+
+class AppOptions:
+    """Typed, checked reads of :data:`TABLE` options from the PETSc database."""
+
+    def __init__(self, db: PETSc.Options | None = None):
+        self.db = db or PETSc.Options()
+
+    def _raw(self, name: str) -> str | None:
+        if name not in TABLE:
+            raise KeyError(name)
+        if not self.db.hasName(name):
+            return None
+        return self.db.getString(name, "")
+
+    def _bad(self, o: Option, raw: str) -> InputError:
+        return InputError(f"-{o.name}: expected {o.allowed()}, got '{raw}'")
+
+    def _number(self, o: Option, raw: str, cast) -> float:
+        try:
+            x = cast(raw)
+        except ValueError:
+            raise self._bad(o, raw) from None
+        if not math.isfinite(x) or x > o.hi or x < o.lo or (o.lo_open and x == o.lo) or (o.hi_open and x == o.hi):
+            raise self._bad(o, raw)
+        return x
+
+    def real(self, name: str):
+        """The value of a real option, checked against its range, or its default."""
+        o, raw = TABLE[name], self._raw(name)
+        return o.default if raw is None else self._number(o, raw, _strict_float)
+
+    def int(self, name: str):
+        """The value of an integer option, checked against its range, or its default."""
+        o, raw = TABLE[name], self._raw(name)
+        return o.default if raw is None else int(self._number(o, raw, _strict_int))
+
+    def reals(self, name: str) -> tuple:
+        """The values of a comma-separated list of reals, each checked, or the default."""
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        return tuple(self._number(o, s.strip(), _strict_float) for s in raw.split(",") if s.strip())
+
+    def sweep(self, name: str) -> tuple:
+        """The values of a sweep: comma-separated reals or ranges ``lo:hi:n`` (n evenly spaced values)
+        and ``lo:hi:n:log`` (n geometrically spaced, lo > 0), each checked, in the order given.
+
+        >>> AppOptions._range("0.01:1:3:log"), AppOptions._range("0:1:5")
+        ((0.01, 0.1, 1.0), (0.0, 0.25, 0.5, 0.75, 1.0))
+        """
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        out = []
+        for item in (s.strip() for s in raw.split(",")):
+            try:
+                values = self._range(item) if ":" in item else (_strict_float(item),)
+            except ValueError:
+                raise self._bad(o, raw) from None
+            out += [self._number(o, repr(x), float) for x in values]
+        if not out:
+            raise self._bad(o, raw)
+        return tuple(out)
+
+    @staticmethod
+    def _range(item: str) -> tuple:
+        parts = item.split(":")
+        if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] != "log"):
+            raise ValueError(item)
+        lo, hi, n = _strict_float(parts[0]), _strict_float(parts[1]), _strict_int(parts[2])
+        if n < 2 or not lo < hi or (len(parts) == 4 and lo <= 0):
+            raise ValueError(item)
+        xs = np.geomspace(lo, hi, n) if len(parts) == 4 else np.linspace(lo, hi, n)
+        return tuple(float(x) for x in np.round(xs, 12))
+
+    def choices(self, name: str) -> tuple:
+        """A comma-separated subset of an option's choices, or its default."""
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        picked = tuple(s.strip() for s in raw.split(","))
+        if not all(p in o.choices for p in picked):
+            raise self._bad(o, raw)
+        return picked
+
+    def choice(self, name: str) -> str:
+        """The value of a choice option, one of its choices, or its default."""
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        if raw not in o.choices:
+            raise self._bad(o, raw)
+        return raw
+
+    def string(self, name: str):
+        """The value of a string option (non-empty), or its default."""
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        if not raw:
+            raise self._bad(o, raw)
+        return raw
+
+    def flag(self, name: str) -> bool:
+        """The value of a flag (bare, or true/false, yes/no, on/off, 1/0), or its default."""
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        if raw.lower() in ("", "1", "true", "yes", "on"):
+            return True
+        if raw.lower() in ("0", "false", "no", "off"):
+            return False
+        raise self._bad(o, raw)
+
+    def given(self) -> dict:
+        """Every option in the database as given: name -> value string (None for a bare flag).
+
+        petsc4py's getAll splits values at blanks; each value is read again whole,
+        which marks every option used: only after the checks for unused options.
+        """
+        return {k: (None if v is None else self.db.getString(k, "")) for k, v in self.db.getAll().items()}
+
+    def values(self) -> dict:
+        """Every application option's value, as ``repr`` of what it reads (defaults included)."""
+        return {name: repr(getattr(self, o.kind)(name)) for name, o in TABLE.items()}
+
+    def read_all(self) -> None:
+        """Read (and so check) every application option now, before any work."""
+        for name, o in TABLE.items():
+            getattr(self, o.kind)(name)
+
+
+#: A number as users write it: no Python extras (1_0, 0x10, whitespace), inf and nan named to be refused.
+_NUMBER = re.compile(r"[+-]?((\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|inf|infinity|nan)", re.I)
+
+
+def _strict_float(s: str) -> float:
+    if not _NUMBER.fullmatch(s.strip()):
+        raise ValueError(s)
+    return float(s)
+
+
+def _strict_int(s: str) -> int:
+    x = _strict_float(s)
+    if not math.isfinite(x) or x != int(x):
+        raise ValueError(s)
+    return int(x)
+
+
+# -- options into objects ------------------------------------------------------------
+#: The options of :class:`~petsc_adhesion.model.physical.Bodies`, by field.
+PHYSICAL = {f: f"phys_{f}" for f in ("radius", "radius2", "young1", "poisson1", "young2", "poisson2", "gamma",
+                                     "hamaker", "hamaker_cutoff", "epsilon", "rms")}
+
+
+def read_physical(opts: AppOptions) -> Bodies | None:
+    """The bodies of the -phys_ options (SI), or None without them; one line for a missing or
+    contradicting input."""
+    given = {f: opts.real(name) for f, name in PHYSICAL.items() if opts.db.hasName(name)}
+    if not given:
+        return None
+    for f in ("radius", "young1", "poisson1", "epsilon"):
+        if f not in given:
+            raise InputError(f"-{PHYSICAL[f]}: required with the other -phys_ options (radius, young1, poisson1, "
+                             f"epsilon, and gamma or hamaker)")
+    if ("gamma" in given) == ("hamaker" in given):
+        raise InputError("-phys_gamma: not with -phys_hamaker; give one of them (the work of adhesion)"
+                         if "gamma" in given else "-phys_gamma: required, or -phys_hamaker (the work of adhesion)")
+    if ("young2" in given) != ("poisson2" in given):
+        raise InputError(f"-{PHYSICAL['poisson2' if 'young2' in given else 'young2']}: needed with "
+                         f"-{PHYSICAL['young2' if 'young2' in given else 'poisson2']} (eq. 2)")
+    if "hamaker_cutoff" in given and "hamaker" not in given:
+        raise InputError("-phys_hamaker_cutoff: only with -phys_hamaker")
+    for name, why in (("adh_mu", "the -phys_ options set mu by eq. (9)"),
+                      *((("adh_sigma", "-phys_rms sets sigma = rms / epsilon"),) if "rms" in given else ())):
+        if opts.db.hasName(name):
+            raise InputError(f"-{name}: not with the -phys_ options: {why}")
+    if "rms" in given and opts.choice("adh_roughness") == "measured":
+        raise InputError("-phys_rms: not with -adh_roughness measured, whose heights set sigma")
+    bodies = Bodies(**given)
+    if not 0 <= bodies.mu <= TABLE["adh_mu"].hi:
+        raise InputError(f"-phys_radius: with the other -phys_ options gives mu = {bodies.mu:.3g} by eq. (9), "
+                         f"outside [0, {TABLE['adh_mu'].hi:g}]")
+    if bodies.sigma is not None and not bodies.sigma <= TABLE["adh_sigma"].hi:
+        raise InputError(f"-phys_rms: gives sigma = rms / epsilon = {bodies.sigma:.3g}, above "
+                         f"{TABLE['adh_sigma'].hi:g}")
+    return bodies
+
+
+def read_model(opts: AppOptions) -> Model:
+    """The model of -adh_mu (or the -phys_ options), -adh_sigma (or -phys_rms), -adh_rmax and the roughness
+    rule."""
+    phys = read_physical(opts)
+    mu = phys.mu if phys else opts.real("adh_mu")
+    rmax = opts.real("adh_rmax")
+    if rmax is None:
+        rmax = GridChoice(opts.choice("grid_type")).default_rmax
+    rough, sigma, heights = opts.choice("adh_roughness"), opts.real("adh_sigma"), None
+    if phys and phys.sigma is not None:
+        sigma = phys.sigma
+    if rough == "measured":
+        heights = read_measured(opts, phys.epsilon if phys else None)
+        sigma = Measured(heights).rms
+    model = Model(mu=mu, sigma=sigma, rmax=rmax, roughness=rough, hermite_points=opts.int("adh_hermite_points"),
+                  roughness_cutoff=opts.real("adh_roughness_cutoff"),
+                  roughness_skewness=opts.real("adh_roughness_skewness"),
+                  quadrature_points=opts.int("adh_quadrature_points"), heights=heights,
+                  farfield=opts.flag("adh_farfield"), bodies=phys)
+    if model.roughness == "none" and model.sigma > 0:
+        raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
+    return model
+
+
+def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
+    """The heights of -adh_roughness_file in units of epsilon (:func:`~.roughness.read_heights`)."""
+    path = opts.string("adh_roughness_file")
+    if path is None:
+        raise InputError("-adh_roughness_file: required with -adh_roughness measured: a file of heights")
+    if opts.db.hasName("adh_sigma"):
+        raise InputError("-adh_sigma: not with -adh_roughness measured, whose heights set it")
+    try:
+        heights = read_heights(path, epsilon, opts.real("adh_roughness_unit"))
+        Measured(heights)
+    except HeightFileError as e:
+        why = str(e).replace("need epsilon (> 0, in metres) for units of epsilon", "need -phys_epsilon")
+        raise InputError(f"-adh_roughness_file: {printable(why)}") from None
+    if not np.sqrt(np.mean((heights - heights.mean()) ** 2)) <= TABLE["adh_sigma"].hi:
+        raise InputError(f"-adh_roughness_file: heights of rms above {TABLE['adh_sigma'].hi:g} epsilon")
+    return heights
+
+
+def read_grid(opts: AppOptions, model: Model) -> GridChoice:
+    """The grid of -grid_type and its options, checked against the domain [0, r_m] of ``model``."""
+    kind = opts.choice("grid_type")
+    choice = GridChoice(kind, n=opts.int("grid_n"), paper_uniform=opts.int("grid_paper_uniform"),
+                        paper_extra=opts.int("grid_paper_extra"), paper_split=opts.int("grid_paper_split"),
+                        paper_refine_from=opts.real("grid_paper_refine_from"))
+    if kind == "paper":
+        nu, extra, start = choice.paper_uniform, choice.paper_extra, choice.paper_refine_from
+        if extra > nu - 1:
+            raise InputError(f"-grid_paper_extra: expected an integer in [0, {nu - 1}], got {extra}")
+        if start >= model.rmax:
+            raise InputError(f"-grid_paper_refine_from: expected a real in [0, {model.rmax:g}), got {start:g}")
+    return choice
+
+
+def read_solver(opts: AppOptions) -> SolverChoice:
+    """What every solver's preconditioner is built from (-adh_pmat, -adh_pmat_band) and how long it is kept."""
+    return SolverChoice(pmat=opts.choice("adh_pmat"), band=opts.int("adh_pmat_band"),
+                        pc_reuse_its=opts.int("adh_pc_reuse_its"))
+
+
+def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = False) -> CurveRequest:
+    """What a curve reports (-cont_lambda_start, -cont_at_lambda, -cont_event_tol, -cont_error_estimate,
+    -target_error, -profiles); ``kinds`` and ``profiles`` as a study's case asks."""
+    return CurveRequest(lambda_start=opts.real("cont_lambda_start"), at_lambda=opts.reals("cont_at_lambda"),
+                        event_tol=opts.real("cont_event_tol"), error_bars=opts.flag("cont_error_estimate"),
+                        target_error=opts.real("target_error"), profiles=profiles or opts.flag("profiles"),
+                        kinds=kinds)
+
+
+def read_settings(opts: AppOptions):
+    """The continuation's step control and stops; the load F is the observable watched."""
+    lam_max = opts.real("cont_lambda_max")
+    return curve_settings(corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
+                          ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
+                          max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
+                          observable_step=opts.real("cont_dF_max"), observable_max=opts.real("cont_F_max"),
+                          p_max=math.inf if lam_max is None else lam_max, max_steps=opts.int("cont_max_steps"),
+                          pc_reuse_its=opts.int("adh_pc_reuse_its"), monitor=opts.flag("cont_monitor"))

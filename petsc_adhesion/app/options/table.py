@@ -1,0 +1,206 @@
+"""The option table: every application option, its kind, default, accepted values and help.
+
+The defaults are those of the objects the options configure (``Model``,
+``GridChoice``, ``SolverChoice``, ``Settings``, ``CurveRequest``), read from
+there; -help and docs/usage.md are made from this table.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ...app import checkpoint, progress
+from ...core.bordered import ARCLENGTH_PREFIX
+from ...core.continuation import CORRECTORS, NATURAL_PREFIX, Settings
+from ...core.events import EVENT_TOL
+from ...core.newton import PC_REUSE_ITS
+from ...discretization import grid, preconditioning
+from ...model.parameters import Model
+from ...model.physical import HAMAKER_CUTOFF
+from ...model.roughness import DISTRIBUTIONS, Weibull
+from ...tracing.edge_grids import RMAX
+from ...tracing.trace import F_MAX
+
+__all__ = ["Option", "RULES_HERMITE", "SOLVER_PREFIXES", "TABLE", "ROUGHNESS_OPTIONS"]
+
+
+@dataclass(frozen=True)
+class Option:
+    """One application option: its kind, default, help and accepted values."""
+
+    name: str
+    kind: str          # "real" | "int" | "choice" | "string" | "flag" | "reals"
+    default: object
+    help: str
+    lo: float = -math.inf
+    hi: float = math.inf
+    lo_open: bool = False
+    choices: tuple = ()
+    hi_open: bool = False
+
+    def allowed(self) -> str:
+        """What the option accepts, in words."""
+        if self.kind == "choice":
+            return "one of " + ", ".join(self.choices)
+        if self.kind == "choices":
+            return "comma-separated names from " + ", ".join(self.choices)
+        if self.kind in ("real", "int", "reals", "sweep"):
+            left, right = "(" if self.lo_open else "[", ")" if self.hi_open else "]"
+            what = {"real": "a finite real", "int": "an integer", "reals": "comma-separated finite reals",
+                    "sweep": "comma-separated reals or ranges lo:hi:n[:log]"}[self.kind]
+            if self.lo == -math.inf and self.hi == math.inf:
+                return what
+            return f"{what} in {left}{_fmt(self.lo)}, {_fmt(self.hi)}{right}"
+        return {"string": "a file name", "flag": "true or false"}[self.kind]
+
+
+def _fmt(x: float) -> str:
+    return "inf" if x == math.inf else "-inf" if x == -math.inf else f"{x:g}"
+
+
+#: -adh_roughness values averaged by a Gauss-Hermite rule (pressure.RULES without "none").
+RULES_HERMITE = ("hermite",)
+
+
+
+
+#: Options prefixes of the three solvers: (prefix, what it solves).
+SOLVER_PREFIXES = (("", "the fixed-approach solve (-adh_lambda)"),
+                   (NATURAL_PREFIX, "the continuation's natural corrector and first point"),
+                   (ARCLENGTH_PREFIX, "its arclength corrector and tangents"))
+
+
+_INF = math.inf
+
+
+_S = Settings
+
+
+TABLE = {o.name: o for o in [
+    # model (paper eq. 9-14)
+    Option("adh_mu", "real", Model.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
+    Option("adh_sigma", "real", Model.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
+    Option("adh_roughness", "choice", Model.roughness, "height distribution averaged over (eq. 7, 10): the "
+           "paper's Gaussian by its Gauss-Hermite rule (eq. 14), whose rule is the model; Gaussian truncated at "
+           "the highest asperity; skewed (reversed Weibull); measured heights; none (smooth)",
+           choices=("none", *RULES_HERMITE, *DISTRIBUTIONS)),
+    Option("adh_hermite_points", "int", Model.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
+    Option("adh_roughness_cutoff", "real", Model.roughness_cutoff, "truncated_gaussian: the highest asperity, "
+           "in standard deviations (-adh_sigma) of the untruncated Gaussian", 0.0, 10.0, lo_open=True),
+    Option("adh_roughness_skewness", "real", Model.roughness_skewness, "weibull: skewness of the heights "
+           "(-2: exponential valleys, 0.5: the most symmetric bounded)", *Weibull.SKEWNESS),
+    Option("adh_roughness_file", "string", None, "measured: heights, one a line in units of epsilon; a table "
+           "(Gwyddion ASCII export, '# Value units: m'), .gsf or .npy height map; it sets sigma itself"),
+    Option("adh_roughness_unit", "real", None, "measured: metres per value of a file that states no unit "
+           "(needs -phys_epsilon)", 0.0, 1.0, lo_open=True),
+    Option("adh_quadrature_points", "int", Model.quadrature_points, "truncated_gaussian, weibull: points of "
+           "the quadrature's moving part at the wall (its fixed panels get 2/3 as many)", 2, 400),
+    Option("adh_rmax", "real", None, f"end r_m of the computational domain (default: {RMAX:g} on grids that "
+           f"follow the contact edge, {grid.PAPER_RMAX:g} as in the paper otherwise)", 0.0, 1e3, lo_open=True),
+    Option("adh_farfield", "flag", Model.farfield, "add the rigid sphere's attraction beyond r_m to the load: "
+           "the half-infinite model (false: the paper's model truncated at r_m)"),
+    Option("adh_lambda", "real", None, "solve at this one approach lambda only (no continuation)", -1e3, 1e3),
+    Option("adh_guess", "string", None, "HDF5 result whose H(r) is the initial guess of -adh_lambda"),
+    Option("adh_pmat", "choice", "dense", "matrix handed to the preconditioner: the assembled Jacobian, "
+           "its near-field band (AIJ), or the shell itself", choices=preconditioning.KINDS),
+    Option("adh_pmat_band", "int", preconditioning.BAND, "half bandwidth of -adh_pmat band", 0, 10**6),
+    Option("adh_pc_reuse_its", "int", PC_REUSE_ITS, "keep the preconditioner while Krylov needs at most this many "
+           "iterations (0: rebuild at every Newton iteration)", 0, 10**6),
+    # grid
+    # physical inputs (SI): mu from eq. (9), sigma = rms / epsilon, results also in nN, nm, MPa
+    Option("phys_radius", "real", None, "radius R1 of the sphere (m); with -phys_young1, -phys_poisson1, "
+           "-phys_gamma (or -phys_hamaker) and -phys_epsilon it sets mu by eq. (9), and results are reported also "
+           "in nN, nm and MPa", 0.0, 1.0, lo_open=True),
+    Option("phys_radius2", "real", None, "radius R2 of a second sphere (m): R = R1 R2 / (R1 + R2) (default: a "
+           "flat)", 0.0, 1.0, lo_open=True),
+    Option("phys_young1", "real", None, "Young's modulus E1 of the sphere (Pa)", 0.0, 1e13, lo_open=True),
+    Option("phys_poisson1", "real", None, "Poisson's ratio nu1 of the sphere", -1.0, 0.5, lo_open=True),
+    Option("phys_young2", "real", None, "Young's modulus E2 of the flat (or second sphere) (Pa); eq. (2) "
+           "(default: rigid)", 0.0, 1e13, lo_open=True),
+    Option("phys_poisson2", "real", None, "Poisson's ratio nu2 of the flat (with -phys_young2)", -1.0, 0.5,
+           lo_open=True),
+    Option("phys_gamma", "real", None, "work of adhesion gamma (J/m^2)", 0.0, 100.0, lo_open=True),
+    Option("phys_hamaker", "real", None, "Hamaker constant A (J), instead of -phys_gamma: gamma = A / (12 pi D0^2)",
+           0.0, 1e-16, lo_open=True),
+    Option("phys_hamaker_cutoff", "real", None, f"cut-off distance D0 of -phys_hamaker (m; default "
+           f"{HAMAKER_CUTOFF:g}, Israelachvili's)", 0.0, 1e-8, lo_open=True),
+    Option("phys_epsilon", "real", None, "equilibrium spacing epsilon of the Lennard-Jones law (m)", 0.0, 1e-8,
+           lo_open=True),
+    Option("phys_rms", "real", None, "rms roughness of the combined surfaces (m): sigma = rms / epsilon", 0.0,
+           1e-6),
+    Option("grid_type", "choice", "edge", "node set: graded about the contact edge and following it along "
+           "the curve; the paper's; uniform", choices=("edge", "paper", "uniform")),
+    Option("grid_n", "int", grid.PAPER_UNIFORM + grid.PAPER_EXTRA, "number of nodes of -grid_type uniform",
+           3, 200000),
+    Option("grid_paper_uniform", "int", grid.PAPER_UNIFORM, "uniform nodes of -grid_type paper", 3, 200000),
+    Option("grid_paper_extra", "int", grid.PAPER_EXTRA, "elements refined by -grid_type paper", 0, 200000),
+    Option("grid_paper_split", "int", grid.PAPER_SPLIT, "parts each refined element is split into", 2, 1000),
+    Option("grid_paper_refine_from", "real", 0.0, "first refined element of -grid_type paper starts here", 0.0, 1e3),
+    # continuation
+    Option("cont_type", "choice", _S.corrector, f"corrector: switch at |lambdadot| < {_S.switch:g} (paper), "
+           "or one kind", choices=CORRECTORS),
+    Option("cont_lambda_start", "real", None, "first approach (default: below the reach of the forces)", -1e3, 1e3),
+    Option("cont_lambda_max", "real", None, "stop at this approach (default: past equilibrium)", -1e3, 1e3),
+    Option("cont_F_max", "real", F_MAX, "stop at this compressive load", -_INF, 1e6),
+    Option("cont_max_steps", "int", _S.max_steps, "stop after this many accepted steps", 1, 10**7),
+    Option("cont_dF_max", "real", _S.observable_step, "largest change of the load in one step, relative above "
+           "|F| = 1", 0.0, 1e6, lo_open=True),
+    Option("cont_max_folds", "int", _S.max_folds, "stop after more than this many turning points (a grid that "
+           "traps the contact edge makes dozens)", 0, 10**6),
+    Option("cont_ds", "real", _S.ds, "first arclength step", 0.0, 1e3, lo_open=True),
+    Option("cont_ds_min", "real", _S.ds_min, "smallest step before giving up", 0.0, 1e3, lo_open=True),
+    Option("cont_ds_max", "real", _S.ds_max, "largest step", 0.0, 1e3, lo_open=True),
+    Option("cont_newton_target", "int", _S.newton_target, "corrector iterations aimed at by the step control",
+           1, 100),
+    Option("cont_max_deviation", "real", _S.max_deviation, "largest corrector distance from the predictor, per "
+           "unit step (bounds the step by the curvature)", 0.0, 10.0, lo_open=True),
+    Option("cont_at_lambda", "reals", (), "approaches at which to record the state (e.g. 0 for Fig. 12)", -1e3, 1e3),
+    Option("cont_event_tol", "real", EVENT_TOL, "event location tolerance in lambda", 0.0, 1.0, lo_open=True),
+    Option("cont_monitor", "flag", _S.monitor, "one line a continuation step"),
+    Option("cont_checkpoint", "string", None, "save the curve's state (a study's: its finished cases) into "
+           "this file as it goes, for -cont_restart (default: .NAME.checkpoint beside -out, else -summary or "
+           "-plot; the file restarted from; none: no checkpoint); a finished run removes it"),
+    Option("cont_checkpoint_interval", "real", checkpoint.INTERVAL, "least seconds between two checkpoint saves "
+           "(0: before every step)", 0.0, 1e6),
+    Option("cont_restart", "string", None, "go on from this checkpoint of an interrupted run with the same "
+           "options (output and printing options aside): the same steps, events and error bars; a study runs "
+           "only the cases not in it"),
+    Option("cont_error_estimate", "flag", True, "give every event its best value and error bar: located again "
+           "on its grid's coarser (or finer) nested levels, Richardson-extrapolated"),
+    Option("target_error", "real", None, "refine each event's levels until its error bars (lambda and F) are "
+           "below this", 0.0, 1.0, lo_open=True),
+    # studies: a sweep over cases (petsc_adhesion.app.study)
+    Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 50.0),
+    Option("study_sigma", "sweep", (), "study: the roughness sigma of its cases", 0.0, 5.0),
+    Option("study_option", "string", None, "study: a further real or integer option swept over -study_values "
+           "(without the dash, e.g. phys_radius, adh_hermite_points, grid_n)"),
+    Option("study_values", "sweep", (), "study: the values of -study_option", -1e12, 1e12),
+    Option("study_compute", "choice", "curve", "study: what each case computes: the whole curve; the events up to "
+           "equilibrium; only the pull-off and the equilibrium after it; only the turning points; the critical "
+           "roughness sigma_c(mu) of each -study_mu and the critical mu_c(sigma) of each -study_sigma",
+           choices=("curve", "events", "pull_off", "folds", "critical")),
+    Option("study_profiles", "choices", (), "study: the event kinds whose H(r), P(r) each case keeps",
+           choices=("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda")),
+    Option("study_ranks", "int", 1, "study: MPI ranks per case; the cases are spread over the groups of this "
+           "many ranks, the longest first", 1, 10**6),
+    Option("study_plot", "choice", "curves", "study: what -plot draws: load-approach curves; one panel per case "
+           "about its turning points; the profiles of -study_profiles; pull-off against mu; reduction of the "
+           "pull-off against sigma; the boundary of hysteresis (sigma_c, mu_c: the only one, and the default, with "
+           "-study_compute critical)",
+           choices=("curves", "folds", "profiles", "pull_off", "reduction", "critical")),
+    # output
+    Option("out", "string", None, "HDF5 result file"),
+    Option("summary", "string", None, "JSON summary file"),
+    Option("profiles", "flag", False, "store H(r) and P(r) at every event"),
+    Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
+    Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "
+           "events, time elapsed and an estimate of the time left (default: when stderr is a terminal)"),
+    Option("progress_interval", "real", progress.INTERVAL, "least seconds between two progress lines", 0.0, 1e6,
+           lo_open=True),
+]}
+
+
+#: Options of one roughness model: name -> the -adh_roughness values that use it.
+ROUGHNESS_OPTIONS = {"adh_hermite_points": RULES_HERMITE, "adh_roughness_cutoff": ("truncated_gaussian",),
+                     "adh_roughness_skewness": ("weibull",), "adh_quadrature_points": ("truncated_gaussian", "weibull"),
+                     "adh_roughness_file": ("measured",), "adh_roughness_unit": ("measured",)}

@@ -1,0 +1,182 @@
+"""One run of the program: its options into the library's objects, one library call, the result files.
+
+    petsc-adhesion -adh_mu 2 -out mu2.h5 -summary mu2.json     # the load-approach curve
+    petsc-adhesion -adh_mu 2 -adh_lambda -3                    # the state at one approach
+
+A run is either the whole load-approach curve
+(:func:`~petsc_adhesion.tracing.trace.trace_curve`, the default) or one solve at
+a fixed approach (``-adh_lambda``, :func:`~petsc_adhesion.tracing.trace.solve_at`).
+Data flow one way: the options are read into typed objects and checked
+(:func:`read`, on every rank, agreed before any work), the library computes,
+and rank 0 writes the files all together or none
+(:mod:`petsc_adhesion.io.write`) and the console report.  A study of many cases
+is :mod:`petsc_adhesion.app.study`'s.
+"""
+from __future__ import annotations
+
+import sys
+from contextlib import nullcontext
+from dataclasses import dataclass
+
+from petsc4py import PETSc
+
+from ..core.continuation import Settings
+from ..errors import InputError, Interrupted, collective
+from ..io.guess import read_guess
+from ..io.report import report_curve, report_solve
+from ..io.resultset import PLOT_FORMATS, check_targets, mark_done, written
+from ..io.write import write_curve, write_solve
+from ..model.parameters import Model
+from ..model.pressure import pressure_law
+from ..tracing.trace import (
+    CurveRequest,
+    GridChoice,
+    SolverChoice,
+    configure_solvers,
+    solve_at,
+    trace_curve,
+)
+from .checkpoint import open_checkpoint
+from .options.checks import (
+    check_consistency,
+    check_memory,
+    check_petsc_values,
+    check_unused,
+)
+from .options.reading import (
+    AppOptions,
+    read_grid,
+    read_model,
+    read_request,
+    read_settings,
+    read_solver,
+)
+from .options.table import TABLE
+from .optionsfile import options_files
+from .progress import Progress
+
+__all__ = ["Request", "read", "execute", "main", "is_study", "refuse_study_options"]
+
+_APP = ("adh_", "grid_", "cont_")
+_OUTPUTS = ("out", "summary", "plot")
+
+
+def is_study(opts: AppOptions) -> bool:
+    """Whether the options describe a study of many cases (:mod:`petsc_adhesion.app.study`)."""
+    return any(opts.db.hasName(n) for n in ("study_mu", "study_sigma", "study_option")) or \
+        opts.choice("study_compute") == "critical"
+
+
+def _is_app(name: str) -> bool:
+    return name.startswith(_APP) or name in TABLE
+
+
+@dataclass
+class Request:
+    """Everything a run needs from its options, read into the library's objects and checked."""
+
+    model: Model
+    grid: GridChoice
+    solver: SolverChoice
+    settings: Settings
+    curve: CurveRequest
+    lam: float | None                 # a fixed approach, or None for the curve
+    guess: str | None                 # -adh_guess
+    targets: dict                     # option -> output path
+    inputs: dict                      # option -> paths read
+
+
+def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False) -> Request:
+    """Read and check every option before any work (PETSc's solver options too, as far as they can be judged
+    before the solvers exist); ``kinds`` and ``profiles``: what a study's case reports."""
+    model = read_model(opts)
+    grid_choice = read_grid(opts, model)
+    lam = opts.real("adh_lambda")
+    nodes = grid_choice.nodes(model.rmax)
+    if nodes is not None:
+        check_memory(nodes.size, opts.choice("adh_pmat"), lam is None, comm.getSize())
+    if opts.string("adh_guess") is not None and lam is None:
+        raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
+    opts.read_all()
+    check_unused(_is_app)
+    check_consistency(opts, model)
+    check_petsc_values(opts.db)
+    targets = {k: opts.string(k) for k in _OUTPUTS if opts.string(k)}
+    if "plot" in targets and not targets["plot"].lower().endswith(tuple(PLOT_FORMATS)):
+        raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
+    inputs = {"options_file": options_files(argv), "adh_guess": [opts.string("adh_guess") or ""],
+              "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
+    if comm.getRank() == 0:                  # only rank 0 writes
+        check_targets(targets, inputs)
+    return Request(model, grid_choice, read_solver(opts), read_settings(opts), read_request(opts, kinds, profiles),
+                   lam, opts.string("adh_guess"), targets, inputs)
+
+
+def execute(opts: AppOptions, argv: list[str], report: bool = True):
+    """The run of the options database: (exit status, the library's result: a
+    :class:`~petsc_adhesion.tracing.curve.Curve` or :class:`~petsc_adhesion.tracing.curve.Solution`).
+
+    Rank 0 writes the files asked for and, with ``report``, the console lines.  Errors raise
+    (:mod:`petsc_adhesion.app.cli` turns them into one line).
+    """
+    comm = PETSc.COMM_WORLD
+    req = collective(comm, read, opts, comm, argv)
+    ck = None
+    if req.lam is None:
+        ck = open_checkpoint(opts, req.targets, req.inputs, comm)
+        shown = opts.flag("progress")
+        progress = Progress(comm, sys.stderr.isatty() if shown is None else shown, opts.real("progress_interval"))
+        with ck.on_interrupt():
+            result = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, checkpoint=ck,
+                                 progress=progress, started=check_unused)
+    else:
+        guess = None if req.guess is None else \
+            collective(comm, read_guess, req.guess, pressure_law(req.model).wall)
+        result = solve_at(req.lam, req.model, req.grid, req.solver, guess=guess, started=check_unused)
+    check_unused()
+    status = 3 if req.lam is None and not result.complete else 0
+    files = None
+    try:
+        if comm.getRank() == 0:
+            given = opts.given()
+            with ck.on_interrupt() if ck else nullcontext(), written(req.targets, ck.paths() if ck else ()) as files:
+                if req.lam is None:
+                    write_curve(result, given, files)
+                else:
+                    write_solve(result, given, files)
+            if report:
+                if req.lam is None:
+                    report_curve(result.summary)
+                else:
+                    report_solve(result.summary, result.summary.get("physical"))
+        PETSc.garbage_cleanup()
+    except Interrupted as e:
+        mark_done(e, files, status)
+        raise
+    return status, result
+
+
+def refuse_study_options(opts: AppOptions) -> None:
+    """An InputError for an option of a study of many cases given to one run."""
+    stray = [n for n in TABLE if n.startswith("study_") and opts.db.hasName(n)]
+    if stray:
+        raise InputError(f"-{stray[0]}: applies to a study of many cases (-study_mu, -study_sigma or "
+                         f"-study_option); remove it")
+
+
+def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
+    """One run of the options database (initialised from ``argv``); its exit status.
+
+    ``helping`` (-help): the options are checked and the solvers made, so that they print their own
+    options, and nothing is computed.
+    """
+    comm = PETSc.COMM_WORLD
+    if not helping:
+        refuse_study_options(opts)
+    if helping:
+        req = collective(comm, read, opts, comm, argv)
+        if req.lam is None:
+            open_checkpoint(opts, req.targets, req.inputs, comm)
+        configure_solvers(req.model, req.grid, req.solver, req.settings, req.lam)
+        return 0
+    return execute(opts, argv)[0]

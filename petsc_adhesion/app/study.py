@@ -1,0 +1,401 @@
+"""Studies: a sweep over cases described by options, spread over MPI ranks.
+
+    ./run study options/fig18.opts
+    mpiexec -n 2 petsc-adhesion -options_file options/fig18.opts
+
+The cases are the product of ``-study_mu``, ``-study_sigma`` and ``-study_option``'s
+``-study_values`` (each a list or ranges ``lo:hi:n[:log]``); every other option
+applies to every case, which runs exactly as a single curve with those options
+(:func:`petsc_adhesion.app.run.curve`).  ``-study_compute`` says what a case
+computes and ``-study_profiles`` which states it keeps, so that a case leaves
+out what the study does not use.
+
+With P ranks the cases go to P / ``-study_ranks`` groups (MPI subcommunicators),
+the longest first to the least loaded group (by :func:`cost`); each group runs
+its cases in that order.  Rank 0 prints a line for every finished case, with
+the elapsed time and an estimate of the time left, when it next comes up for
+air (after a step of its own curve, or a case).  A case whose options are
+bad is said in one line before any work and left out; a case that fails at
+run time is said in one line and recorded; the others run, and the study's
+files hold them (exit status 3 when any case is missing).  One HDF5 file (a
+group per case and a table of every case's events with their error bars), one
+JSON summary (``cases``: each case's ``mu``, ``sigma`` and the keys of a single
+curve's summary) and the figure of ``-study_plot`` are written together.
+
+Rank 0 saves the finished cases into a checkpoint as they reach it (at most
+every ``-cont_checkpoint_interval`` seconds; by default beside ``-out``):
+after a kill, ``-cont_restart FILE`` with the same options (on any number of
+ranks) runs only the cases not in it, and the study's files equal an
+uninterrupted run's.  A case cut off mid-way runs again from its start.
+"""
+from __future__ import annotations
+
+import itertools
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
+
+from petsc4py import PETSc
+
+from ..core import capi
+from ..errors import InputError, Interrupted, collective, say
+from ..io.layout import case_tree
+from ..io.resultset import check_targets, mark_done, written
+from ..io.write import write_critical, write_study
+from ..tracing.curve import program_record
+from ..tracing.trace import trace_curve
+from .checkpoint import open_checkpoint
+from .options.checks import check_unused
+from .options.reading import AppOptions, read_model
+from .options.table import TABLE
+from .optionsfile import options_files
+from .progress import clock
+from .run import read
+
+__all__ = ["Case", "cases", "cost", "assign", "spread", "main", "KINDS"]
+
+#: The event kinds each -study_compute reports (None: all) and whether it stops at equilibrium.
+KINDS = {"curve": (None, False), "events": (None, True), "pull_off": (("F_min", "equilibrium"), True),
+         "folds": (("snap_on", "snap_off"), True)}
+#: Options a study sets for its cases or writes itself; a -study_option cannot be one of them.
+_OWN = ("adh_mu", "adh_sigma", "adh_lambda", "out", "summary", "plot")
+_TAG = 17
+#: Options of the study as a whole, not of its cases
+_STUDY_FILES = ("out", "summary", "plot", "options_file", "cont_checkpoint", "cont_checkpoint_interval",
+                "cont_restart")
+
+
+@dataclass
+class Case:
+    """One case of a study: its number and the options it sets."""
+
+    index: int
+    values: dict                                      # option name -> value
+    error: str | None = field(default=None)          # why it cannot run, or None
+
+    @property
+    def label(self) -> str:
+        names = {"adh_mu": "mu", "adh_sigma": "sigma"}
+        return ", ".join(f"{names.get(k, k)} = {v:g}" for k, v in self.values.items())
+
+    def options(self, study: dict) -> dict:
+        """The options of this case: the study's (``study``: name -> value), less the study's own files
+        and checkpoint, with its values."""
+        keep = {k: v for k, v in study.items() if k not in _STUDY_FILES}
+        return keep | {k: f"{v:.17g}" for k, v in self.values.items()}
+
+
+def _check(opts: AppOptions) -> tuple[list, str]:
+    """The study's axes (option, values), checked; and the option its -study_values sweep."""
+    axes, swept = [], opts.string("study_option")
+    for name, own in (("study_mu", "adh_mu"), ("study_sigma", "adh_sigma")):
+        if opts.db.hasName(name):
+            if opts.db.hasName(own):
+                raise InputError(f"-{own}: not with -{name}, which sets it for each case")
+            axes.append((own, opts.sweep(name)))
+    if swept is not None:
+        o = TABLE.get(swept.lstrip("-"))
+        if o is None or o.kind not in ("real", "int") or o.name in _OWN or o.name.startswith("study_"):
+            why = "use -study_mu or -study_sigma" if o is not None and o.name in ("adh_mu", "adh_sigma") else \
+                "expected the name of a real or integer option (without the dash) other than the study's own"
+            raise InputError(f"-study_option: '{swept}': {why}")
+        if opts.db.hasName(o.name):
+            raise InputError(f"-{o.name}: not with -study_option {o.name}, which sets it for each case")
+        if not opts.db.hasName("study_values"):
+            raise InputError("-study_values: required with -study_option: the values it takes")
+        axes.append((o.name, opts.sweep("study_values")))
+    elif opts.db.hasName("study_values"):
+        raise InputError("-study_values: only with -study_option, the option they are values of")
+    if opts.real("adh_lambda") is not None:
+        raise InputError("-adh_lambda: a study traces curves; remove it")
+    if opts.db.hasName("study_ranks") and PETSc.COMM_WORLD.getSize() % opts.int("study_ranks"):
+        raise InputError(f"-study_ranks: {opts.int('study_ranks')} does not divide the "
+                         f"{PETSc.COMM_WORLD.getSize()} ranks of the run")
+    if not axes:
+        raise InputError("-study_mu: a study needs -study_mu, -study_sigma or -study_option")
+    return axes, swept
+
+
+def cases(axes: list) -> list[Case]:
+    """The product of the axes, the first varying slowest."""
+    names = [n for n, _ in axes]
+    return [Case(i, dict(zip(names, vals))) for i, vals in enumerate(itertools.product(*(v for _, v in axes)))]
+
+
+def cost(case: Case) -> float:
+    """A rough relative run time of a case, for ordering: the contact widens with mu (more steps,
+    larger grids) and roughness adds its quadrature to every evaluation."""
+    mu = case.values.get("adh_mu", 1.0)
+    return (1.0 + mu) * (1.5 if case.values.get("adh_sigma", 0.0) > 0 else 1.0)
+
+
+def assign(todo: list[Case], groups: int) -> list[list[Case]]:
+    """Longest first, each to the group with the least work so far (LPT scheduling)."""
+    load, out = [0.0] * groups, [[] for _ in range(groups)]
+    for c in sorted(todo, key=lambda c: (-cost(c), c.index)):
+        g = min(range(groups), key=lambda k: (load[k], k))
+        out[g].append(c)
+        load[g] += cost(c)
+    return out
+
+
+@contextmanager
+def _case(c: Case, study: dict):
+    """The options of case ``c`` as the global database for the block (the study's comes back after)."""
+    with capi.options_of(c.options(study)):
+        yield AppOptions()
+
+
+def _validate(todo: list[Case], study: dict, argv: list[str]) -> None:
+    """Each case's options checked as a single run's would be, before any work (every rank alike)."""
+    for c in todo:
+        try:
+            with _case(c, study) as opts:
+                read(opts, PETSc.COMM_SELF, argv)
+        except InputError as e:
+            c.error = str(e)
+
+
+def _run(c: Case, study: dict, argv: list[str], comm, compute: str, keep: tuple) -> dict:
+    """One case on ``comm``: its summary and result tree on the group's rank 0 (None elsewhere)."""
+    kinds, stop = KINDS[compute]
+    with _case(c, study) as opts:
+        req = read(opts, comm, argv, kinds, bool(keep))
+        settings = replace(req.settings, observable_max=0.0) \
+            if stop and not opts.db.hasName("cont_F_max") else req.settings
+        curve = trace_curve(req.model, req.grid, req.solver, settings, req.curve, comm=comm, started=check_unused)
+        check_unused()
+        if comm.getRank():
+            return None
+        tree = case_tree(curve, keep=None if opts.flag("profiles") else keep)
+        return {"case": c.index, "values": c.values, "summary": curve.summary, "tree": tree,
+                "incomplete": not curve.complete}
+
+
+def _failure(c: Case, why: str) -> dict:
+    return {"case": c.index, "values": c.values, "error": why}
+
+
+def _failures(records: list[dict]) -> list[dict]:
+    """The records of the cases that failed at run time, as the files hold them."""
+    return [_failure(Case(r["case"], r["values"]), r["error"]) for r in records if "error" in r]
+
+
+class _Progress:
+    """Rank 0's line per finished case: which, how long, elapsed, and the time left by the cases' costs;
+    rank 0 also keeps every finished case's record (``records``, those of a restart first) and saves them
+    into the ``journal`` as they come."""
+
+    def __init__(self, comm, todo: list[Case], records: list[dict], journal):
+        self.mpi, self.t0, self.total = comm.tompi4py(), time.perf_counter(), sum(cost(c) for c in todo)
+        self.done, self.count, self.n, self.sent = 0.0, len(records), len(records) + len(todo), []
+        self.records, self.journal = list(records), journal
+
+    def finished(self, rec: dict, brief: dict) -> None:
+        """A group leader's case is done: rank 0 keeps and says it, another leader sends it to rank 0."""
+        if self.mpi.Get_rank() == 0:
+            self._keep(rec, brief)
+        else:
+            self.sent.append(self.mpi.isend((rec, brief), dest=0, tag=_TAG))
+
+    def poll(self, block: bool = False) -> None:
+        """Rank 0: keep and say what the other groups finished (``block``: wait for all of them, polling,
+        so that a signal is taken at once)."""
+        if self.mpi.Get_rank():
+            return
+        while True:
+            if self.mpi.iprobe(tag=_TAG):
+                self._keep(*self.mpi.recv(tag=_TAG))
+            elif block and self.count < self.n:
+                time.sleep(0.01)
+            else:
+                return
+
+    def close(self) -> None:
+        for req in self.sent:
+            req.wait()
+
+    def _keep(self, rec: dict, record: dict) -> None:
+        self.records.append(rec)
+        self.journal.save_cases(self.records)
+        self.count += 1
+        self.done += record["cost"]
+        elapsed = time.perf_counter() - self.t0
+        left = elapsed * max(self.total - self.done, 0.0) / self.done if self.done else float("nan")
+        what = record.get("error") or record.get("what", "")
+        say(f"case {rec['case'] + 1} ({record['label']}) {what}; {self.count}/{self.n} done, "
+            f"{clock(elapsed)} elapsed, about {clock(left)} left")
+
+
+def _brief(record: dict) -> dict:
+    """What the progress line says about a finished case."""
+    out = {"label": record["label"], "cost": record["cost"]}
+    if "error" in record:
+        return out | {"error": f"failed: {record['error']}"}
+    po = record["summary"].get("pull_off")
+    what = f"done in {record['summary']['wall_time_s']:.1f} s"
+    if po:
+        what += f", pull-off F = {po['F']:.6f}" + (f" +- {po['F_err']:.1e}" if po.get("F_err") else "")
+    return out | {"what": what}
+
+
+def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
+    """The study of the options database: its cases, spread over the ranks; its files from rank 0.
+
+    Returns the exit status: 0, or 3 when a case is missing (each said in one line).
+    ``helping`` (-help): check the study and its cases, then stop.
+    """
+    world = PETSc.COMM_WORLD
+    mpi = world.tompi4py()
+    axes, _ = collective(world, _check, opts)
+    compute = opts.choice("study_compute")
+    if compute == "critical":
+        return _critical_main(opts, argv, axes, helping)
+    if opts.choice("study_plot") == "critical":
+        raise InputError("-study_plot: critical draws the cusps of -study_compute critical, not curves; "
+                         "one of curves, folds, profiles, pull_off, reduction")
+    keep = opts.choices("study_profiles")
+    todo = cases(axes)
+    targets, journal = _files(opts, argv)
+    given = opts.given()
+    _validate(todo, given, argv)
+    bad = [c for c in todo if c.error]
+    if len(bad) == len(todo):
+        raise InputError(bad[0].error)
+    if mpi.Get_rank() == 0:
+        for c in bad:
+            say(f"case {c.index + 1} ({c.label}) left out: {c.error}")
+    if helping:
+        return 0
+    files, status = None, 0
+    try:
+        with journal.on_interrupt():
+            records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
+                             lambda c, comm: _run(c, given, argv, comm, compute, keep), _brief, journal)
+            if mpi.Get_rank() == 0:
+                failed = [_failure(c, c.error) for c in bad] + _failures(records)
+                done = [r for r in records if "error" not in r]
+                study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
+                         "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
+                status = 3 if failed or any(r["incomplete"] for r in done) else 0
+                with written(targets, journal.paths()) as files:
+                    write_study({**program_record(world), "options": opts.given()}, study, done, sorted(failed, key=lambda r: r["case"]), files)
+        return mpi.bcast(status, root=0)
+    except Interrupted as e:
+        mark_done(e, files, status)
+        raise
+
+
+def _files(opts: AppOptions, argv: list[str]):
+    """The study's files (-out, -summary, -plot), checked writable and apart from its inputs, and its
+    checkpoint (:func:`~petsc_adhesion.app.checkpoint.open_checkpoint`; collective)."""
+    targets = {k: opts.string(k) for k in ("out", "summary", "plot") if opts.string(k)}
+    inputs = {"options_file": options_files(argv), "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
+    world = PETSc.COMM_WORLD
+    collective(world, lambda: check_targets(targets, inputs) if world.getRank() == 0 else None)
+    return targets, open_checkpoint(opts, targets, inputs, world, study=True)
+
+
+def spread(todo: list[Case], ranks: int, work, brief, journal) -> list[dict] | None:
+    """``work(case, comm)`` for each case, the cases spread over groups of ``ranks`` ranks (LPT by
+    :func:`cost`); a progress line on rank 0 for each finished case (``brief(record)``).
+
+    ``work`` returns the case's record on its group's rank 0; a case that raises is recorded with its
+    one-line error.  ``journal`` (a study's :class:`~petsc_adhesion.app.checkpoint.Checkpoint`): the cases
+    of its restart are not run again, rank 0 saves the finished ones into it.  Returns every record on
+    rank 0, in case order (None elsewhere).
+    """
+    world = PETSc.COMM_WORLD
+    mpi = world.tompi4py()
+    done, records = journal.cases()
+    todo = [c for c in todo if c.index not in done]
+    if done and mpi.Get_rank() == 0:
+        say(f"going on from the checkpoint {journal.restart}: {len(done)} case"
+            f"{'s' * (len(done) != 1)} done, {len(todo)} to run")
+    color = mpi.Get_rank() // ranks
+    plan_of = assign(todo, mpi.Get_size() // ranks)
+    sub = mpi.Split(color, mpi.Get_rank())
+    comm = PETSc.Comm(sub)
+    progress = _Progress(world, todo, records, journal)
+    try:
+        for c in plan_of[color]:
+            t0 = time.perf_counter()
+            try:
+                rec = work(c, comm)
+            except (InputError, RuntimeError, FloatingPointError, PETSc.Error) as e:
+                rec = _failure(c, _one_line(e))
+            if sub.Get_rank() == 0:
+                rec |= {"label": c.label, "cost": cost(c), "wall_s": time.perf_counter() - t0}
+                progress.finished(rec, brief(rec))
+            progress.poll()
+        progress.poll(block=True)
+    finally:
+        sub.Free()
+    progress.close()
+    return sorted(progress.records, key=lambda r: r["case"]) if mpi.Get_rank() == 0 else None
+
+
+def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool) -> int:
+    """-study_compute critical: sigma_c at each -study_mu and mu_c at each -study_sigma
+    (:mod:`~petsc_adhesion.tracing.critical`), each a case; the files from rank 0."""
+    world = PETSc.COMM_WORLD
+    mpi = world.tompi4py()
+    other = [n for n, _ in axes if n not in ("adh_mu", "adh_sigma")]
+    if other:
+        raise InputError("-study_option: not with -study_compute critical, which continues the turning points "
+                         "in mu (each -study_sigma) and in sigma (each -study_mu)")
+    if opts.db.hasName("study_plot") and opts.choice("study_plot") != "critical":
+        raise InputError(f"-study_plot: {opts.choice('study_plot')} draws curves; -study_compute critical "
+                         f"draws 'critical'")
+    model = collective(world, read_model, opts)
+    todo = [Case(i, {name: v}) for i, (name, v) in enumerate((n, v) for n, vals in axes for v in vals)]
+    targets, journal = _files(opts, argv)
+    if helping:
+        return 0
+    files, status = None, 0
+    try:
+        with journal.on_interrupt():
+            records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, comm), _cusp_brief,
+                             journal)
+            if mpi.Get_rank() == 0:
+                failed = _failures(records)
+                done = [r for r in records if "error" not in r]
+                study = {"compute": "critical", "axes": [n for n, _ in axes],
+                         "ranks_per_case": opts.int("study_ranks"), "cases": len(todo), "plot": "critical"}
+                status = 3 if failed else 0
+                with written(targets, journal.paths()) as files:
+                    write_critical({**program_record(world), "options": opts.given()}, study, done, failed, files)
+        check_unused()
+        return mpi.bcast(status, root=0)
+    except Interrupted as e:
+        mark_done(e, files, status)
+        raise
+
+
+def _cusp(c: Case, model, comm) -> dict | None:
+    """One case of a critical study: sigma_c at its mu, or mu_c at its sigma."""
+    from ..tracing.critical import mu_c, sigma_c
+
+    (name, value), = c.values.items()
+    try:
+        out = sigma_c(model, value, comm=comm) if name == "adh_mu" else mu_c(model, value, comm=comm)
+    except ValueError as e:                        # no cusp in the range searched
+        raise RuntimeError(str(e)) from None
+    return {"case": c.index, "values": c.values, "kind": "sigma_c" if name == "adh_mu" else "mu_c", **out} \
+        if comm.getRank() == 0 else None
+
+
+def _cusp_brief(record: dict) -> dict:
+    out = {"label": record["label"], "cost": record["cost"]}
+    if "error" in record:
+        return out | {"error": f"failed: {record['error']}"}
+    k = record["kind"]
+    return out | {"what": f"{k} = {record[k]:.6f} +- {record[k + '_err']:.1e} in {record['wall_time_s']:.1f} s"}
+
+
+def _one_line(e: BaseException) -> str:
+    if isinstance(e, PETSc.Error):
+        from .options.checks import petsc_error
+        return str(petsc_error(e))
+    text = str(e).strip()
+    return text.splitlines()[0] if text else type(e).__name__

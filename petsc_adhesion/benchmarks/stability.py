@@ -1,0 +1,120 @@
+"""The stability matrix of docs/stability.md: every Tabor parameter and roughness, default settings.
+
+    ./run stability            # all cells, two at a time, into docs/stability.md (about 10 minutes)
+    ./run stability 20 2       # one cell (mu, sigma), printed
+
+Each cell traces the curve from far apart to F >= 2 with the program's
+defaults and -cont_error_estimate, as a user would, and records whether it
+completed (exit status 0 and a complete result), its turning points, pull-off
+with its error bar, the smallest step, rejected steps, domain-guard
+activations, the most Newton and Krylov iterations of one point, the nodes,
+regrids, the wall time and the warnings.  Extra rows: strong compression
+(F up to 50 at mu = 1 and 10) and the smallest Tabor parameter (mu = 1e-4).
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+from . import paths
+
+__all__ = ["MUS", "SIGMAS", "EXTRA", "cell", "main", "OUT", "TIMEOUT", "HEAD", "STABILITY_DOC"]
+
+MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 4.5, 7.0, 10.0, 20.0)
+SIGMAS = (0.0, 0.1, 0.2, 0.4, 1.0, 2.0)
+#: (mu, sigma, extra options, what the row shows)
+EXTRA = ((1.0, 0.0, ("-cont_F_max", "50"), "strong compression"),
+         (10.0, 0.0, ("-cont_F_max", "50"), "strong compression"),
+         (1e-4, 0.0, (), "smallest Tabor parameter"))
+OUT = os.path.join(paths.DOCS, "stability.md")
+TIMEOUT = 900
+
+
+def cell(mu: float, sigma: float, extra=()) -> dict:
+    """One traced curve with default settings: its summary and how the process ended."""
+    with tempfile.TemporaryDirectory() as tmp:
+        js = os.path.join(tmp, "s.json")
+        cmd = [sys.executable, "-m", "petsc_adhesion", "-adh_mu", f"{mu:g}", "-adh_sigma", f"{sigma:g}",
+               "-cont_error_estimate", *extra, "-summary", js]
+        t0 = time.perf_counter()
+        try:
+            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT)
+            status, err = proc.returncode, proc.stderr.strip()
+        except subprocess.TimeoutExpired:
+            status, err = None, f"no result in {TIMEOUT} s"
+        wall = time.perf_counter() - t0
+        summary = json.load(open(js)) if os.path.exists(js) else None
+    return {"mu": mu, "sigma": sigma, "extra": list(extra), "status": status, "error": err, "wall_s": wall,
+            "summary": summary}
+
+
+def _row(c: dict, what: str = "") -> str:
+    s = c["summary"]
+    if s is None:
+        return f"| {c['mu']:g} | {c['sigma']:g} | no: {c['error'] or c['status']} |" + " |" * 12
+    po = s["pull_off"] or {}
+    err = f" +- {po['F_err']:.1e}" if "F_err" in po else " (no bar)"
+    done = "yes" if c["status"] == 0 and s["complete"] else f"no (exit {c['status']})"
+    folds = len(s["folds"])
+    return (f"| {c['mu']:g} | {c['sigma']:g}{(' ' + what) if what else ''} | {done} | {folds} | "
+            f"{po.get('F', float('nan')):.5f}{err} | {s['smallest_step']:.1e} | {s['rejected_steps']} | "
+            f"{s['guard_activations']} | {s['most_newton_its']} | {s['most_ksp_its']} | {s['n_nodes']} | "
+            f"{s['regrids']} | {s['wall_gap']:.2g} | {c['wall_s']:.1f} | {'; '.join(s['warnings']) or '-'} |")
+
+
+HEAD = ("| mu | sigma | completed | turning points | pull-off F (error bar) | smallest step | rejected | "
+        "guard | Newton (most) | Krylov (most) | nodes | regrids | wall gap | wall (s) | warnings |\n" + "|---" * 15 + "|")
+
+
+def main(argv: list[str]) -> int:
+    """All cells into docs/stability.md, or the one cell given as mu sigma."""
+    if argv:
+        c = cell(float(argv[0]), float(argv[1]))
+        print(HEAD + "\n" + _row(c))
+        return 0
+    jobs = [(m, s, (), "") for m in MUS for s in SIGMAS] + [(m, s, e, w) for m, s, e, w in EXTRA]
+    with ThreadPoolExecutor(2) as pool:
+        cells = list(pool.map(lambda j: (cell(*j[:3]), j[3]), jobs))
+    rows = "\n".join(_row(c, w) for c, w in cells)
+    done = sum(c["status"] == 0 and c["summary"] and c["summary"]["complete"] for c, _ in cells)
+    failed = [c for c, _ in cells if not (c["status"] == 0 and c["summary"] and c["summary"]["complete"])]
+    failures = "\n".join(f"- mu = {c['mu']:g}, sigma = {c['sigma']:g}: "
+                         f"{'; '.join(c['summary']['warnings']) if c['summary'] else c['error']}" for c in failed)
+    with open(OUT, "w") as f:
+        f.write(STABILITY_DOC.format(head=HEAD, rows=rows, done=done, total=len(cells),
+                                     failures=failures or "none",
+                                     machine=f"{os.cpu_count()} cores, two cells at a time, one rank each"))
+    print(f"{done} of {len(cells)} cells completed; docs/stability.md written")
+    return 0
+
+
+STABILITY_DOC = """# Stability matrix
+
+<!-- made by: ./run stability -->
+Every cell traces the load-approach curve from far apart to F >= 2 with the program's
+default settings (`petsc-adhesion -adh_mu MU -adh_sigma SIGMA -cont_error_estimate`),
+as a new user would.  {done} of {total} cells completed.  Machine: {machine}.
+
+- completed: exit status 0 and a complete result (no warning that makes it incomplete).
+- turning points: snap-on and snap-off events (the secondary pairs included).
+- pull-off: the most tensile load with its error bar (`-cont_error_estimate`).
+- smallest step, rejected steps: the step control's work; guard: Newton steps shortened
+  because they would have closed a gap (the domain guard); Newton, Krylov: the most
+  iterations one point took; nodes: the largest grid; regrids: changes of grid.
+- wall gap: the smallest H - wall over the curve, in epsilon: how close the curve came to
+  the wall of the roughness law (the outermost node of the 16-point Hermite rule,
+  6.63 sigma - 1; the curve never steps into it, and below 1e-3 it is warned about).
+
+{head}
+{rows}
+
+Cells not completed: {failures}
+"""
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,343 @@
+"""Predictor-corrector continuation of G(x, p) = 0 in one parameter p (paper, "Numerical Procedure").
+
+The core knows nothing of the problem beyond its protocol
+(:class:`~petsc_adhesion.core.protocol.ContinuationProblem`, in the manner of
+pacopy's ``f``, ``df_dlmbda``, ``jacobian_solver``, ``inner``).
+
+The curve is followed in X = (x, p) with the inner product <x, y> + p q.
+
+* Natural corrector (eq. 20-22): Newton on G(x; p) = 0 at the predicted p;
+  tangent from G_x phi_0 = -G_p with the normalisation and sign rule of
+  eq. (16)-(19).  Fails at a turning point, where G_x is singular.
+* Pseudo-arclength corrector (eq. 24-25): Newton on [G; Q] = 0, whose Jacobian
+  is the bordered matrix [[G_x, G_p], [xdot^T W, pdot]], a MatNest holding
+  the problem's operator; regular at a fold.  Its tangent solves the same
+  bordered matrix with right-hand side (0, 1), which also keeps eq. (19).
+* ``auto`` (the paper's switch) takes the natural step while |pdot| >= 0.5.
+
+Step control (:class:`Settings`): halve on a failed corrector, a predictor
+outside the domain, a turn of the tangent, a corrector far from its predictor
+(curvature), or a large change of the watched observable; grow on fast Newton
+and a nearly straight curve.
+
+Solvers and their options prefixes: the natural corrector ``nat_`` (also the
+first point), the arclength corrector ``arc_`` (also every tangent along it).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from petsc4py import PETSc
+
+from .bordered import Bordered
+from .newton import PC_REUSE_ITS, Newton, krylov_retry
+from .protocol import POINT_FIELDS, Point
+
+__all__ = ["Settings", "Continuation", "NATURAL_PREFIX", "CORRECTORS"]
+
+#: Options prefix of the natural corrector (and the first point).
+NATURAL_PREFIX = "nat_"
+#: What -cont_type accepts: the paper's switch, or one corrector throughout.
+CORRECTORS = ("auto", "natural", "arclength")
+
+
+@dataclass
+class Settings:
+    """Step control and stop criteria; the one place of their defaults.
+
+    Step lengths are measured in the inner product of X = (x, p).
+    """
+
+    corrector: str = "auto"         # one of CORRECTORS
+    ds: float = 0.05                # first step
+    ds_min: float = 1e-7            # give up below
+    ds_max: float = 0.5
+    newton_target: int = 5          # corrector iterations aimed at
+    max_deviation: float = 0.2      # largest corrector distance from the predictor per unit step
+    min_turn_cosine: float = 0.8    # smallest cosine between successive tangents (37 degrees)
+    grow: float = 1.5               # step factor after an easy step
+    shrink: float = 0.7             # after a slow one (more than newton_target iterations)
+    cut: float = 0.5                # after a rejected one
+    grow_margin: float = 0.5        # easy: deviation and observable change below this share of their bounds
+    switch: float = 0.5             # auto: natural corrector while |pdot| >= switch (the paper's)
+    natural_fallback: float = 0.1   # natural corrector as fallback only while |pdot| >= this
+    observable: str | None = None   # the observable bounded per step and stopped on
+    observable_step: float = 0.2    # its largest change in one step, relative above magnitude 1
+    observable_max: float = math.inf  # stop when the observable reaches this
+    p_max: float = math.inf         # stop when the parameter reaches this
+    p_min: float = -math.inf        # or falls to this
+    max_steps: int = 2000
+    max_folds: int = 12             # stop after more than this many turning points
+    pc_reuse_its: int = PC_REUSE_ITS
+    monitor: bool = False           # one line a step
+
+
+class Continuation:
+    """Trace a curve of G(x, p) = 0 from a start point; collect the points and step statistics.
+
+    ``stop`` after :meth:`run`: (reason, value) with reason one of
+    "observable_max", "p_max", "p_min", "max_steps", "max_folds", "ds_min",
+    or "until" (the caller's criterion).  ``ds`` is the step it would take next.
+    ``index0`` numbers the monitor's lines after those of earlier segments.
+    """
+
+    def __init__(self, problem, settings: Settings | None = None, index0: int = 0):
+        self.pb, self.set, self.index0 = problem, settings or Settings(), index0
+        self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its)
+        try:
+            self.bordered = Bordered(problem, self.set.pc_reuse_its)
+        except BaseException:           # a solver option refused: free the Newton solver made
+            self.newton.destroy()
+            raise
+        self._x, self._xt, self._rhs, self._phi, self._r = (problem.create_vec() for _ in range(5))
+        self._gp = np.zeros(self._x.getLocalSize())
+        self.points: list[Point] = []
+        self.rejected = 0
+        self.folds = 0
+        self.stop: tuple[str, float] | None = None
+        self.ds = self.set.ds
+
+    def inner(self, u: np.ndarray, v: np.ndarray) -> float:
+        """<u, v> of local parts, summed over ranks."""
+        return self.bordered.inner(u, v)
+
+    # -- tangents -----------------------------------------------------------
+    def natural_tangent(self, x: np.ndarray, p: float, prev: Point):
+        """Tangent of eq. (16)-(19): G_x phi_0 = -G_p, a = +-1/sqrt(1 + |phi_0|^2)."""
+        pb, newton = self.pb, self.newton
+        self._xt.setArray(x)
+        self._rhs.setArray(-pb.dG_dp(self._xt, p, self._gp))
+        ksp = newton.snes.getKSP()
+        if not krylov_retry(ksp, pb.jacobian, newton.pmat or pb.jacobian, self._rhs, self._phi, newton.reuse,
+                            lambda refill: newton.linearize(self._xt, refill), self._r):
+            return None
+        phi = self._phi.getArray(readonly=True).copy()
+        a = 1.0 / math.sqrt(1.0 + self.inner(phi, phi))
+        if a * (self.inner(prev.xdot, phi) + prev.pdot) < 0:      # eq. (19)
+            a = -a
+        return a * phi, a, ksp.getIterationNumber()
+
+    def make_point(self, x, p, xdot, pdot, **kw) -> Point:
+        """A Point with the problem's observables at (x, p) along (xdot, pdot)."""
+        values, rates = self.pb.observe(x, p, xdot, pdot)
+        return Point(x=x, p=p, xdot=xdot, pdot=pdot, values=values, rates=rates, **kw)
+
+    def start(self, guess: PETSc.Vec, p0: float, direction: int = 1) -> Point:
+        """Solve at p0 from ``guess`` (natural corrector's SNES); tangent towards larger p (``direction`` 1)
+        or smaller (-1).
+
+        RuntimeError when Newton or the tangent fails there.
+        """
+        x = guess.copy()
+        if not self.newton.solve(p0, x):
+            x.destroy()
+            raise RuntimeError(f"no solution at the start {self.pb.parameter} = {p0:g}")
+        a = x.getArray(readonly=True).copy()
+        x.destroy()
+        tan = self.bordered.tangent(a, p0, np.zeros_like(a), float(direction))
+        if tan is None:
+            raise RuntimeError(f"no tangent at the start {self.pb.parameter} = {p0:g}")
+        xdot, pdot, kits = tan
+        its, lits = self.newton.iterations
+        return self.make_point(a, p0, xdot, pdot, newton_its=its, ksp_its=lits + kits)
+
+    def project(self, x: PETSc.Vec, p: float, xdot: np.ndarray, pdot: float) -> Point | None:
+        """The point of the curve nearest (x, p) along (xdot, pdot), with its tangent oriented alike.
+
+        A zero-length arclength correction (eq. 24-25, regular at folds): how a
+        point carried over from another discretization is put back on this one's
+        curve.  None when it fails.
+        """
+        guess = Point(x=x.getArray(readonly=True).copy(), p=p, xdot=xdot, pdot=pdot)
+        sol = self.arclength(guess, 0.0)
+        if sol is None:
+            return None
+        x1, p1, (xdot1, pdot1, kits), its, lits, _ = sol
+        return self.make_point(x1, p1, xdot1, pdot1, newton_its=its, ksp_its=lits + kits, corrector="regrid")
+
+    # -- one step -------------------------------------------------------------
+    def natural_ok(self, a: Point) -> bool:
+        """Whether the step from a takes the natural corrector first."""
+        s = self.set
+        return s.corrector == "natural" or (s.corrector == "auto" and abs(a.pdot) >= s.switch)
+
+    def natural(self, a: Point, ds: float, tangent: bool = True):
+        """Natural corrector (eq. 20-22) at p = a.p + ds a.pdot; tangent of eq. (16)-(19)."""
+        p = a.p + ds * a.pdot
+        x = a.x + ds * a.xdot                               # eq. (20)
+        if not self.pb.inside(x):
+            return None
+        self._x.setArray(x)
+        if not self.newton.solve(p, self._x, retry=True):   # eq. (21)-(22)
+            return None
+        x = self._x.getArray(readonly=True).copy()
+        its, kits = self.newton.iterations
+        tan = self.natural_tangent(x, p, a) if tangent else (a.xdot, a.pdot, 0)
+        return None if tan is None else (x, p, tan, its, kits, "natural")
+
+    def arclength(self, a: Point, ds: float, tangent: bool = True):
+        """Pseudo-arclength corrector (eq. 24-25) at distance ds; tangent of the bordered system."""
+        sol = self.bordered.correct(a, ds)
+        if sol is None:
+            return None
+        x, p, its, kits = sol
+        tan = self.bordered.tangent(x, p, a.xdot, a.pdot) if tangent else (a.xdot, a.pdot, 0)
+        return None if tan is None else (x, p, tan, its, kits, "arclength")
+
+    def correct(self, a: Point, ds: float, tangent: bool = True):
+        """The point at step ds from a: the corrector the mode asks for, the other as fallback.
+
+        The natural one serves only away from folds (|pdot| >= ``natural_fallback``),
+        where p is a good parameter; near the wall of a fine roughness rule it is
+        the more robust of the two.  Without ``tangent`` the point gets a's.
+        Returns (x, p, (xdot, pdot, tangent KSP its), Newton its, KSP its, corrector) or None.
+        """
+        s = self.set
+        first, second = (self.natural, self.arclength) if self.natural_ok(a) else (self.arclength, self.natural)
+        sol = first(a, ds, tangent)
+        if sol is None and (second is self.arclength or abs(a.pdot) >= s.natural_fallback) \
+                and s.corrector != "natural":
+            sol = second(a, ds, tangent)
+        return sol
+
+    def _observable_bound(self, a: Point) -> float:
+        return self.set.observable_step * max(1.0, abs(a.values[self.set.observable]))
+
+    def step(self, a: Point, ds: float) -> Point | None:
+        """One predictor-corrector step of length ds from a, or None (retry smaller)."""
+        s = self.set
+        sol = self.correct(a, ds)
+        if sol is None:
+            return None
+        x, p, (xdot, pdot, tangent_its), its, kits, kind = sol
+        # the corrector's distance from the predictor grows as ds^2 times the curvature;
+        # a step that had to travel far may have cut across a fold pair unseen
+        dx = x - (a.x + ds * a.xdot)
+        deviation = math.sqrt(self.inner(dx, dx) + (p - a.p - ds * a.pdot) ** 2) / ds
+        if deviation > s.max_deviation or self.inner(a.xdot, xdot) + a.pdot * pdot < s.min_turn_cosine:
+            return None
+        b = self.make_point(x, p, xdot, pdot, ds=ds, newton_its=its, ksp_its=kits + tangent_its,
+                            corrector=kind, deviation=deviation)
+        # the observable is what users read: resolve the curve in it too
+        if s.observable is not None and abs(b.values[s.observable] - a.values[s.observable]) > self._observable_bound(a):
+            return None
+        return b
+
+    def done(self, b: Point) -> tuple[str, float] | None:
+        """The stop criterion b meets, as (reason, value), or None."""
+        s = self.set
+        if s.observable is not None and b.values[s.observable] >= s.observable_max:
+            return "observable_max", b.values[s.observable]
+        if b.p >= s.p_max:
+            return "p_max", b.p
+        if b.p <= s.p_min:
+            return "p_min", b.p
+        if len(self.points) > s.max_steps:
+            return "max_steps", s.max_steps
+        if self.folds > s.max_folds:
+            return "max_folds", s.max_folds
+        return None
+
+    def run(self, start: Point, on_step=None, until=None, pause=None) -> list[Point]:
+        """Trace from ``start`` until a stop criterion; ``on_step(a, b)`` sees every accepted step,
+        and ``until(a, b)`` True ends the run there (after on_step).
+
+        ``pause()`` is called before every step attempt, where the state is whole: the
+        points, ``ds``, the counters and what the solvers keep (the points their
+        preconditioners were built at, :class:`~petsc_adhesion.core.newton.PCReuse`).  A
+        checkpoint saves it there, and :meth:`resume` goes on from it alike.
+        """
+        self.points.append(start)
+        self.ds = self.set.ds
+        self.monitor(start)
+        return self.resume(on_step, until, pause)
+
+    def resume(self, on_step=None, until=None, pause=None) -> list[Point]:
+        """Go on from the last point with the step ``ds``: after :meth:`run`'s start, or from a state
+        restored as :meth:`run`'s ``pause`` saw it."""
+        s = self.set
+        a, ds = self.points[-1], self.ds
+        while True:
+            if pause:
+                pause()
+            b = self.step(a, ds)
+            if b is None:
+                self.newton.reuse.expire()
+                self.bordered.reuse.expire()
+                self.rejected += 1
+                ds *= s.cut
+                self.ds = ds
+                if ds < s.ds_min:
+                    self.stop = ("ds_min", a.p)
+                    break
+                continue
+            self.points.append(b)
+            self.folds += a.pdot * b.pdot < 0
+            self.monitor(b)
+            if on_step:
+                on_step(a, b)
+            self.stop = self.done(b)
+            if self.stop:
+                break
+            self.ds = self._next_step(a, b, ds)
+            if until and until(a, b):
+                self.stop = ("until", b.p)
+            if self.stop:
+                break
+            ds = self.ds
+            a = b
+        return self.points
+
+    def _next_step(self, a: Point, b: Point, ds: float) -> float:
+        """The step after an accepted one of length ds: grow on fast Newton and a nearly straight
+        curve, shrink on slow Newton."""
+        s = self.set
+        easy = b.deviation < s.grow_margin * s.max_deviation and (
+            s.observable is None or abs(b.values[s.observable] - a.values[s.observable])
+            < s.grow_margin * self._observable_bound(a))
+        if b.newton_its < s.newton_target and easy:
+            return min(s.grow * ds, s.ds_max)
+        if b.newton_its > s.newton_target:
+            return max(s.shrink * ds, s.ds_min)
+        return ds
+
+    def monitor(self, pt: Point) -> None:
+        """One line a point with -cont_monitor (rank 0)."""
+        if self.set.monitor:
+            obs = "".join(f" {k} {v: .10e}" for k, v in pt.values.items())
+            PETSc.Sys.Print(f"{self.index0 + len(self.points) - 1:4d} CONT {self.pb.parameter} {pt.p: .10e}{obs} ds {pt.ds:.3e} "
+                            f"{pt.corrector[:3]} Newton {pt.newton_its} KSP {pt.ksp_its}", comm=self.pb.comm)
+
+    def state(self, solvers: bool = True) -> dict:
+        """Everything the run depends on, as plain data (a checkpoint saves it): the settings, the points
+        (local parts), the next step, the counters and, with ``solvers``, what each solver keeps of its
+        preconditioner.  :meth:`restore` on a continuation made with these settings goes on exactly
+        as this one would (the continuation is deterministic)."""
+        pts = self.points
+        out = {"settings": asdict(self.set), "index0": self.index0, "ds": self.ds, "rejected": self.rejected,
+               "folds": self.folds, "stop": self.stop,
+               "points": {"x": np.array([p.x for p in pts]), "xdot": np.array([p.xdot for p in pts]),
+                          **{k: [getattr(p, k) for p in pts] for k in POINT_FIELDS}}}
+        if solvers:
+            out |= {"newton": self.newton.state(), "bordered": self.bordered.state()}
+        return out
+
+    def restore(self, state: dict) -> None:
+        """Take up :meth:`state` (its settings are this continuation's own, given at its making)."""
+        self.index0, self.ds, self.rejected, self.folds = state["index0"], state["ds"], state["rejected"], state["folds"]
+        self.stop = tuple(state["stop"]) if state["stop"] is not None else None
+        pts = state["points"]
+        self.points = [Point(x=pts["x"][i].copy(), xdot=pts["xdot"][i].copy(), **{k: pts[k][i] for k in POINT_FIELDS})
+                       for i in range(len(pts["p"]))]
+        if "newton" in state:
+            self.newton.restore(state["newton"])
+            self.bordered.restore(state["bordered"])
+
+    def destroy(self) -> None:
+        """Free the PETSc objects made here."""
+        self.newton.destroy()
+        self.bordered.destroy()
+        for v in (self._x, self._xt, self._rhs, self._phi, self._r):
+            v.destroy()

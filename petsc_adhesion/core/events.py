@@ -1,0 +1,359 @@
+"""Events along a curve, located on the discrete problem (in the manner of BifurcationKit's events).
+
+An event is a zero of a test function between two accepted points a, b of a
+:class:`~petsc_adhesion.core.continuation.Continuation`.  It is located by Brent's
+method on the pseudo-arclength distance s from a (each evaluation one
+corrector solve, eq. 24-25), never taken as the nearest computed point.
+
+=====================  =======================  ==========================================
+event                  test function            labels (by the sign before the zero)
+=====================  =======================  ==========================================
+:class:`Fold`          pdot                     + to -: p is largest; - to +: smallest
+:class:`Extremum`      d(observable)/ds         - to +: minimum; + to -: maximum
+:class:`Zero`          observable - level       one label
+:class:`ParameterValue` p - target              one label
+=====================  =======================  ==========================================
+
+Where the control is the parameter p, the solution jumps at a fold to
+another stable branch at the same p: forward along the curve from a fold
+where p is largest, backward from one where it is smallest
+(:meth:`EventFinder.jumps`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import brent
+from .protocol import Point
+
+__all__ = ["Fold", "Extremum", "Zero", "ParameterValue", "Found", "EventFinder", "jumps", "EVENT_TOL", "SUBSTEPS", "DIP_XTOL"]
+
+#: Default location tolerance in the parameter.
+EVENT_TOL = 1e-10
+#: Where the sampled pdot dips toward zero without changing sign, the two steps about the dip are
+#: walked again in SUBSTEPS sub-steps each, and a dip of the walk's pdot is searched for its
+#: minimum to DIP_XTOL of its sub-steps: a fold pair inside one step (near a cusp the pair is
+#: narrower than any step) is found when its depth exceeds pdot's change over that distance.
+SUBSTEPS, DIP_XTOL = 8, 1e-3
+
+
+class _Below(Exception):
+    """The dip search met the other sign at distance ``s``: a fold pair lies on the step."""
+
+    def __init__(self, s: float):
+        super().__init__(s)
+        self.s = s
+
+
+@dataclass(frozen=True)
+class Fold:
+    """Turning point in p: pdot changes sign. ``labels``: (p largest, p smallest).
+
+    Two folds inside one step leave pdot with one sign at both ends; the
+    :class:`EventFinder` looks for them where the sampled pdot dips toward zero.
+    """
+
+    labels: tuple = ("fold_max", "fold_min")
+    needs_tangent = True
+
+    def test(self, pt) -> float:
+        """The test function at a point: pdot."""
+        return pt.pdot
+
+    def label(self, before: float) -> str:
+        """The name of the fold, by the sign of pdot before it."""
+        return self.labels[0] if before > 0 else self.labels[1]
+
+
+@dataclass(frozen=True)
+class Extremum:
+    """Extremum of the observable ``name`` along the curve: its rate d/ds changes sign.
+
+    ``labels``: (minimum, maximum).
+    """
+
+    name: str
+    labels: tuple = ("min", "max")
+    needs_tangent = True
+
+    def test(self, pt) -> float:
+        """The test function at a point: the observable's rate d/ds."""
+        return pt.rates[self.name]
+
+    def label(self, before: float) -> str:
+        """The name of the extremum, by the sign of the rate before it."""
+        return self.labels[0] if before < 0 else self.labels[1]
+
+
+@dataclass(frozen=True)
+class Zero:
+    """The observable ``name`` crosses ``level``."""
+
+    name: str
+    tag: str = "zero"
+    level: float = 0.0
+    needs_tangent = False
+
+    def test(self, pt) -> float:
+        """The test function at a point: observable - level."""
+        return pt.values[self.name] - self.level
+
+    def label(self, before: float) -> str:
+        """The event's one name."""
+        return self.tag
+
+
+@dataclass(frozen=True)
+class ParameterValue:
+    """The parameter crosses ``target``."""
+
+    target: float
+    tag: str = "p"
+    needs_tangent = False
+
+    def test(self, pt) -> float:
+        """The test function at a point: p - target."""
+        return pt.p - self.target
+
+    def label(self, before: float) -> str:
+        """The event's one name."""
+        return self.tag
+
+
+@dataclass
+class Found:
+    """A located event: its point, its label, and the curve segment [points[segment], points[segment + 1]]."""
+
+    event: object
+    label: str
+    point: object
+    segment: int
+    before: float                 # the test function's value at the segment's start
+    landing: object = None        # for a fold: the point it jumps to (see jumps)
+    landing_by: object = None     # the EventFinder (segment) that located it
+    landing_step: int = -1        # and the step of that segment it lies on
+    estimate: dict | None = None  # best values and error bars, when asked for (error_estimate.event_errors)
+    arc: tuple | None = None      # a fold: (point(s), s0, s, s1), the arc it was located on, s its place
+
+
+class EventFinder:
+    """Watch accepted steps for sign changes of the events' test functions; locate them.
+
+    Parameters
+    ----------
+    cont : Continuation
+    events : sequence
+        Event objects, tested in this order at every step.
+    tol : float
+        Tolerance in the parameter of the located events.
+    """
+
+    def __init__(self, cont, events, tol: float = EVENT_TOL):
+        self.cont, self.events, self.tol = cont, list(events), tol
+        self.found: list[Found] = []
+
+    def __call__(self, a, b) -> None:
+        """The ``on_step`` callback of the continuation."""
+        pts = self.cont.points
+        before = pts[-3] if len(pts) > 2 else None
+        for ev in self.events:
+            fa, fb = ev.test(a), ev.test(b)
+            if fa == 0.0 or fa * fb > 0:
+                if isinstance(ev, Fold) and before is not None and ev.test(before) * fa > 0 \
+                        and abs(fa) < min(abs(ev.test(before)), abs(fb)):
+                    self._pairs(ev, ((before, a, len(pts) - 3), (a, b, len(pts) - 2)))
+                continue
+            point, sb = self._arc(a, b, ev.needs_tangent)
+            at = self._root(point, 0.0, sb, ev.test, 0.0)
+            self.found.append(Found(ev, ev.label(fa), point(at, True), len(pts) - 2, fa,
+                                    arc=(point, 0.0, at, sb) if isinstance(ev, Fold) else None))
+
+    def _arc(self, a, b, tangent: bool, arclength: bool = False):
+        """(point(s, tangent), sb): the corrected point at distance s from a on the step a -> b
+        (cached; RuntimeError when the corrector fails), and b's distance.  With ``arclength`` the
+        pseudo-arclength corrector throughout, which follows the curve through folds where the
+        natural one (at fixed p) may have stepped over them."""
+        cont = self.cont
+        # b's distance from a: along a's tangent for the arclength corrector, in p for the natural
+        sb = b.ds if b.ds and b.corrector == ("natural" if cont.natural_ok(a) and not arclength else "arclength") \
+            else cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p)
+        correct = cont.arclength if arclength else cont.correct
+        cache = {}
+
+        def point(s, tangent=tangent):
+            if s not in cache or (tangent and cache[s].corrector != "event"):
+                sol = correct(a, s, tangent) if s else (a.x, a.p, (a.xdot, a.pdot, 0), 0, 0, "")
+                if sol is None:                       # a factorization kept from afar: once more, fresh
+                    cont.newton.reuse.expire()
+                    cont.bordered.reuse.expire()
+                    sol = correct(a, s, tangent)
+                if sol is None:
+                    raise RuntimeError(f"event location failed near {cont.pb.parameter} = {a.p:.6g}")
+                x, p, (xdot, pdot, _), *_ = sol
+                cache[s] = cont.make_point(x, p, xdot, pdot, corrector="event" if tangent else "untangented")
+            return cache[s]
+
+        return point, sb
+
+    def locate(self, a, b, f, level: float = 0.0, tangent: bool = True):
+        """The point between a and b where f = level, to ``tol`` in the parameter.
+
+        Without ``tangent`` the evaluations skip the tangent solve (f must not
+        need it); the located point gets its own tangent at the end.
+        """
+        point, sb = self._arc(a, b, tangent)
+        return point(self._root(point, 0.0, sb, f, level), True)
+
+    def _root(self, point, s0: float, s1: float, f, level: float) -> float:
+        """The s in [s0, s1] where f(point(s)) = level, point(s) from :meth:`_arc` (an end when f - level
+        does not change sign)."""
+        def g(s):
+            return f(point(s)) - level
+
+        # p moves by at most |s| along a unit tangent, so xtol in s bounds the error in p
+        return brent.root(g, s0, s1, xtol=self.tol, rtol=4 * np.finfo(float).eps, maxiter=100) \
+            if g(s0) * g(s1) < 0 else (s0 if g(s0) == 0 else s1)
+
+    def _pairs(self, ev, steps) -> None:
+        """Fold pairs inside a step, where pdot has one sign at both ends (near a cusp the pair is
+        narrower than any step, and the natural corrector steps over it).
+
+        Called where the sampled pdot dips toward zero: each of the two ``steps`` (a, b, segment)
+        about the dip is walked again in SUBSTEPS arclength sub-steps; the sign changes found are
+        located, and where the walk's own pdot still dips inside, its minimum is sought
+        (to DIP_XTOL of the sub-step) and the two folds about it located when it has the other sign.
+        """
+        for a, b, segment in steps:
+            if any(f.segment == segment and isinstance(f.event, Fold) for f in self.found):
+                continue
+            _, sb = self._arc(a, b, False, arclength=True)
+            walk = self._walk(a, sb / SUBSTEPS)
+            t = [ev.test(c) for c in walk]
+            arcs = [(self._arc(walk[k], walk[k + 1], True, arclength=True), 0.0) for k in range(len(t) - 1)
+                    if t[k] * t[k + 1] <= 0 and t[k] != 0]
+            k = int(np.argmin(np.abs(t)))
+            if not arcs and 0 < k < len(t) - 1:
+                arcs = self._dip(ev, walk[k - 1], walk[k + 1])
+            for (point, end), start in arcs:
+                before = ev.test(point(start))
+                at = self._root(point, start, end, ev.test, 0.0)
+                self.found.append(Found(ev, ev.label(before), point(at, True), segment, before,
+                                        arc=(point, start, at, end)))
+            if arcs:
+                self.found.sort(key=lambda f: (f.segment, self._along(f)))
+
+    def _walk(self, a, h: float) -> list:
+        """a and the points after it by up to SUBSTEPS arclength steps of length h, each from the last
+        with its own tangent; ends early where the corrector fails."""
+        walk = [a]
+        for _ in range(SUBSTEPS):
+            sol = self.cont.arclength(walk[-1], h, True)
+            if sol is None:
+                break
+            x, p, (xdot, pdot, _), *_ = sol
+            walk.append(self.cont.make_point(x, p, xdot, pdot, corrector="event"))
+        return walk
+
+    def _dip(self, ev, a, b) -> list:
+        """The minimum of |pdot| on the arc a -> b: when pdot has the other sign there, the two pieces
+        of the arc about it, each ((point(s), end), start) bracketing a fold, else []."""
+        sign = np.sign(ev.test(a))
+        point, sb = self._arc(a, b, True, arclength=True)
+
+        def depth(s):
+            d = sign * ev.test(point(s))
+            if d < 0:
+                raise _Below(s)
+            return d
+
+        try:
+            brent.minimum(depth, *sorted((0.0, sb)), xatol=DIP_XTOL * abs(sb))
+            return []
+        except _Below as below:
+            return [((point, below.s), 0.0), ((point, sb), below.s)]
+        except RuntimeError:                # the corrector did not reach: no pair seen
+            return []
+
+    def _along(self, f: Found) -> float:
+        """Distance of a located event from the start of its step, along the start's tangent."""
+        a = self.cont.points[f.segment]
+        return self.cont.inner(a.xdot, f.point.x - a.x) + a.pdot * (f.point.p - a.p)
+
+    def jumps(self, stable) -> None:
+        """For each fold, the state it jumps to (``Found.landing``): :func:`jumps` on this one curve."""
+        jumps([self], stable)
+
+    def state(self, index_of) -> list[dict]:
+        """The events found, as plain data (a checkpoint saves them); ``index_of(finder)``: the number of the
+        finder (of the curve's segments) a landing was located by."""
+        return [{"event": self.events.index(f.event), "label": f.label, "segment": f.segment, "before": f.before,
+                 "point": f.point.state(), "landing": None if f.landing is None else f.landing.state(),
+                 "landing_by": None if f.landing_by is None else index_of(f.landing_by),
+                 "landing_step": f.landing_step, "estimate": f.estimate} for f in self.found]
+
+    def restore(self, state: list[dict], finder_at) -> None:
+        """Take up :meth:`state`; ``finder_at(number)``: the finder of that number."""
+        self.found = []
+        for d in state:
+            by = finder_at(d["landing_by"]) if d["landing_by"] is not None else None
+            self.found.append(Found(self.events[d["event"]], d["label"], Point.from_state(d["point"]), d["segment"],
+                                    d["before"], landing=Point.from_state(d["landing"]) if by is not None else None,
+                                    landing_by=by, landing_step=d["landing_step"], estimate=d["estimate"]))
+
+
+def jumps(finders, stable) -> None:
+    """For each fold found by ``finders`` (the segments of one curve, in order), the state on another
+    stable branch at the same p (``Found.landing``).
+
+    Under control of p the state jumps forward along the curve from a fold
+    where p is largest, backward from one where it is smallest: the first
+    crossing of the fold's p on a step whose ends are ``stable(point)`` in that
+    direction is where it lands, located on that step's own segment.  Steps
+    between segments (a change of discretization) are not crossings.
+    """
+    steps = [(f, j) for f in finders for j in range(len(f.cont.points) - 1)]
+    for k, finder in enumerate(finders):
+        for ev in finder.found:
+            if not isinstance(ev.event, Fold):
+                continue
+            at = steps.index((finder, ev.segment))
+            pf = ev.point.p
+            order = steps[at + 1:] if ev.before > 0 else steps[at - 1::-1] if at else []
+            if _near_landing(finder, ev, stable):
+                continue
+            for owner, j in order:
+                a, b = owner.cont.points[j], owner.cont.points[j + 1]
+                if stable(a) and stable(b) and (a.p - pf) * (b.p - pf) <= 0:
+                    ev.landing = owner.locate(a, b, lambda pt: pt.p, level=pf, tangent=False)
+                    ev.landing_by, ev.landing_step = owner, j
+                    break
+
+
+def _near_landing(finder: EventFinder, ev: Found, stable) -> bool:
+    """The landing of the fold ``ev`` on the step of the next fold (forward jump) or of the one before
+    (backward), whose other end is unstable: on the arc that fold was located on, beyond it (before
+    it), then, for a pair inside one step, from that arc's end to the step's end (from the step's
+    start to the arc's start).  Found or not."""
+    folds = [f for f in finder.found if isinstance(f.event, Fold)]
+    k = next(i for i, f in enumerate(folds) if f is ev) + (1 if ev.before > 0 else -1)
+    other = folds[k] if 0 <= k < len(folds) else None
+    if other is None or other.arc is None:
+        return False
+    pts, pf = finder.cont.points, ev.point.p
+    point, s0, at, s1 = other.arc
+    pieces = [(point, at, s1)] if ev.before > 0 else [(point, s0, at)]
+    if other.segment == ev.segment:
+        pieces.append((point(s1), pts[ev.segment + 1]) if ev.before > 0 else (pts[ev.segment], point(s0)))
+    for piece in pieces:
+        if len(piece) == 3:
+            arc, lo, hi = piece
+            if (arc(lo).p - pf) * (arc(hi).p - pf) <= 0 and stable(arc(hi if ev.before > 0 else lo)):
+                ev.landing = arc(finder._root(arc, lo, hi, lambda pt: pt.p, pf), True)
+        elif stable(piece[0]) and stable(piece[1]) and (piece[0].p - pf) * (piece[1].p - pf) <= 0:
+            ev.landing = finder.locate(*piece, lambda pt: pt.p, level=pf, tangent=False)
+        if ev.landing is not None:
+            ev.landing_by, ev.landing_step = finder, other.segment
+            return True
+    return False

@@ -1,0 +1,184 @@
+"""What the continuation core asks of a problem, and the point of a curve it gives back.
+
+The core traces G(x, p) = 0 in one parameter p and knows nothing of adhesion.
+It sees a problem only through :class:`ContinuationProblem` (in the manner of
+pacopy's ``f``, ``df_dlmbda``, ``jacobian_solver``, ``inner``): the Newton
+solver, the bordered arclength system, the continuation and the event finder
+call nothing else.  Code that follows a curve over several discretizations
+(the tracer, the error bars, the results, the checkpoint) needs a little more
+of each discretization, :class:`TracedProblem`; the fold system
+(:mod:`~petsc_adhesion.core.fold`) continues a turning point in a second
+parameter through :class:`FoldBase`.  ``residual``, ``dG_dp`` and
+``linearize`` get x as a PETSc Vec; the other members deal in the rank's local
+parts (numpy arrays); parameters are floats.
+
+The problems of this package: the adhesion problem in the physical frame
+(:class:`~petsc_adhesion.discretization.problem.Problem`), in the frame of the
+contact edge (:class:`~petsc_adhesion.discretization.edge_frame.EdgeFrameProblem`),
+and the fold system built on the first
+(:class:`~petsc_adhesion.core.fold.FoldSystem`); the tests add a scalar fold,
+Bratu and a cusp.  Each is checked against finite differences of its residual
+(tests/test_protocol.py).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields, replace
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+__all__ = ["Point", "ContinuationProblem", "TracedProblem", "FoldBase", "POINT_FIELDS"]
+
+
+@runtime_checkable
+class ContinuationProblem(Protocol):
+    """What the corrector, the tangents, the step control and the events need of a problem.
+
+    The bordered matrix of the arclength corrector is [[G_x, G_p], [w xdot^T, pdot]]
+    (eq. 25); a problem with unknowns of its own beyond x's nodal part (the frame
+    of the edge, the fold system) borders G_x itself, and ``create_pmat`` /
+    ``fill_pmat`` then put their own borders first.
+    """
+
+    #: the PETSc communicator of every object of the problem
+    comm: object
+    #: the name of p, for monitors ("lambda")
+    parameter: str
+    #: G_x at the point of :meth:`linearize` (a PETSc Mat, often a shell)
+    jacobian: object
+    #: local weights w of the inner product <u, v> = sum w u v of the continuation's norm
+    weights: np.ndarray
+
+    def create_vec(self):
+        """A Vec in the layout of x and of G."""
+
+    def residual(self, x, p: float, G) -> None:
+        """G(x, p) into the Vec G, at the p passed in (nothing is stored on the problem)."""
+
+    def dG_dp(self, x, p: float, out: np.ndarray) -> np.ndarray:
+        """dG/dp on the local rows into ``out``; returns ``out``."""
+
+    def linearize(self, x, p: float) -> None:
+        """Set the point of :attr:`jacobian`."""
+
+    def create_pmat(self, borders: int):
+        """The Mat the preconditioner is built from for G_x with ``borders`` extra rows and columns
+        (0: Newton at fixed p; 1: the bordered matrix); None: the operator itself."""
+
+    def fill_pmat(self, P, borders=()) -> None:
+        """Assemble P at the linearization point, with the :class:`~petsc_adhesion.core.bordered.Border`
+        objects ``borders`` appended in order."""
+
+    def setup_pc(self, pc, bordered: bool = False) -> None:
+        """The default preconditioner for the square or the bordered matrix."""
+
+    def inside(self, x: np.ndarray) -> bool:
+        """Domain guard: whether the local part x is admissible (collective, the same on every rank)."""
+
+    def step_fraction(self, x: np.ndarray, y: np.ndarray) -> float:
+        """Domain guard: the largest fraction of the Newton step x -> x - y allowed (the same on every rank)."""
+
+    def observe(self, x: np.ndarray, p: float, xdot: np.ndarray, pdot: float) -> tuple[dict, dict]:
+        """Named observables at (x, p) and their rates d/ds along the tangent (xdot, pdot)."""
+
+
+@runtime_checkable
+class TracedProblem(ContinuationProblem, Protocol):
+    """What the tracer, the error bars, the results and the checkpoint need beside the protocol.
+
+    A state x may hold unknowns beside the nodal separation (the contact radius in
+    the frame of the edge); these members give its physical meaning.
+    """
+
+    #: the model (mu, sigma, roughness, r_m) the problem discretizes
+    model: object
+    #: its pressure law (:func:`~petsc_adhesion.model.pressure.pressure_law`)
+    law: object
+    #: the nodal rows [lo, hi) this rank owns
+    lo: int
+    hi: int
+    #: rows of the nodal part on this rank, of all ranks, and whether this is the last rank
+    layout: object
+    #: Newton steps the domain guard shortened so far
+    guarded: int
+
+    def separation(self, x: np.ndarray) -> np.ndarray:
+        """The local nodal separation H of a state x (collective)."""
+
+    def nodes(self, x: np.ndarray) -> np.ndarray:
+        """All physical nodes r of a state x, r_m the last (collective)."""
+
+    def gather(self, local: np.ndarray) -> np.ndarray:
+        """A whole nodal vector from its local parts, on every rank."""
+
+    def stable(self, point: Point) -> bool:
+        """Stable under displacement control at a point of the curve."""
+
+    def destroy(self) -> None:
+        """Free the PETSc objects of the problem."""
+
+
+@runtime_checkable
+class FoldBase(ContinuationProblem, Protocol):
+    """What the fold system needs of a problem G(u, p; s) = 0 whose turning points in p it continues in s.
+
+    Besides the protocol (for u at fixed p): the transpose of G_u, the second
+    derivatives of G along the null vectors, and the second parameter s, set
+    through the problem (never by writing its fields).
+    """
+
+    def set_parameter(self, name: str, value: float) -> None:
+        """Make the problem that of the second parameter ``name`` at ``value``."""
+
+    def jacobian_transpose(self, u, y) -> None:
+        """y = G_u^T u at the point of :meth:`linearize` (Vecs)."""
+
+    def second_derivatives(self, u: np.ndarray, p: float, v: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, float]:
+        """(w^T (dG_u/du)[v] on the local rows, w^T (dG_u/dp) v) at (u, p): the gradient of the fold's
+        test function, negated (collective)."""
+
+    def parameter_derivatives(self, name: str, u: np.ndarray, p: float, v: np.ndarray, w: np.ndarray,
+                              gap: float) -> tuple[np.ndarray, float]:
+        """(dG/ds on the local rows, w^T (dG_u/ds) v) for the second parameter s = ``name`` at (u, p)
+        (collective); ``gap``: how far the state lies from the edge of its domain, which bounds a
+        difference step."""
+
+    def domain_gap(self, u: np.ndarray) -> float:
+        """How far the local part u lies inside the domain at the current parameters (collective)."""
+
+
+#: The fields of a :class:`Point` beside its vectors x and xdot.
+POINT_FIELDS = ("p", "pdot", "values", "rates", "ds", "deviation", "newton_its", "ksp_its", "corrector")
+
+
+@dataclass
+class Point:
+    """A computed point of the curve with its unit tangent (local parts of x)."""
+
+    x: np.ndarray
+    p: float
+    xdot: np.ndarray
+    pdot: float
+    values: dict = field(default_factory=dict)   # observables
+    rates: dict = field(default_factory=dict)    # their d/ds along the tangent
+    ds: float = 0.0             # the step that reached it
+    deviation: float = 0.0      # |corrector - predictor| / ds: the curvature the step met
+    newton_its: int = 0         # Newton iterations of the corrector
+    ksp_its: int = 0
+    corrector: str = "start"    # "natural" | "arclength" | "start" | "event"
+
+    def reversed(self) -> Point:
+        """The same point with the curve's orientation reversed (tangent and rates negated)."""
+        return replace(self, xdot=-self.xdot, pdot=-self.pdot, rates={k: -v for k, v in self.rates.items()})
+
+    def state(self) -> dict:
+        """The point as plain data: its local vectors and its fields (a checkpoint saves it)."""
+        return {"x": self.x, "xdot": self.xdot, **{k: getattr(self, k) for k in POINT_FIELDS}}
+
+    @classmethod
+    def from_state(cls, d: dict) -> Point:
+        """The point of :meth:`state`."""
+        return cls(x=np.array(d["x"]), xdot=np.array(d["xdot"]), **{k: d[k] for k in POINT_FIELDS})
+
+
+assert set(POINT_FIELDS) | {"x", "xdot"} == {f.name for f in fields(Point)}

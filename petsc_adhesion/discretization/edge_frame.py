@@ -1,0 +1,280 @@
+"""The problem in the frame of the contact edge: r = a rho, the edge pinned at rho = 1.
+
+At large mu the separation has a sharp feature at the contact edge, about
+0.75 mu^-1.5 wide, that travels along the curve.  In the physical frame a
+tangent predictor moves it only linearly, so every step must stay within a
+fraction of its width.  In the frame r = a rho, with the contact radius a an
+unknown and the edge pinned at rho = 1, the profile changes smoothly and the
+steps can be long.  The kernel t/(t + r) K(k) depends on t/r alone, so the
+influence matrix on the nodes a rho is a times that on rho.  The unknown is
+the deformation D = H - a^2 rho^2 / 2 (H itself would change by r^2/a per
+unit change of a far out, and make the curve look long), and eq. (12) reads
+
+    G_i = D_i + lambda - c a sum_j Ahat_ij P(D_j + a^2 rho_j^2 / 2)            (eq. 12)
+    G_a = D(1) + a^2 / 2 - level                                               (the pin)
+
+with D(1) interpolated between its two nodes: the edge is where H reaches
+:func:`edge_level`.  The unknowns are x = (D_0 .. D_{N-1}, a), a the last
+entry (on the last rank); it implements the continuation's protocol.
+"""
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from .. import brent
+from ..core.bordered import Border
+from ..model.pressure import pressure_law
+from ..model.reference.rigid import load_beyond, load_beyond_rates
+from .grid import l2_weights, load_weights
+from .preconditioning import Layout
+from .problem import TO_WALL, local_diagonal, norm_radius
+
+__all__ = ["EdgeFrameProblem", "edge_level", "SMOOTH_LEVEL", "SMOOTH_PEAK", "peak_attraction"]
+
+
+#: H at the pinned contact edge of a smooth surface: a gap of 1.5 epsilon, inside the cohesive zone.
+SMOOTH_LEVEL = 0.5
+#: H of the smooth law's peak attraction: a gap of 3^(1/6) epsilon (eq. 5).
+SMOOTH_PEAK = 3.0 ** (1.0 / 6.0) - 1.0
+
+
+def peak_attraction(law) -> float:
+    """The H at which the law attracts most (P most negative), above its wall.
+
+    A rough average spreads the attraction over the heights, and the peak can lie
+    far from the wall + 1.5 of a smooth surface: with the 16-point Hermite rule at
+    sigma = 1 it is 0.24 above the wall.  Sampled on a geometric scale from the
+    wall, then refined by Brent's method between the neighbours of the best sample.
+    """
+    if law.smooth:
+        return SMOOTH_PEAK
+    reach = 2.0 * (law.wall + 1.0) + 3.0          # past the lowest heights' reach, for any law here
+    H = law.wall + np.geomspace(1e-4, reach, 2000)
+    k = int(np.argmin(law(H)[0]))
+    lo, hi = H[max(k - 1, 0)], H[min(k + 1, H.size - 1)]
+    return float(brent.minimum(lambda h: float(law(np.array([h]))[0][0]), lo, hi, xatol=1e-10))
+
+
+def edge_level(law) -> float:
+    """H at the pinned contact edge: as far beyond the law's peak attraction as a smooth surface's
+    SMOOTH_LEVEL is beyond its own, so inside the cohesive zone whatever the roughness."""
+    return SMOOTH_LEVEL if law.smooth else peak_attraction(law) + (SMOOTH_LEVEL - SMOOTH_PEAK)
+
+
+class EdgeFrameProblem:
+    """Eq. (12) on the nodes a rho with the contact edge pinned at rho = 1.
+
+    Parameters
+    ----------
+    model : Model
+    rho : numpy.ndarray
+        The nodes in units of the contact radius, from 0 past 1.
+    A : petsc4py.PETSc.Mat
+        The influence matrix on ``rho`` (eq. 4, 12), dense, distributed by rows.
+    scale : float
+        The contact radius the grid was made for: it sets the norm's reach and
+        the weight of a in it.
+    pmat
+        A strategy of :mod:`petsc_adhesion.discretization.preconditioning`.
+    """
+
+    parameter = "lambda"
+
+    def __init__(self, model, rho: np.ndarray, A: PETSc.Mat, scale: float, pmat):
+        self.model, self.rho, self.A, self.scale, self.pc = model, rho, A, scale, pmat
+        self.comm = A.getComm()
+        self._mpi = self.comm.tompi4py()
+        self.law = pressure_law(model)
+        self.level = edge_level(self.law)
+        self.c = model.coupling
+        self.lo, self.hi = A.getOwnershipRange()
+        self.nloc, N = self.hi - self.lo, rho.size
+        self.last = self.comm.getRank() == self.comm.getSize() - 1
+        self.layout = Layout(self.lo, self.hi, N, self.last)
+        local = rho[self.lo:self.hi]
+        self.half_rho2 = 0.5 * local * local
+        self.q = (8.0 / 3.0) * load_weights(rho)[self.lo:self.hi]
+        # the pin: H(1) = (1 - t) H_k + t H_{k+1}
+        k = int(np.searchsorted(rho, 1.0)) - 1
+        t = (1.0 - rho[k]) / (rho[k + 1] - rho[k])
+        self.pin = np.zeros(N)
+        self.pin[k], self.pin[k + 1] = 1.0 - t, t
+        self._pin_local = self.pin[self.lo:self.hi]
+        w = l2_weights(scale * rho, norm_radius(model))[self.lo:self.hi]
+        # a relative change of the contact radius weighs like a unit change of H
+        self.weights = np.append(w, 1.0 / scale**2) if self.last else w
+        self._pressure, self._Ap = A.createVecs()
+        self.dp, self.column, self.a = np.zeros(self.nloc), np.zeros(self.nloc), scale
+        n1 = int(self.last)
+        self.jacobian = PETSc.Mat().createPython(((self.nloc + n1, N + 1), (self.nloc + n1, N + 1)),
+                                                 _Jacobian(self), comm=self.comm)
+        self.jacobian.setUp()
+        self._gather = None
+        self.guarded = 0                  # Newton steps the domain guard shortened
+
+    # -- x = (H, a) --------------------------------------------------------------------
+    def create_vec(self) -> PETSc.Vec:
+        """A vector (H, a), a on the last rank."""
+        n1 = int(self.last)
+        return PETSc.Vec().createMPI((self.nloc + n1, self.rho.size + 1), comm=self.comm)
+
+    def _split(self, x: np.ndarray, pinned: bool = False):
+        """(local H, a, and with ``pinned`` H(1)): one reduction."""
+        h = x[:self.nloc]
+        parts = np.array([x[self.nloc] if self.last else 0.0, self._pin_local @ h if pinned else 0.0])
+        a, h1 = self._mpi.allreduce(parts)
+        return h, a, h1
+
+    def separation(self, x: np.ndarray) -> np.ndarray:
+        """The local H = D + a^2 rho^2 / 2 of a state x (collective)."""
+        d, a, _ = self._split(x)
+        return d + a * a * self.half_rho2
+
+    def nodes(self, x: np.ndarray) -> np.ndarray:
+        """The physical nodes a rho of a state x, all of them (collective)."""
+        return self._split(x)[1] * self.rho
+
+    def radius(self, x: np.ndarray) -> float:
+        """The contact radius a of a state x (collective)."""
+        return self._split(x)[1]
+
+    def gather(self, local: np.ndarray) -> np.ndarray:
+        """The whole nodal vector of local parts of H, on every rank."""
+        return np.concatenate(self._mpi.allgather(np.asarray(local)))
+
+    # -- eq. 12, 14, 26 in the frame of the edge ------------------------------------------
+    def residual(self, X: PETSc.Vec, lam: float, G: PETSc.Vec) -> None:
+        """G(D, a, lambda): eq. (12) on the nodes a rho, and the pin."""
+        d, a, d1 = self._split(X.getArray(readonly=True), pinned=True)
+        pressure, _ = self.law(d + a * a * self.half_rho2)
+        self._pressure.setArray(pressure)
+        self.A.mult(self._pressure, self._Ap)
+        g = d + lam - self.c * a * self._Ap.getArray(readonly=True)
+        G.setArray(np.append(g, d1 + 0.5 * a * a - self.level) if self.last else g)
+
+    def dG_dp(self, X: PETSc.Vec, lam: float, out: np.ndarray) -> np.ndarray:
+        """G_lambda: ones on the rows of eq. (12), zero on the pin."""
+        out[:self.nloc] = 1.0
+        out[self.nloc:] = 0.0
+        return out
+
+    def observe(self, x: np.ndarray, lam: float, xdot: np.ndarray, pdot: float):
+        """The load F = (8/3) a^2 integral P rho drho (eq. 26) and its rate d/ds along the tangent."""
+        d, a, _ = self._split(x)
+        ddot, adot, _ = self._split(xdot)
+        pressure, dpressure = self.law(d + a * a * self.half_rho2)
+        hdot = ddot + 2 * a * adot * self.half_rho2
+        S, dS = self._mpi.allreduce(np.array([self.q @ pressure, self.q @ (dpressure * hdot)]))
+        F, dF = a * a * S, 2 * a * adot * S + a * a * dS
+        if self.model.farfield:                 # beyond r_m = a rho_m (problem.Problem.observe)
+            rm = a * self.rho[-1]
+            dlam, drm = load_beyond_rates(rm, lam)
+            F, dF = F + load_beyond(rm, lam), dF + dlam * pdot + drm * self.rho[-1] * adot
+        return {"F": float(F)}, {"F": float(dF)}
+
+    @staticmethod
+    def stable(point) -> bool:
+        """Stable under displacement control: lambdadot > 0."""
+        return point.pdot > 0
+
+    # -- domain guard ----------------------------------------------------------------------
+    def inside(self, x: np.ndarray) -> bool:
+        """Every gap open and the contact radius positive, on all ranks."""
+        d, a, _ = self._split(x)
+        return self._mpi.allreduce(bool(np.all(d + a * a * self.half_rho2 > self.law.wall)), op=MPI.LAND) and a > 0
+
+    def step_fraction(self, x: np.ndarray, y: np.ndarray) -> float:
+        """Largest fraction of x -> x - y that covers at most TO_WALL of the way to the wall,
+        and at most halves the contact radius."""
+        d, a, _ = self._split(x)
+        yd, ya, _ = self._split(y)
+        # H falls by yd + a ya rho^2 to first order in the step
+        room, yh = d + a * a * self.half_rho2 - self.law.wall, yd + 2 * a * ya * self.half_rho2
+        toward = yh > 0
+        alpha = float(np.min(TO_WALL * room[toward] / yh[toward], initial=1.0))
+        if ya > 0:
+            alpha = min(alpha, 0.5 * a / ya)
+        alpha = self._mpi.allreduce(alpha, op=MPI.MIN)
+        self.guarded += alpha < 1.0
+        return alpha
+
+    # -- linearization -----------------------------------------------------------------------
+    def linearize(self, X: PETSc.Vec, lam: float) -> None:
+        """Set the point of the shell Jacobian: P'(H), a and the column dG/da = -c Ahat (P + a^2 rho^2 P')."""
+        d, self.a, _ = self._split(X.getArray(readonly=True))
+        pressure, self.dp = self.law(d + self.a * self.a * self.half_rho2)
+        # dG/da = -c Ahat (P + a^2 rho^2 P')
+        self._pressure.setArray(pressure + 2 * self.a * self.a * self.half_rho2 * self.dp)
+        self.A.mult(self._pressure, self._Ap)
+        self.column = -self.c * self._Ap.getArray(readonly=True)
+
+    def _dp_all(self) -> np.ndarray:
+        if self._gather is None:
+            self._dpv = self._pressure.duplicate()
+            self._gather, self._dpall = PETSc.Scatter.toAll(self._dpv)
+        self._dpv.setArray(self.dp)
+        self._gather.scatter(self._dpv, self._dpall, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        return self._dpall.getArray(readonly=True)
+
+    def jacobian_rows(self, out: np.ndarray) -> np.ndarray:
+        """Local rows of dG/dD = I - c a Ahat diag(P'), dense, into ``out``."""
+        np.multiply(self.A.getDenseArray(), -self.c * self.a * self._dp_all(), out=out)
+        out[np.arange(self.nloc), np.arange(self.lo, self.hi)] += 1.0
+        return out
+
+    def band_values(self, ai: np.ndarray, aj: np.ndarray) -> np.ndarray:
+        """Entries of dG/dD on the local CSR pattern (ai, aj)."""
+        rows = np.repeat(np.arange(self.nloc), np.diff(ai))
+        v = -self.c * self.a * self.A.getDenseArray()[rows, aj] * self._dp_all()[aj]
+        v[rows + self.lo == aj] += 1.0
+        return v
+
+    def _own_border(self) -> Border:
+        return Border(self.column, self.pin if self.last else None, self.a)
+
+    def create_pmat(self, borders: int) -> PETSc.Mat | None:
+        """The PC matrix of [[dG/dD, dG/da], [pin, a]] with ``borders`` more (1: the arclength corrector's)."""
+        return self.pc.create(self.layout, self.comm, 1 + borders)
+
+    def fill_pmat(self, P: PETSc.Mat, borders=()) -> None:
+        """Assemble P at the linearization point, its own border first."""
+        self.pc.fill(P, self, self.layout, [self._own_border(), *borders])
+
+    def setup_pc(self, pc: PETSc.PC, bordered: bool = False) -> None:
+        """Default preconditioner for the kind of P."""
+        self.pc.setup_pc(pc, bordered, self.layout.N)
+
+    def destroy(self) -> None:
+        """Free the PETSc objects held here, the influence matrix included."""
+        for obj in (self.jacobian, self._pressure, self._Ap, self.A):
+            obj.destroy()
+        if self._gather is not None:
+            for obj in (self._gather, self._dpv, self._dpall):
+                obj.destroy()
+
+
+class _Jacobian:
+    """MatPython context of [[I - c a Ahat diag(P'), dG/da], [pin, a]]."""
+
+    def __init__(self, problem: EdgeFrameProblem):
+        self.pb = problem
+        self._diag = None
+
+    def mult(self, mat, x, y):
+        """y = J x."""
+        pb = self.pb
+        vh, va, v1 = pb._split(x.getArray(readonly=True), pinned=True)
+        pb._pressure.setArray(pb.dp * vh)
+        pb.A.mult(pb._pressure, pb._Ap)
+        yh = vh - pb.c * pb.a * pb._Ap.getArray(readonly=True) + va * pb.column
+        y.setArray(np.append(yh, v1 + pb.a * va) if pb.last else yh)
+
+    def getDiagonal(self, mat, d):
+        """diag J (for -pc_type jacobi)."""
+        pb = self.pb
+        if self._diag is None:              # Ahat does not change: its diagonal once
+            self._diag = local_diagonal(pb.A)
+        dh = 1.0 - pb.c * pb.a * self._diag * pb.dp
+        d.setArray(np.append(dh, pb.a) if pb.last else dh)

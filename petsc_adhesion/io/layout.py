@@ -1,0 +1,150 @@
+"""The layout of the result files: the HDF5 trees of a curve, a solve, a study and a critical study, and the units
+and description of every group and dataset (docs/output.md)."""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["DESCRIBE", "curve_tree", "study_table", "CRITICAL_KEYS", "critical_table", "with_options", "case_tree", "solve_tree"]
+
+# Units of the dimensionless results (docs/model.md)
+_EPS, _LOAD, _RAD, _PRES = "epsilon", "2 pi R gamma", "sqrt(epsilon R)", "8 gamma / (3 epsilon)"
+_STATE = f"lambda, H0: {_EPS}; F: {_LOAD}"
+
+
+_ERRORS = f"lambda_err, lambda_grid: {_EPS}; F_err, F_grid, F_beyond: {_LOAD}; contact_radius: {_RAD}"
+
+
+_PHYS = ("R_m, epsilon_m: m; E_Pa: Pa; gamma_J_m2: J/m^2; mu: 1; sigma: epsilon; force_nN: nN per 2 pi R gamma; "
+         "approach_nm: nm per epsilon; radius_nm: nm per sqrt(epsilon R); pressure_MPa: MPa per 8 gamma / (3 epsilon)")
+
+
+#: path pattern (numbered groups as *) -> (units, one-line description), for every group and dataset
+DESCRIBE = {
+    "": ("", "petsc-adhesion result: adhesive contact of an elastic sphere with a flat (Cheng, Dunn and Brach "
+             "2002); kind: curve (continuation) or solve (one approach)"),
+    "options": ("", "every option of the run as given (name without the dash: value)"),
+    "model": (f"mu: 1; sigma: {_EPS}; rmax: {_RAD}", "the model: Tabor parameter mu (eq. 9), roughness sigma "
+              "(with its averaging rule when sigma > 0), end r_m of the domain"),
+    "physical": (_PHYS, "the physical inputs (-phys_, SI) as given (inputs), the combined radius and modulus "
+                 "(eq. 2), the work of adhesion, epsilon, the mu (eq. 9) and sigma they make, and the value of each "
+                 "unit of the model in nN, nm and MPa"),
+    "physical/inputs": ("radius*: m; young*: Pa; poisson*: 1; gamma: J/m^2; hamaker: J; hamaker_cutoff: m; "
+                        "epsilon: m; rms: m", "the -phys_ options as given (SI)"),
+    "grid": ("", "the collocation grid (of the last segment when the grid followed the contact edge)"),
+    "grid/r": (_RAD, "the nodes r_i on [0, r_m]"),
+    "grid/lambda": (_EPS, "approach where each segment of the curve, on its own grid, starts"),
+    "grid/edge": (_RAD, "contact edge (or, in the frame of the edge, contact radius) each segment's grid is "
+                        "centred on; absent on a fixed grid"),
+    "grid/n_nodes": ("", "nodes of each segment's grid"),
+    "solution": (f"{_STATE}; wall_time_s: s", "the state at one approach (-adh_lambda) and the solver's effort"),
+    "solution/H": (_EPS, "separation H = h / epsilon - 1 at the nodes"),
+    "solution/P": (_PRES, "pressure at the nodes (eq. 14), positive when repulsive"),
+    "curve": ("", "the load-approach curve, one entry per computed point, start first"),
+    "curve/lambda": (_EPS, "approach lambda = alpha / epsilon"),
+    "curve/F": (_LOAD, "load (eq. 26), negative when tensile"),
+    "curve/H0": (_EPS, "separation at r = 0"),
+    "curve/lambdadot": ("1", "d lambda / ds of the unit tangent (s: pseudo-arclength)"),
+    "curve/stable": ("", "stable under displacement control (lambdadot > 0)"),
+    "curve/ds": ("1", "the step that reached the point (0 at the start)"),
+    "curve/newton_its": ("", "Newton iterations of the corrector"),
+    "curve/ksp_its": ("", "Krylov iterations of the corrector and the tangent"),
+    "curve/corrector": ("", "start, natural (eq. 21-22) or arclength (eq. 24-25)"),
+    "events": ("", "events located on the curve, in the order found"),
+    "events/*": (f"{_STATE}; {_ERRORS}", "one event: kind (snap_on, snap_off, F_min, F_max, equilibrium, "
+                 "lambda), its state, stability, error estimates"),
+    "events/*/r": (_RAD, "the nodes of the grid the event was located on (-profiles)"),
+    "events/*/H": (_EPS, "separation at the nodes at the event (-profiles)"),
+    "events/*/P": (_PRES, "pressure at the nodes at the event (-profiles)"),
+    "events/*/landing": (_STATE, "where the jump from this fold lands: the other stable branch at its lambda"),
+    "events/*/landing/r": (_RAD, "the nodes of the grid the landing was located on (-profiles)"),
+    "events/*/landing/H": (_EPS, "separation at the nodes after the jump (-profiles)"),
+    "events/*/landing/P": (_PRES, "pressure at the nodes after the jump (-profiles)"),
+    "summary": (f"{_STATE}; {_ERRORS}; *_s: s; *_nm: nm; *_nN: nN", "the JSON summary (docs/output.md); "
+                "physical: its events in nm and nN"),
+    "study": ("", "a study (kind: study): what its cases compute, the options swept, ranks per case, the figure"),
+    "cases": ("", "the cases of a study that ran, in their order; each holds a curve's layout and its values"),
+    "cases/*": ("", "one case: the options it sets (values), its model, grid, curve, events and summary"),
+    "cases/*/values": ("", "the options this case sets (name without the dash: value)"),
+    "failed": ("", "the cases of a study that did not run or failed, each with its one-line reason"),
+    "table": (f"{_STATE}; {_ERRORS}", "every case's events, one row each: case number, the swept options, kind, "
+              "best lambda and F with their error bars (NaN: none), the single-grid values"),
+    "table/*": ("", "one column of the table (units as the table's)"),
+    "critical_roughness": (f"mu: 1; sigma_c*: {_EPS}; lambda_c*: {_EPS}; F_c*: {_LOAD}; wall_time_s: s",
+                           "the critical roughness sigma_c(mu), above which the curve has no turning points: one "
+                           "row per mu of the study, the cusp's best values, error bars and values on each level"),
+    "critical_roughness/*": ("", "one column (units as the group's; *_grid, n_nodes: a row per mu, a column per "
+                                 "level)"),
+    "critical_mu": (f"sigma: {_EPS}; mu_c*: 1; lambda_c*: {_EPS}; F_c*: {_LOAD}; wall_time_s: s",
+                    "the critical Tabor parameter mu_c(sigma), below which the curve has no turning points: one "
+                    "row per sigma of the study"),
+    "critical_mu/*": ("", "one column (units as the group's; *_grid, n_nodes: a row per sigma, a column per level)"),
+}
+
+
+# -- layout ---------------------------------------------------------------------
+def with_options(head: dict, options: dict) -> dict:
+    """A result's head with the options of its run after the program's keys, as the files hold them."""
+    program = {k: v for k, v in head.items() if k not in ("model", "grid", "physical")}
+    return {**program, "options": options, **{k: head[k] for k in ("model", "grid", "physical") if k in head}}
+
+
+def curve_tree(curve, options: dict) -> dict:
+    """The HDF5 tree of a :class:`~petsc_adhesion.tracing.curve.Curve`: its head, the options of its run, the
+    points, the events and the summary."""
+    return {**with_options(curve.head, options), "kind": "curve", "curve": curve.branch, "events": curve.records,
+            "summary": curve.summary}
+
+
+def case_tree(curve, keep: tuple | None = None) -> dict:
+    """A study's case: a curve's tree without the program's keys; the profiles only of the event kinds in
+    ``keep`` (None: all that were computed)."""
+    events = curve.records
+    if keep is not None:
+        events = [_without_profiles(e) if e["kind"] not in keep else e for e in events]
+    tree = {**curve.head, "curve": curve.branch, "events": events, "summary": curve.summary}
+    return {k: v for k, v in tree.items() if k in ("model", "grid", "curve", "events", "summary", "physical")}
+
+
+def _without_profiles(e: dict) -> dict:
+    out = {k: v for k, v in e.items() if k not in ("r", "H", "P")}
+    if "landing" in e:
+        out["landing"] = {k: v for k, v in e["landing"].items() if k not in ("r", "H", "P")}
+    return out
+
+
+def solve_tree(solution, options: dict) -> dict:
+    """The HDF5 tree of a :class:`~petsc_adhesion.tracing.curve.Solution`."""
+    return {**with_options(solution.head, options), "kind": "solve",
+            "solution": {"H": solution.H, "P": solution.P, **solution.record}}
+
+
+def study_table(done: list[dict], axes: list[str]) -> dict:
+    """Every case's events as columns: case, the swept options, kind, best values, bars, grid values."""
+    rows = [(r, e) for r in done for e in r["tree"]["events"]]
+    cols = {"case": np.array([r["case"] for r, _ in rows], dtype=int)}
+    cols |= {name: np.array([r["values"][name] for r, _ in rows], dtype=float) for name in axes}
+    cols["kind"] = np.array([e["kind"] for _, e in rows], dtype="S12")
+    for k in ("lambda", "lambda_err", "F", "F_err", "lambda_grid", "F_grid"):
+        cols[k] = np.array([e.get(k, np.nan) for _, e in rows], dtype=float)
+    return cols
+
+
+#: The columns of a critical study's cases (critical.sigma_c, critical.mu_c) by kind, in the JSON summary
+#: and the HDF5 tables (which add the values on each level).
+CRITICAL_KEYS = {k: (fixed, k, f"{k}_err", "lambda_c", "lambda_c_err", "F_c", "F_c_err", f"{k}_domain",
+                     "contact_radius", "wall_time_s")
+                 for k, fixed in (("sigma_c", "mu"), ("mu_c", "sigma"))}
+
+
+_CRITICAL = (("critical_roughness", "sigma_c"), ("critical_mu", "mu_c"))
+
+
+def critical_table(done: list[dict], kind: str) -> dict:
+    """The columns of the critical cases of ``kind`` (sigma_c or mu_c): CRITICAL_KEYS, the values on each
+    level (``*_grid``, a column per level) and the nodes of each level."""
+    rows = [r for r in done if r["kind"] == kind]
+    cols = {k: np.array([r[k] for r in rows], dtype=float) for k in CRITICAL_KEYS[kind]}
+    for k in (f"{kind}_grid", "lambda_c_grid", "F_c_grid"):
+        cols[k] = np.array([r[k] for r in rows], dtype=float)
+    cols["n_nodes"] = np.array([r["n_nodes"] for r in rows], dtype=int)
+    return cols

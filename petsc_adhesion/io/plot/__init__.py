@@ -1,0 +1,1 @@
+"""Figures from results (matplotlib, imported only when something is drawn)."""

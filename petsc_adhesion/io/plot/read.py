@@ -1,0 +1,34 @@
+"""Result files read back for their figures: a curve's layout from an HDF5 file or group, or from a tree."""
+from __future__ import annotations
+
+import h5py
+
+__all__ = ["from_tree", "read", "read_group"]
+
+
+def from_tree(tree: dict) -> dict:
+    """The layout of :func:`read` from a result tree of :mod:`petsc_adhesion.io.write` (before it is a file)."""
+    return {"mu": tree["model"]["mu"], "sigma": tree["model"]["sigma"], "r": tree["grid"]["r"],
+            "curve": tree["curve"], "events": tree["events"], "physical": tree.get("physical")}
+
+
+def read(path: str) -> dict:
+    """A curve result file as plain arrays and event dicts."""
+    with h5py.File(path, "r") as f:
+        return read_group(f)
+
+
+def read_group(f) -> dict:
+    """A curve's layout from an HDF5 group (a curve file's root, or a study's case)."""
+    out = {"mu": f["model"].attrs["mu"], "sigma": f["model"].attrs["sigma"], "r": f["grid/r"][()],
+           "curve": {k: v[()] for k, v in f["curve"].items()}, "events": [],
+           "physical": dict(f["physical"].attrs) if "physical" in f else None}
+    for name in sorted(f["events"]) if "events" in f else []:
+        g = f["events"][name]
+        ev = dict(g.attrs)
+        ev.update({k: g[k][()] for k in ("r", "H", "P") if k in g})
+        if "landing" in g:
+            ev["landing"] = dict(g["landing"].attrs) | {k: g["landing"][k][()] for k in ("r", "H", "P")
+                                                        if k in g["landing"]}
+        out["events"].append(ev)
+    return out

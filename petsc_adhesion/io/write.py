@@ -1,0 +1,170 @@
+"""Result files: their layout (docs/output.md) and their writing, by rank 0.
+
+The layout of a curve or a solve is built here from the result dicts of
+:mod:`petsc_adhesion.tracing.results`, once for the JSON summary and the HDF5 tree;
+the files of one run are written into the temporaries of a
+:class:`~petsc_adhesion.io.resultset.ResultSet` and committed together.
+"""
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from .layout import (
+    _CRITICAL,
+    CRITICAL_KEYS,
+    DESCRIBE,
+    critical_table,
+    curve_tree,
+    solve_tree,
+    study_table,
+)
+from .resultset import PLOT_FORMATS, ResultSet
+
+__all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study", "write_critical"]
+
+
+
+
+
+def _describe(name: str, obj) -> None:
+    key = "/".join("*" if part.isdigit() else part for part in name.split("/"))
+    if key.startswith("cases/*/") and key not in DESCRIBE:     # a study's case holds a curve's layout
+        key = key[len("cases/*/"):]
+    if key.startswith(("summary/", "study/", "failed/")):
+        key = key.split("/")[0]
+    elif key.startswith(("table/", "critical_roughness/", "critical_mu/")):
+        key = key.split("/")[0] + "/*"
+    units, text = DESCRIBE[key]
+    obj.attrs["units"], obj.attrs["description"] = units, text
+
+
+def _write(group, tree: dict) -> None:
+    """Dicts become groups, lists of dicts numbered groups; arrays datasets; scalars, strings and lists of
+    numbers or strings attributes (None: an empty string)."""
+    import h5py
+
+    for key, val in tree.items():
+        if isinstance(val, dict):
+            _write(group.require_group(key), val)
+        elif isinstance(val, (list, tuple)) and val and isinstance(val[0], dict):
+            sub = group.require_group(key)
+            for i, item in enumerate(val):
+                _write(sub.require_group(f"{i:04d}"), item)
+        elif isinstance(val, (list, tuple)) and all(isinstance(v, (int, float)) for v in val) and val:
+            group.attrs[key] = np.array(val)
+        elif isinstance(val, (list, tuple)):
+            group.attrs[key] = np.array([str(v) for v in val], dtype=h5py.string_dtype())
+        elif isinstance(val, np.ndarray):
+            group.create_dataset(key, data=val)
+        else:
+            group.attrs[key] = "" if val is None else val
+
+
+def write_h5(path: str, tree: dict) -> None:
+    """The tree as an HDF5 file (see :func:`_write`), every group and dataset with units and a description."""
+    import h5py
+
+    with h5py.File(path, "w") as f:
+        _write(f, tree)
+        _describe("", f)
+        f.visititems(_describe)
+
+
+def _plain(x):
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+def write_json(path: str, summary: dict) -> None:
+    """The summary as JSON (no NaN allowed)."""
+    with open(path, "w") as f:
+        json.dump(_plain(summary), f, indent=1, allow_nan=False)
+        f.write("\n")
+
+
+def write_curve(curve, options: dict, files: ResultSet) -> None:
+    """The files of a :class:`~petsc_adhesion.tracing.curve.Curve` (``options``: its run's, as given),
+    committed together."""
+    tree = curve_tree(curve, options)
+    if "out" in files.targets:
+        write_h5(files.temp("out"), tree)
+    if "plot" in files.targets:
+        from .plot.curve import curve_figure
+
+        fmt = PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()]
+        curve_figure(tree, files.temp("plot"), fmt)
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), curve.summary)
+    files.commit()
+
+
+def write_solve(solution, options: dict, files: ResultSet) -> None:
+    """The files of a :class:`~petsc_adhesion.tracing.curve.Solution`, committed together."""
+    if "out" in files.targets:
+        write_h5(files.temp("out"), solve_tree(solution, options))
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), solution.summary)
+    files.commit()
+
+
+def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
+    """The files of a critical study (``-study_compute critical``), committed together; returns the summary.
+
+    ``done``: the cases that ran, each a record of :func:`~petsc_adhesion.tracing.critical.sigma_c` or
+    :func:`~petsc_adhesion.tracing.critical.mu_c` with its ``kind``; ``failed``: {case, values, error}.
+    """
+    brief = {k: v for k, v in prog.items() if k != "options"}
+    def keys(kind):
+        return CRITICAL_KEYS[kind] + (f"{kind}_grid", "levels", "n_nodes", "bracket", "roughness", "rmax", "warning")
+
+    lists = {name: [{k: r[k] for k in keys(kind) if k in r} for r in done if r["kind"] == kind]
+             for name, kind in _CRITICAL}
+    summ = {**brief, "kind": "critical", "study": study, **lists, "failed": failed}
+    tree = {**prog, "kind": "critical", "study": study,
+            **{name: critical_table(done, kind) for name, kind in _CRITICAL},
+            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in failed]}
+               if failed else {})}
+    if "out" in files.targets:
+        write_h5(files.temp("out"), tree)
+    if "plot" in files.targets:
+        from .plot.study import critical_figure
+
+        critical_figure(tree, files.temp("plot"), PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()])
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), summ)
+    files.commit()
+    return summ
+
+
+def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
+    """The files of a study (:mod:`petsc_adhesion.app.study`), committed together; returns the summary.
+
+    ``done``: each case that ran as {case, values, summary, tree}; ``failed``: {case, values, error}.
+    """
+    brief = {k: v for k, v in prog.items() if k != "options"}
+    cases = [{"case": r["case"], "values": r["values"], **r["summary"]} for r in done]
+    summ = {**brief, "kind": "study", "study": study, "cases": cases, "failed": failed}
+    tree = {**prog, "kind": "study", "study": study,
+            "cases": [{"case": r["case"], "values": r["values"], **r["tree"]} for r in done],
+            "table": study_table(done, study["axes"]),
+            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in failed]}
+               if failed else {})}
+    if "out" in files.targets:
+        write_h5(files.temp("out"), tree)
+    if "plot" in files.targets:
+        from .plot.study import study_figure
+
+        fmt = PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()]
+        study_figure(tree, files.temp("plot"), study["plot"], fmt)
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), summ)
+    files.commit()
+    return summ

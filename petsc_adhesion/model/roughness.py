@@ -1,0 +1,311 @@
+"""Roughness heights bounded above, and the quadrature of averages over them.
+
+The pressure of paper eq. (7) and (10) is the average of the Lennard-Jones law over
+the roughness heights S (units of epsilon, from the mean plane).  With the Gaussian
+of eq. (3) (weight exp(-S^2/(2 sigma^2)), docs/model.md, paper note 1) that average diverges:
+heights above H + 1 close the gap, and (H + 1 - S)^-9 is not integrable there.  It
+exists for every H above a wall only when the heights are bounded above, by the
+highest asperity S_max (:attr:`top` of each distribution); the gap to it,
+d = H + 1 - S_max > 0, then sets how singular the integrand is.
+
+With u = S_max - S the depth below the highest asperity and q(u) its density,
+
+    E[f(H + 1 - S)] = integral_0^U q(u) f(d + u) du,
+
+and f ~ g^-9 gathers the integral on u ~ d: a rule fixed in S loses accuracy as d
+falls.  :class:`WallQuadrature` splits the depths at a width b of the distribution.
+On [0, b] its nodes move with d: u = d (e^v - 1), Gauss in v in [0, log(1 + b/d)],
+where g^-k du = d^(1-k) e^((1-k) v) dv is smooth for every d (Gauss-Jacobi when
+q ~ u^beta at the top).  On [b, U] they are fixed: Gauss panels in log u next to the
+top, where the poles of (d + u)^-k sit at Im log u = +-pi whatever d >= 0, and in a
+variable of the distribution in the bulk.  It averages f and f' alike, to about
+1e-11 relative for d from 1e-5 rms to infinity (tests/test_roughness.py).
+
+Families, by name (:data:`DISTRIBUTIONS`):
+
+``truncated_gaussian``
+    eq. (3) cut at +-K sigma (:class:`TruncatedGaussian`);
+``weibull``
+    reversed Weibull heights, skewed and bounded above by construction (:class:`Weibull`);
+``measured``
+    the histogram of heights read from a file (:class:`Measured`, :func:`read_heights`),
+    averaged exactly by ``pressure.HistogramLaw``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.special import gamma, roots_jacobi
+
+from .. import brent
+from .heights import _check
+
+__all__ = ["TruncatedGaussian", "Weibull", "Measured", "WallQuadrature", "DISTRIBUTIONS", "NEAR_POINTS", "PANEL_POINTS", "panel_points", "distribution"]
+
+#: Points of the moving rule on [0, b]: relative error below 1e-11 while b/d <= 5e3.
+NEAR_POINTS = 24
+#: Points of each fixed panel on [b, U].
+PANEL_POINTS = 16
+
+
+def panel_points(near_points: int) -> int:
+    """Points of each fixed panel for a moving rule of ``near_points``: in the ratio of the defaults."""
+    return max(2, -(-near_points * PANEL_POINTS // NEAR_POINTS))
+
+
+def _gauss(n: int, lo: float, hi: float, log: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights for integral_lo^hi du, in the variable log u when ``log``."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    if not log:
+        return lo + (hi - lo) * (x + 1) / 2, w * (hi - lo) / 2
+    a, b = math.log(lo), math.log(hi)
+    u = np.exp(a + (b - a) * (x + 1) / 2)
+    return u, w * (b - a) / 2 * u
+
+
+def _panels(edges, n: int, log: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Composite Gauss-Legendre rule on the panels between consecutive ``edges``."""
+    parts = [_gauss(n, lo, hi, log) for lo, hi in zip(edges[:-1], edges[1:])]
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+class TruncatedGaussian:
+    """Gaussian heights (paper eq. 3) cut symmetrically at +-K sigma and renormalised.
+
+    Only the upper cut is needed for a finite average: the lower tail never closes a
+    gap.  Both tails are cut so that the heights keep zero mean and no odd moments,
+    H stays the separation of the mean planes of eq. (6), and the surface has a
+    deepest valley as it has a highest asperity; the lower cut removes the weight
+    (0.13 % at K = 3) where the gaps are largest and the law weakest.
+
+    Parameters
+    ----------
+    sigma
+        Standard deviation of the untruncated Gaussian (units of epsilon).  The rms of
+        the heights, :attr:`rms`, is slightly smaller (0.987 sigma at K = 3).
+    cutoff
+        K, in (0, 10]: the highest asperity is at K sigma, the wall of the pressure law
+        at H = K sigma - 1.
+    """
+
+    name = "truncated_gaussian"
+    skewness = 0.0
+    wall_exponent = 0.0
+
+    def __init__(self, sigma: float, cutoff: float = 3.0):
+        if not (math.isfinite(sigma) and sigma >= 0):
+            raise ValueError(f"sigma must be finite and >= 0, got {sigma:g}")
+        if not 0 < cutoff <= 10:
+            raise ValueError(f"the cutoff K must lie in (0, 10], got {cutoff:g}")
+        self.sigma, self.cutoff = float(sigma), float(cutoff)
+        K = self.cutoff
+        self._mass = math.erf(K / math.sqrt(2))
+        self.rms = self.sigma * math.sqrt(1 - 2 * K * math.exp(-K * K / 2) / (math.sqrt(2 * math.pi) * self._mass))
+        self.top, self.bottom = K * self.sigma, -K * self.sigma
+        self.near_width = self.rms / 20
+
+    def pdf(self, S: np.ndarray) -> np.ndarray:
+        """Density exp(-S^2/(2 sigma^2)) / (sqrt(2 pi) sigma erf(K/sqrt 2)) on |S| <= K sigma, 0 outside."""
+        S = np.asarray(S, dtype=float)
+        return np.where(np.abs(S) <= self.top, self._gauss(S / self.sigma), 0.0)
+
+    def depth_pdf(self, u: np.ndarray) -> np.ndarray:
+        """Density q(u) of the depth u = S_max - S, 0 <= u <= 2 K sigma."""
+        return self._gauss(self.cutoff - u / self.sigma)
+
+    def _gauss(self, z):
+        return np.exp(-0.5 * z * z) / (math.sqrt(2 * math.pi) * self.sigma * self._mass)
+
+    def far_rule(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Fixed depths in [b, 2 K sigma] and their weights (density included).
+
+        One panel in log u from b = rms/20 to sigma (where the moving part ends and the
+        Gaussian starts to vary), then panels of at most 6 sigma in u, n points each.
+        """
+        b, U = self.near_width, 2 * self.top
+        c = min(self.sigma, U)
+        u, w = _gauss(n, b, c, log=True)
+        if U > c:
+            ul, wl = _panels(np.linspace(c, U, math.ceil((U - c) / (6 * self.sigma)) + 1), n)
+            u, w = np.concatenate([u, ul]), np.concatenate([w, wl])
+        return u, w * self.depth_pdf(u)
+
+
+class Weibull:
+    """Reversed Weibull heights: S = S_max - W, W Weibull of shape k and scale lambda.
+
+    Bounded above by construction (the Weibull law of maxima), so no cut-off is
+    needed: the highest asperity, S_max = lambda Gamma(1 + 1/k), is where the mean
+    is zero.  The density falls to zero at the top like (S_max - S)^(k-1) and has an
+    exponential tail of valleys.  The shape follows from the skewness: -2 is k = 1
+    (exponential depths, density finite at the top), 0 is k = 3.60 with
+    S_max = 3.24 rms, 0.5 is k = 7.49 with S_max = 6.34 rms.  Beyond 0.59 (k > 9) the
+    repulsion would stay finite at the wall, so the skewness is capped at 0.5.
+
+    Parameters
+    ----------
+    sigma
+        Root mean square height (units of epsilon).
+    skewness
+        Third standardised moment of the heights, in [-2, 0.5].
+    """
+
+    name = "weibull"
+    SKEWNESS = (-2.0, 0.5)
+
+    def __init__(self, sigma: float, skewness: float = 0.0):
+        if not (math.isfinite(sigma) and sigma >= 0):
+            raise ValueError(f"sigma must be finite and >= 0, got {sigma:g}")
+        lo, hi = self.SKEWNESS
+        if not lo <= skewness <= hi:
+            raise ValueError(f"the skewness of weibull heights must lie in [{lo:g}, {hi:g}], got {skewness:g}")
+        self.sigma = self.rms = float(sigma)
+        self.skewness = float(skewness)
+        self.shape = k = 1.0 if skewness == lo else brent.root(lambda k: _skewness(k) - skewness, 1.0, 9.0, xtol=1e-14)
+        g1, g2 = gamma(1 + 1 / k), gamma(1 + 2 / k)
+        self.scale = lam = self.sigma / math.sqrt(g2 - g1 * g1)
+        self.top, self.bottom = lam * g1, -math.inf
+        self.wall_exponent = k - 1
+        # Within the top 1e-6 of the weight e^-z = 1 - z + ..., z = (u/lambda)^k < 1e-6: the
+        # terms u^(k-1+jk) that no Jacobi rule in v integrates exactly weigh 1e-6 at most.
+        self.near_width = min(self.sigma / 20, lam * 1e-6 ** (1 / k))
+
+    def pdf(self, S: np.ndarray) -> np.ndarray:
+        """Density (k/lambda) (u/lambda)^(k-1) exp(-(u/lambda)^k) at depth u = S_max - S >= 0, 0 above."""
+        u = self.top - np.asarray(S, dtype=float)
+        top = self.shape / self.scale if self.shape == 1 else 0.0
+        return np.where(u > 0, self.depth_pdf(np.where(u > 0, u, 1.0)), np.where(u == 0, top, 0.0))
+
+    def depth_pdf(self, u: np.ndarray) -> np.ndarray:
+        """Density q(u) of the depth u > 0 below the highest asperity."""
+        a = u / self.scale
+        z = a ** self.shape
+        return (self.shape / self.scale) * (z / a) * np.exp(-z)
+
+    def far_rule(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Fixed depths in [b, inf) and their weights (density included).
+
+        In s = log z, z = (u/lambda)^k, the weight is e^(s - e^s) ds and the gap
+        d + lambda e^(s/k): both analytic in a strip whatever d.  One panel of 3 in s
+        over the bulk of the weight (z from 1.84 to 37), then panels of min(6, 3k),
+        i.e. at most 3 in log u, down to b; n points each.  The tail z > 37 holds
+        1e-16 of the weight and is left out.
+        """
+        k, lam = self.shape, self.scale
+        lo, step = k * math.log(self.near_width / lam), min(6.0, 3 * k)
+        edges = [math.log(37.0), math.log(37.0) - 3]
+        while edges[-1] - step > lo + step / 4:
+            edges.append(edges[-1] - step)
+        s, w = _panels([lo] + edges[::-1], n)
+        z = np.exp(s)
+        return lam * z ** (1 / k), w * z * np.exp(-z)
+
+
+def _skewness(k: float) -> float:
+    """Skewness of -W, W Weibull of shape k."""
+    g1, g2, g3 = gamma(1 + 1 / k), gamma(1 + 2 / k), gamma(1 + 3 / k)
+    return -(g3 - 3 * g1 * g2 + 2 * g1 ** 3) / (g2 - g1 * g1) ** 1.5
+
+
+class WallQuadrature:
+    """Rule for E[f(d + u)] over the depth u below the highest asperity, f ~ g^-k at g = 0.
+
+    Moving part on [0, b], b = ``dist.near_width``: u = d (e^v - 1), v in
+    [0, log(1 + b/d)], Gauss-Jacobi with weight v^beta for q ~ u^beta at the top
+    (beta = ``dist.wall_exponent``; Gauss-Legendre for beta = 0).  Fixed part on
+    [b, U]: ``dist.far_rule``.  A rule for gaps g = d + u, so it serves the
+    Lennard-Jones law and its derivative with the same accuracy.
+
+    Parameters
+    ----------
+    dist
+        Has ``near_width``, ``wall_exponent``, ``depth_pdf`` and ``far_rule``.
+    near_points, panel_points
+        Points of the moving rule and of each fixed panel.
+
+    Attributes
+    ----------
+    depths, weights
+        Depths u_l and weights of the fixed part (density included).
+    near_points, size
+        Points of the moving part, and in all, per node.
+    """
+
+    def __init__(self, dist, near_points: int = NEAR_POINTS, panel_points: int = PANEL_POINTS):
+        self.near_width, self.beta = dist.near_width, dist.wall_exponent
+        x, w = roots_jacobi(near_points, 0.0, self.beta)
+        # the rule on [0, V] is V^(1+beta) sum w_i phi(V t_i) with phi = q g / v^beta, v^beta = V^beta t^beta
+        self._t = (1 + x) / 2
+        self._w = w / 2 ** (1 + self.beta) / self._t ** self.beta
+        self._pdf = dist.depth_pdf
+        self.depths, self.weights = dist.far_rule(panel_points)
+        self.near_points, self.size = near_points, near_points + self.depths.size
+
+    def near(self, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Gaps d + u and weights of the moving part, each (len(d), near_points), for d > 0."""
+        d = d[:, None]
+        V = np.log1p(self.near_width / d)
+        v = V * self._t
+        u = d * np.expm1(v)
+        g = d + u
+        return g, self._w * V * self._pdf(u) * g
+
+
+class Measured:
+    """Measured heights, averaged through their histogram.
+
+    The heights are shifted to zero mean (S from the mean plane, as in eq. 6).  Their
+    histogram, equal bins from the lowest to the highest sample, is the density: the
+    highest measured height is the highest asperity and sets the wall, and the
+    average of the Lennard-Jones law over a piecewise-constant density is exact in
+    closed form at one term per bin edge, however many samples.  Binning moves the
+    average by O(w^2) away from the wall (w the bin width; the variance by w^2/12),
+    below the sampling error of a map; near the wall the law is that of the top
+    bins, i.e. of the few highest samples, and a spike in the data is a wall.
+
+    Parameters
+    ----------
+    heights
+        Heights in units of epsilon, any shape.
+    bins
+        Number of bins; default Freedman-Diaconis, at most :attr:`MAX_BINS`.
+    """
+
+    name = "measured"
+    MAX_BINS = 128
+
+    def __init__(self, heights: np.ndarray, bins: int | None = None):
+        S = np.asarray(heights, dtype=float).ravel()
+        _check(S, "heights")
+        S = S - S.mean()
+        self.samples = S.size
+        self.rms = self.sigma = float(np.sqrt(np.mean(S * S)))
+        self.skewness = float(np.mean(S ** 3)) / self.rms ** 3
+        self.top, self.bottom = float(S.max()), float(S.min())
+        if bins is None:
+            bins = min(np.histogram_bin_edges(S, "fd").size - 1, self.MAX_BINS)
+        if not (isinstance(bins, (int, np.integer)) and bins >= 1):
+            raise ValueError(f"bins must be an integer >= 1, got {bins}")
+        self.edges = np.linspace(self.bottom, self.top, bins + 1)
+        counts, _ = np.histogram(S, self.edges)
+        self.density = counts / (S.size * np.diff(self.edges))
+
+    def pdf(self, S: np.ndarray) -> np.ndarray:
+        """The histogram density (the top edge belongs to the top bin)."""
+        S = np.asarray(S, dtype=float)
+        j = np.clip(np.searchsorted(self.edges, S, side="right") - 1, 0, self.density.size - 1)
+        return np.where((S >= self.bottom) & (S <= self.top), self.density[j], 0.0)
+
+
+#: The distributions of -adh_roughness bounded above, by name.
+DISTRIBUTIONS = (TruncatedGaussian.name, Weibull.name, Measured.name)
+
+
+def distribution(model):
+    """The height distribution of ``model`` (its ``roughness`` one of :data:`DISTRIBUTIONS`)."""
+    if model.roughness == Measured.name:
+        return Measured(model.heights)
+    if model.roughness == Weibull.name:
+        return Weibull(model.sigma, model.roughness_skewness)
+    return TruncatedGaussian(model.sigma, model.roughness_cutoff)

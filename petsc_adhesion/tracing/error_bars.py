@@ -1,0 +1,187 @@
+"""The error of each event: the same event located on nested refinement levels of its own grid.
+
+An event was located on the grid of one segment of the curve (refinement level
+0).  The same grid design at level k has 2^k times the nodes, nested: every
+other node of level k + 1 is a node of level k.  The event is located again at
+other levels by carrying the point before it to that level's grid and tracing
+a few steps through it (:func:`relocate`), never by tracing the whole curve
+again and never across grids of different centres.  The collocation of
+eq. (11)-(12) is second order, but with the log-singular kernel on graded
+grids its error has an h^2 log h term too: X_k = X + h_k^2 (A + B log h_k) +
+...; three levels determine X, A and B, and the distance of that value from
+Richardson's (which has no B) is its error bar's scale (:func:`extrapolate`,
+calibrated by the coverage study of docs/coverage.md).
+
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..core.events import EventFinder, ParameterValue
+from ..discretization.resolution import NODES_PER_ZONE, cohesive_zone
+
+__all__ = ["relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE",
+           "MAX_LEVEL"]
+
+#: Steps a local trace may take to pass the event on another level.
+LOCAL_STEPS = 40
+#: The bar is this times the distance of the three-level value from Richardson's (docs/coverage.md:
+#: 234 of 235 quantities covered, median bar about 3 times the true error).
+BAR_FACTOR = 2.5
+#: ... and at least this times the last refinement's change: the two values can agree by accident
+#: (mu = 1, snap-on landing: 3e-9 apart, 2.4e-8 from the truth, after a change of 1e-4).  On the
+#: coverage data, 2e-4 starts to miss (4 of 235) and 3e-3 made the snap-on lambda's bars 25 times its
+#: error; 6e-4 covers as 3e-3 did with those bars 5 times the error.
+FLOOR = 6e-4
+
+
+def relocate(tracer, seg, found, level: int, target=None):
+    """The event ``found`` of segment ``seg`` located on ``seg``'s grid at refinement ``level``.
+
+    Starts from the point before the step that found it (an extremum of F, flat
+    about itself, may move on another level by more than a step's part: mu = 3,
+    sigma = 0.2, the pull-off moved back past the step's first point), carried
+    to that level, and traces with steps no longer than the step that found the
+    event until the event's test function changes sign; of several such events,
+    the one nearest in lambda.  ``target``: for a landing, the approach to find
+    (the fold's own at that level), from the step's first point.  Returns the
+    located point, or None.
+    """
+    j = found.segment if target is None else found.landing_step
+    owner = seg if target is None else next(s for s in tracer.segments if s.finder is found.landing_by)
+    a, b = owner.cont.points[j], owner.cont.points[j + 1]
+    back = owner.cont.points[j - 1] if target is None and j > 0 else a
+    event = found.event if target is None else ParameterValue(target, "landing")
+    length = max(b.ds, 1e-3) if b.ds else 0.05
+    settings = replace(tracer.set, ds=length / 2, ds_max=length, max_steps=LOCAL_STEPS, max_folds=10**6,
+                       monitor=False)
+    at = owner.grid.edge if owner.grid is not None else None
+    new = tracer.segment(owner.kind, at, level=level, settings=settings,
+                         band=owner.grid.band if owner.kind == "scaled" else None)
+    try:
+        start = _carry_start(owner, new, back)
+        if start is None:
+            return None
+        finder = EventFinder(new.cont, [event], tracer.tol or 1e-10)
+        if target is not None and (a.p - target) * (b.p - target) > 0 and abs(a.p - target) > 2 * length:
+            return None
+        behind = a.ds if back is not a and a.ds else 0.0        # an event found there may be another
+
+        def far(u, v):
+            travelled[0] += v.ds
+            return bool(finder.found) and travelled[0] > behind or travelled[0] > 4 * length + behind
+
+        travelled = [0.0]
+
+        new.cont.run(start, on_step=finder, until=far)
+        hits = [f for f in finder.found if f.label == found.label] if target is None else finder.found
+        return min(hits, key=lambda f: abs(f.point.p - found.point.p)).point if hits else None
+    finally:
+        new.destroy()
+
+
+def _carry_start(old, new, pt):
+    from .tracer import carry
+
+    return carry(old, new, pt)
+
+
+def extrapolate(values: dict) -> tuple:
+    """(best value, error bar) from values at refinement levels {level: X}, the finest three used.
+
+    With h = 2^-level, X + h^2 (A + B log h) through the three values is the
+    best value; the bar is BAR_FACTOR times its distance from Richardson's
+    R = X_2 + (X_2 - X_1) / 3 of the finest two, and at least FLOOR |X_2 - X_1|.
+    Two levels only: R with the bar |X_2 - X_1|.
+
+    >>> value, bar = extrapolate({k: 1.0 + 4.0**-k for k in (-2, -1, 0)})   # pure h^2: exact, the floor's bar
+    >>> round(value, 12), round(bar, 12)
+    (1.0, 0.0018)
+    """
+    ks = sorted(values)[-3:]
+    X = [values[k] for k in ks]
+    if len(X) == 1:
+        return X[0], float("inf")
+    R = X[-1] + (X[-1] - X[-2]) / 3
+    if len(X) == 2:
+        return R, abs(X[1] - X[0])
+    h = 2.0 ** -np.array(ks, dtype=float)
+    best = np.linalg.solve(np.column_stack([np.ones(3), h**2, h**2 * np.log(h)]), np.array(X))[0]
+    return float(best), max(BAR_FACTOR * abs(best - R), FLOOR * abs(X[2] - X[1]))
+
+
+#: The levels tried first, cheapest first, as far as they resolve the contact edge (:func:`coarse_levels`);
+#: refined ones when a coarse level fails or does not resolve, and for -target_error.
+COARSE = (-1, -2)
+#: The finest level -target_error may reach.
+MAX_LEVEL = 4
+
+
+def coarse_levels(segments) -> tuple:
+    """The levels of COARSE whose grids still resolve the cohesive zone in each of ``segments``.
+
+    A grid that follows the edge has its finest spacing h there; level -k has
+    2^k h, which must stay below zone / NODES_PER_ZONE, or the coarse levels
+    trap the edge and their values are no guide to the error (mu = 7: the best
+    value from levels -2, -1, 0 was 60 times further from the truth than the
+    grid's own).  Fixed grids are the user's choice: all of COARSE.
+    """
+    keep = len(COARSE)
+    for seg in segments:
+        if seg.grid is not None:
+            spare = cohesive_zone(seg.problem.model, seg.problem.law) / NODES_PER_ZONE / seg.grid.fine
+            if np.isfinite(spare):                  # mu = 0: no edge to resolve
+                keep = min(keep, max(0, int(np.floor(np.log2(spare) + 1e-9))))
+    return COARSE[:keep]
+
+
+def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
+    """Best values and error bars of one event's lambda and F (and its landing's F) from its levels.
+
+    Levels 0, -1, -2 by default, as far as they resolve the edge (:func:`coarse_levels`), then finer ones;
+    where a coarse level does not yield the event, 0,
+    1, 2; with ``target_error``, finer levels up to MAX_LEVEL until every bar is
+    below it (``target_met`` says whether it was).  Returns {lambda, F,
+    lambda_err, F_err, levels, target_met} and, for a fold with a landing,
+    {landing: {F, F_err, F_grid}}; {} when no other level yields the event.
+    """
+    points, landing = {0: found.point}, {0: found.landing}
+
+    def add(level: int) -> bool:
+        pt = relocate(tracer, seg, found, level)
+        if pt is None:
+            return False
+        points[level] = pt
+        if found.landing is not None:
+            landing[level] = relocate(tracer, seg, found, level, target=pt.p)
+        return True
+
+    owners = [seg] + [s for s in tracer.segments if found.landing is not None and s.finder is found.landing_by]
+    for level in coarse_levels(owners):
+        if not add(level):
+            break
+    while len(points) < 3:
+        if not add(max(points) + 1):
+            return {}
+
+    def bars():
+        out = {"lambda": extrapolate({k: p.p for k, p in points.items()}),
+               "F": extrapolate({k: p.values["F"] for k, p in points.items()})}
+        land = {k: p.values["F"] for k, p in landing.items() if p is not None}
+        if found.landing is not None and len(land) >= 2:
+            out["landing"] = extrapolate(land)
+        return out
+
+    est = bars()
+    while target_error and max(bar for _, bar in est.values()) > target_error and max(points) < MAX_LEVEL:
+        if not add(max(points) + 1):
+            break
+        est = bars()
+    out = {"lambda": est["lambda"][0], "lambda_err": est["lambda"][1], "F": est["F"][0], "F_err": est["F"][1],
+           "levels": sorted(points),
+           "target_met": not target_error or max(bar for _, bar in est.values()) <= target_error}
+    if "landing" in est:
+        out["landing"] = {"F": est["landing"][0], "F_err": est["landing"][1], "F_grid": found.landing.values["F"]}
+    return out

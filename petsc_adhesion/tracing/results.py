@@ -1,0 +1,259 @@
+"""What a traced load-approach curve means for adhesion: its events by name, the pull-off, warnings, the report.
+
+The continuation core finds folds, extrema and zeros; here they get their
+physical names:
+
+=============  ======================  =============================================
+kind           core event              meaning
+=============  ======================  =============================================
+snap_on        fold, lambda largest    jump-in on approach (displacement control)
+snap_off       fold, lambda smallest   jump-out on retraction
+F_min, F_max   extremum of F           the most tensile F_min is the load-controlled pull-off
+equilibrium    F = 0                   zero load
+lambda         lambda = target         state asked for by -cont_at_lambda
+=============  ======================  =============================================
+
+Under displacement control a point is stable when lambdadot > 0; a fold's
+landing is the state on the other stable branch at the same lambda after the
+jump (Figs. 6, 7).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from mpi4py import MPI
+
+from ..core.events import Extremum, Fold, ParameterValue, Zero
+from ..discretization import grid
+from ..model.reference.rigid import far_deflection, load_beyond
+from .tracer import contact_radius
+
+__all__ = ["curve_events", "curve", "stop_reason", "assess", "WALL_GAP", "event_record", "QUADRATURE_MARGIN", "quadrature_error", "EDGE_SHARE", "PEAK_ATTRACTION"]
+
+#: Closer than this to the wall of the roughness rule, a state is set by its smallest weights.
+WALL_GAP = 1e-3
+
+
+def curve_events(at_lambda=()) -> list:
+    """The events of a load-approach curve, in the order they are tested at every step."""
+    return [Fold(("snap_on", "snap_off")), Extremum("F", ("F_min", "F_max")), Zero("F", "equilibrium"),
+            *(ParameterValue(t, "lambda") for t in at_lambda)]
+
+
+def _H0(problem, pt) -> float:
+    """H at r = 0, on every rank (collective)."""
+    return problem.comm.tompi4py().bcast(float(pt.x[0]) if problem.lo == 0 else None, root=0)
+
+
+def _whole(problem, local: np.ndarray):
+    """The whole nodal vector on rank 0 (None elsewhere); collective."""
+    parts = problem.comm.tompi4py().gather(local, root=0)
+    return np.concatenate(parts) if parts is not None else None
+
+
+def _state(problem, pt, profiles: bool) -> dict:
+    out = {"lambda": pt.p, "F": pt.values["F"], "H0": _H0(problem, pt), "contact_radius": contact_radius(problem, pt.x)}
+    if profiles:
+        r = problem.nodes(pt.x)
+        H = _whole(problem, problem.separation(pt.x))
+        if H is not None:
+            out["r"], out["H"], out["P"] = r, H, problem.law(H)[0]
+    return out
+
+
+def event_record(problem, found, profiles: bool) -> dict:
+    """One event as the result files hold it (collective: H0 and profiles gather).
+
+    With an error estimate, ``lambda`` and ``F`` are the best values, ``*_err``
+    their bars and ``*_grid`` the values on the grid it was located on.  A lambda
+    asked for is exact, so is F = 0 at an equilibrium.  The half-infinite model
+    adds the rigid sphere's attraction beyond r_m to F (``F_beyond``); its
+    remainder, the deflection that attraction causes inside, enters both bars
+    (:func:`~petsc_adhesion.model.reference.far_deflection`).
+    """
+    ev = {"kind": found.label, **_state(problem, found.point, profiles), "segment": found.segment}
+    if not isinstance(found.event, Fold):          # at a fold lambdadot = 0: marginal
+        ev["stable"] = bool(problem.stable(found.point))
+    if found.landing is not None:
+        ev["landing"] = _state(found.landing_by.cont.pb, found.landing, profiles)
+    est = getattr(found, "estimate", None)
+    if est is None:
+        return ev
+    if not est:
+        ev["error_note"] = "no error bar: the event was not found again on the coarser and finer levels"
+        return ev
+    model = problem.model
+    rm = float(problem.nodes(found.point.x)[-1])
+    far = far_deflection(rm, model.coupling) if model.farfield else 0.0
+    ev |= {"lambda_grid": ev["lambda"], "F_grid": ev["F"], "levels": est["levels"], "target_met": est["target_met"],
+           "F_beyond": float(load_beyond(rm, ev["lambda"])) if model.farfield else 0.0}
+    beyond = far + quadrature_error(problem, found.point)
+    if found.label == "lambda":
+        ev |= {"F": est["F"], "F_err": est["F_err"] + beyond, "lambda_err": 0.0}
+    elif found.label == "equilibrium":
+        ev |= {"lambda": est["lambda"], "lambda_err": est["lambda_err"] + beyond, "F": 0.0, "F_err": 0.0}
+    else:
+        ev |= {"lambda": est["lambda"], "lambda_err": est["lambda_err"] + beyond, "F": est["F"],
+               "F_err": est["F_err"] + beyond}
+    if "landing" in ev and "landing" in est:
+        land = est["landing"]
+        ev["landing"] |= {"lambda": ev["lambda"], "F": land["F"], "F_err": land["F_err"] + beyond,
+                          "F_grid": land["F_grid"]}
+    return ev
+
+
+#: The load of the quadrature error, times this, bounds its effect on results (tests/test_roughness_models.py).
+QUADRATURE_MARGIN = 3.0
+
+
+def quadrature_error(problem, pt) -> float:
+    """The part of an event's error bars due to the roughness quadrature (collective).
+
+    The load of the pressure's quadrature error e(r) = |P - P_ref| at the event's
+    state, (8/3) integral e r dr (eq. 26), is the first-order change of F at fixed
+    H; the elastic response and, at a fold, the conversion into lambda change it
+    by a factor of order one, which QUADRATURE_MARGIN covers (measured: bars 1.2 to
+    20 times the error at 3 and 6 points, up to 1000 at 12, where both are tiny).
+    Zero for the smooth law, the Hermite rule (which is the model) and a histogram
+    (exact but for rounding).
+    """
+    H = _whole(problem, problem.separation(pt.x))
+    r = problem.nodes(pt.x)
+    load = 0.0 if H is None else 8.0 / 3.0 * float(grid.load_weights(r) @ problem.law.error(H))
+    return QUADRATURE_MARGIN * problem.comm.tompi4py().bcast(load)
+
+
+def stop_reason(stop, settings) -> str:
+    """Why the continuation stopped, in the options' words."""
+    reason, value = stop
+    if reason == "ds_min":
+        where = "a turning point (natural continuation cannot pass it)" \
+            if settings.corrector == "natural" else "a point it cannot pass"
+        return f"step below -cont_ds_min at lambda = {value:.6g}: {where}"
+    return {"observable_max": f"load F = {value:.4g} >= -cont_F_max {settings.observable_max:g}",
+            "p_max": f"approach lambda = {value:.4g} >= -cont_lambda_max {settings.p_max:g}",
+            "p_min": f"approach lambda = {value:.4g} <= {settings.p_min:g}",
+            "max_steps": f"-cont_max_steps {value} reached",
+            "max_folds": f"more than -cont_max_folds {value} turning points"}[reason]
+
+
+def _current(segments, seg) -> list:
+    """``seg``'s points but, when another segment follows, its last: that is the next one's first,
+    solved again on the grid the curve moved to, and the two differ by the grids' errors."""
+    return seg.cont.points if seg is segments[-1] else seg.cont.points[:-1]
+
+
+def curve(segments, profiles: bool = False) -> dict:
+    """The traced curve (its segments, in order) with its events as dicts and the pull-off.
+
+    Collective.  ``profiles`` (rank 0, else empty): the nodes and the pressure of
+    every point, for the resolution check.
+    """
+    events = [event_record(seg.problem, f, profiles) for seg in segments for f in seg.finder.found]
+    pts = [p for seg in segments for p in seg.cont.points]
+    states = []
+    for seg in segments:
+        pb = seg.problem
+        for p in _current(segments, seg):
+            r, H = pb.nodes(p.x), _whole(pb, pb.separation(p.x))
+            if H is not None:
+                states.append((r, H, pb.law(H)[0]))
+    mins = [e for e in events if e["kind"] == "F_min"]
+    last = segments[-1].cont
+    lowest = min(float(seg.problem.separation(p.x).min()) for seg in segments for p in seg.cont.points)
+    return {"points": pts, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
+            "wall_gap": segments[-1].problem.comm.tompi4py().allreduce(lowest, op=MPI.MIN) - segments[-1].problem.law.wall,
+            "steps": sum(len(seg.cont.points) - 1 for seg in segments),
+            "rejected_steps": sum(seg.cont.rejected for seg in segments),
+            "folds": sum(seg.cont.folds for seg in segments), "regrids": len(segments) - 1,
+            "guard_activations": sum(seg.problem.guarded for seg in segments),
+            "smallest_step": min((p.ds for p in pts if p.ds > 0), default=0.0),
+            "most_newton_its": max(p.newton_its for p in pts), "most_ksp_its": max(p.ksp_its for p in pts),
+            "stop": last.stop, "stop_reason": stop_reason(last.stop, last.set), "states": states,
+            "grid": segments[-1].problem.nodes(segments[-1].cont.points[-1].x),
+            "grids": {"lambda": np.array([seg.cont.points[0].p for seg in segments]),
+                      "n_nodes": np.array([seg.problem.layout.N for seg in segments]),
+                      **({"edge": np.array([seg.grid.edge for seg in segments])}
+                         if all(seg.grid is not None for seg in segments) else {})}}
+
+
+#: The contact reaches the end of the domain when |P(r_m)| exceeds this share of the peak attraction.
+EDGE_SHARE = 1e-3
+#: The peak of the Lennard-Jones attraction, |P| at H + 1 = 3^(1/6) (units 8 gamma / (3 epsilon)).
+PEAK_ATTRACTION = 2.0 / (3.0 * 3.0 ** 0.5)
+
+
+def _missed_minimum(segments) -> str:
+    """Why the located pull-off may not be the most tensile load of the curve, or "".
+
+    A discrete minimum F[k-1] > F[k] < F[k+1] of a grid segment, more tensile than
+    every located minimum, must lie next to a located minimum (on step k-1 or k)
+    no higher than itself; a step that passes a shallow minimum and maximum of
+    the load elsewhere (a wiggle of the unstable branch) does not matter here.
+    Within one grid: the grids of two segments differ by their discretization errors.
+    """
+    found = [(seg, f) for seg in segments for f in seg.finder.found if f.label == "F_min"]
+    pull_off = min((f.point.values["F"] for _, f in found), default=math.inf)
+    for seg in segments:
+        F = [p.values["F"] for p in _current(segments, seg)]
+        located = {f.segment: f.point.values["F"] for s, f in found if s is seg}
+        for k in range(1, len(F) - 1):
+            if not F[k - 1] > F[k] < F[k + 1] or F[k] >= pull_off:
+                continue
+            near = [located[j] for j in (k - 1, k) if j in located]
+            if not near:
+                return f"a computed point (F = {F[k]:.6g}) is a load minimum more tensile than the located " \
+                       f"pull-off ({pull_off:.6g})"
+            if min(near) > F[k] + 1e-9:
+                return f"a computed point (F = {F[k]:.6g}) is more tensile than the load minimum located " \
+                       f"next to it ({min(near):.6g})"
+    return ""
+
+
+def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
+    """What makes a traced curve untrustworthy, one line each: (warnings, the subset that makes it
+    not what was asked for: exit status 3).  Collective."""
+    warn, short = [], []
+    problem = segments[-1].problem
+    law, pts, gap, mpi = problem.law, res["points"], res["wall_gap"], problem.comm.tompi4py()
+    if law.rule == "hermite" and gap < WALL_GAP:
+        warn.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
+                    f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
+                    f"the loads there are properties of the rule and ill-conditioned; use fewer points")
+    if res["stop"][0] in ("ds_min", "max_steps", "max_folds"):
+        short.append(f"the curve ended early: {res['stop_reason']}")
+    if res["grid_warning"]:
+        short.append(res["grid_warning"])
+    missed_min = "" if res["grid_warning"] else _missed_minimum(segments)
+    if missed_min:
+        short.append(f"{missed_min}: the load varies faster than the steps resolve; lower -cont_dF_max or -cont_ds_max")
+    if pts[0].values["F"] > 0:
+        short.append(f"the curve starts in contact (F = {pts[0].values['F']:.3g} > 0 at lambda = {pts[0].p:g}): "
+                     f"the approach and its events lie before it; give -cont_lambda_start further apart")
+    missed = [e for e in res["events"] if e.get("target_met") is False]
+    if missed:
+        e = max(missed, key=lambda e: max(e.get("lambda_err", 0), e.get("F_err", 0)))
+        short.append(f"-target_error not reached for {len(missed)} event(s): {e['kind']} at lambda = {e['lambda']:.6g} "
+                     f"has lambda +- {e.get('lambda_err', 0):.1e}, F +- {e.get('F_err', 0):.1e} on levels up to "
+                     f"{max(e['levels'])}, the finest tried")
+    found = [e["lambda"] for e in res["events"] if e["kind"] == "lambda"]
+    for t in at_lambda:
+        if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):
+            short.append(f"-cont_at_lambda {t:g} not reached: the curve spans lambda in "
+                         f"[{min(p.p for p in pts):.4g}, {max(p.p for p in pts):.4g}]")
+    edge = 0.0
+    for seg in segments:
+        last = seg.problem.hi == seg.problem.layout.N
+        for p in seg.cont.points:
+            H = seg.problem.separation(p.x)           # collective in the frame of the edge: on every rank
+            if last:
+                edge = max(edge, abs(float(law(H[-1:])[0][0])))
+    edge = mpi.allreduce(edge, op=MPI.MAX)
+    rm = float(problem.nodes(pts[-1].x)[-1])         # in the frame of the edge r_m moves with the contact radius
+    if edge > EDGE_SHARE * PEAK_ATTRACTION:
+        short.append(f"the contact reaches the end of the domain r_m = {rm:g} (|P(r_m)| up to "
+                     f"{edge:.2g}): give a larger -adh_rmax")
+    return warn + short, short
+
+

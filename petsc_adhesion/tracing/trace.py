@@ -1,0 +1,367 @@
+"""The library's two calls: the load-approach curve of a model, and the state at one fixed approach.
+
+    from petsc_adhesion import Model, GridChoice, trace_curve, solve_at
+    c = trace_curve(Model(mu=1.0))                          # grids that follow the contact edge, error bars
+    print(c.pull_off.F, "+-", c.pull_off.F_err)
+    s = solve_at(-2.0, Model(mu=1.0), GridChoice("uniform", n=201))
+
+Each takes plain typed objects: the :class:`~petsc_adhesion.model.parameters.Model`
+(mu, sigma, roughness, r_m, the far field, the physical inputs), a
+:class:`GridChoice`, a :class:`SolverChoice` (the matrix handed to the
+preconditioner), the continuation's :class:`~petsc_adhesion.core.continuation.Settings`
+(step control and stops; :func:`curve_settings` gives a curve's) and a
+:class:`CurveRequest` (what the curve reports).  PETSc's own options reach each
+solver through its prefix (``nat_``, ``arc_``, none for the fixed-approach
+solve) from the options database, as PETSc's objects read them; the command
+line and the Python API (:mod:`petsc_adhesion.app`) are thin layers that read
+their options into these objects and call these two functions.
+
+Collective: under MPI every rank calls them with the same arguments and gets
+the same result.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .. import brent
+from ..core.continuation import Continuation, Settings
+from ..core.events import EVENT_TOL, jumps
+from ..core.newton import PC_REUSE_ITS, Newton
+from ..discretization import grid, preconditioning, resolution
+from ..discretization.influence import create_influence
+from ..discretization.problem import Problem, far_approach
+from ..model.reference.jkr import jkr_approach, jkr_load
+from . import error_bars, results
+from .curve import Curve, Solution, model_record, program_record
+from .edge_grids import RMAX, grid_for
+from .tracer import Tracer
+
+__all__ = ["GridChoice", "SolverChoice", "CurveRequest", "curve_settings", "trace_curve", "solve_at", "rigid_edge",
+           "discretize", "configure_solvers", "expected_end", "F_MAX", "GRID_KINDS"]
+
+#: The load at which a curve stops by default: past equilibrium, into compression.
+F_MAX = 2.0
+#: The node sets of :class:`GridChoice`.
+GRID_KINDS = ("edge", "paper", "uniform", "given")
+
+
+@dataclass(frozen=True)
+class GridChoice:
+    """The collocation grid: ``edge`` (graded about the contact edge and following it along the curve, out to
+    r_m = 150 by default), ``paper`` (the paper's N = 531 on r_m = 10: uniform nodes with refined elements,
+    :func:`~petsc_adhesion.discretization.grid.paper`), ``uniform`` (``n`` nodes) or ``given`` (the nodes ``r``,
+    r_m their last)."""
+
+    kind: str = "edge"
+    n: int = grid.PAPER_UNIFORM + grid.PAPER_EXTRA
+    paper_uniform: int = grid.PAPER_UNIFORM
+    paper_extra: int = grid.PAPER_EXTRA
+    paper_split: int = grid.PAPER_SPLIT
+    paper_refine_from: float = 0.0
+    r: np.ndarray | None = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self):
+        if self.kind not in GRID_KINDS:
+            raise ValueError(f"grid kind '{self.kind}': expected one of {', '.join(GRID_KINDS)}")
+        if (self.kind == "given") != (self.r is not None):
+            raise ValueError("grid kind 'given' takes its nodes r, and only it")
+
+    @property
+    def default_rmax(self) -> float:
+        """r_m when the model leaves it to the grid: 150 for grids that follow the edge, 10 (the paper's) else."""
+        if self.kind == "given":
+            return float(self.r[-1])
+        return RMAX if self.kind == "edge" else grid.PAPER_RMAX
+
+    def nodes(self, rmax: float) -> np.ndarray | None:
+        """The nodes on [0, rmax]; None for grids that follow the contact edge (made along the curve)."""
+        if self.kind == "edge":
+            return None
+        if self.kind == "uniform":
+            return grid.uniform(self.n, rmax)
+        if self.kind == "given":
+            return np.asarray(self.r, dtype=float)
+        return grid.paper(rmax, self.paper_uniform, self.paper_extra, self.paper_refine_from, self.paper_split)
+
+
+@dataclass(frozen=True)
+class SolverChoice:
+    """What the preconditioner of every solver is built from (``pmat``: dense, band or shell,
+    :mod:`~petsc_adhesion.discretization.preconditioning`; ``band``: the half bandwidth of band) and how long a
+    preconditioner is kept (``pc_reuse_its``: while Krylov needs at most that many iterations)."""
+
+    pmat: str = "dense"
+    band: int = preconditioning.BAND
+    pc_reuse_its: int = PC_REUSE_ITS
+
+    def strategy(self):
+        """A fresh preconditioning strategy of this kind."""
+        return preconditioning.create(self.pmat, self.band)
+
+
+@dataclass(frozen=True)
+class CurveRequest:
+    """What a curve reports.
+
+    ``lambda_start``: the first approach (None: out of reach of the forces,
+    :func:`~petsc_adhesion.discretization.problem.far_approach`); ``at_lambda``: approaches at which to
+    record the state; ``event_tol``: the location tolerance of events in lambda; ``error_bars``: every event
+    located again on nested levels of its grid for its best value and bar, refined to ``target_error`` when
+    given; ``profiles``: H(r) and P(r) at every event; ``kinds``: the event kinds reported (None: all; the
+    others are left out, unestimated).
+    """
+
+    lambda_start: float | None = None
+    at_lambda: tuple = ()
+    event_tol: float = EVENT_TOL
+    error_bars: bool = True
+    target_error: float | None = None
+    profiles: bool = False
+    kinds: tuple | None = None
+
+
+def curve_settings(**changes) -> Settings:
+    """The continuation settings of a load-approach curve: the load F watched, stopping at F_MAX."""
+    return Settings(**{"observable": "F", "observable_max": F_MAX, **changes})
+
+
+def rigid_edge(lam: float) -> float:
+    """The contact edge of the rigid sphere at approach lam: the peak attraction, gap 3^(1/6) epsilon."""
+    return float(np.sqrt(2.0 * max(0.0, lam + 3.0 ** (1.0 / 6.0) - 1.0)))
+
+
+def discretize(model, r: np.ndarray, pmat=None, comm=None) -> Problem:
+    """The problem on grid r: influence matrix (eq. 4, 12), pressure law, preconditioning strategy."""
+    from petsc4py import PETSc
+
+    return Problem(model, r, create_influence(r, comm or PETSc.COMM_WORLD), pmat)
+
+
+def _init() -> None:
+    """PETSc, on a library call from a process that has not started it (the options of the caller's argv
+    are not read: a program reading them calls petsc4py.init itself first)."""
+    import sys
+
+    if "petsc4py.PETSc" not in sys.modules:
+        import petsc4py
+
+        petsc4py.init([sys.argv[0] if sys.argv and sys.argv[0] else "petsc_adhesion"])
+
+
+def _domain(model, grid_choice: GridChoice):
+    """``model`` with its r_m: its own, or the grid's default."""
+    return model if model.rmax is not None else replace(model, rmax=grid_choice.default_rmax)
+
+
+def configure_solvers(model, grid_choice: GridChoice = GridChoice(), solver: SolverChoice = SolverChoice(),
+                      settings: Settings | None = None, lam: float | None = None, comm=None) -> None:
+    """Make the solvers of a curve (or, at a fixed approach ``lam``, of the solve) and free them again: each
+    reads its options, and with -help prints those it reads."""
+    _init()
+    from petsc4py import PETSc
+
+    model = _domain(model, grid_choice)
+    r = grid_choice.nodes(model.rmax)
+    if r is None:
+        r = grid_for(model, 0.0 if lam is None else rigid_edge(lam), rmax=model.rmax).nodes()
+    problem = discretize(model, r, solver.strategy(), comm or PETSc.COMM_WORLD)
+    try:
+        if lam is None:
+            Continuation(problem, settings or curve_settings()).destroy()
+        else:
+            Newton(problem, "", pc_reuse_its=solver.pc_reuse_its).destroy()
+    finally:
+        problem.destroy()
+
+
+def _head(comm, model, grid_record: dict) -> dict:
+    """The program, model, grid and physical inputs of a result."""
+    head = {**program_record(comm), "model": model_record(model), "grid": grid_record}
+    if model.bodies is not None:
+        head["physical"] = model.bodies.describe()
+    return head
+
+
+def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverChoice = SolverChoice(),
+                settings: Settings | None = None, request: CurveRequest = CurveRequest(), comm=None,
+                checkpoint=None, progress=None, started=None) -> Curve:
+    """The load-approach curve of ``model``: every event with its best value, error bar and landing, the
+    pull-off, the resolution check and the warnings (collective).
+
+    Parameters
+    ----------
+    model : Model
+        Its ``rmax`` is the end of the domain (:attr:`GridChoice.default_rmax` when the caller takes the grid's).
+    grid_choice, solver, request
+        The grid, the preconditioning, what the curve reports.
+    settings : Settings
+        Step control and stops (default :func:`curve_settings`).
+    comm : petsc4py.PETSc.Comm
+        The communicator of every object (PETSc.COMM_WORLD by default): a study runs cases on parts of it.
+    checkpoint
+        Saves the run as it goes and restores the state it holds first: ``restore(tracer)`` returns
+        (phase, seconds spent by phase) or None, ``pause(tracer, phase, seconds)`` is called where the
+        state is whole (:class:`~petsc_adhesion.app.checkpoint.Checkpoint`).
+    progress
+        Says how far the run is: ``due()``, ``update(fraction, text)``, ``line(text)``, ``reset()``
+        (:class:`~petsc_adhesion.app.progress.Progress`).
+    started
+        Called once the first point and its tangent are computed (the solvers have then read their options).
+
+    Raises RuntimeError when the curve cannot start; a curve that ends early is returned with its warnings
+    (``complete`` False).
+    """
+    _init()
+    from petsc4py import PETSc
+
+    comm = comm or PETSc.COMM_WORLD
+    model = _domain(model, grid_choice)
+    settings = settings or curve_settings()
+    lam0 = far_approach(model) if request.lambda_start is None else request.lambda_start
+    nodes = grid_choice.nodes(model.rmax)
+    t0 = t1 = time.perf_counter()
+    tracer = Tracer(model, settings, results.curve_events(request.at_lambda), request.event_tol, nodes=nodes,
+                    pmat=solver.strategy(), rmax=model.rmax, comm=comm)
+    kinds = request.kinds
+    kept = (lambda label: True) if kinds is None else (lambda label: label in kinds or label == "lambda")
+    try:
+        restored = checkpoint.restore(tracer) if checkpoint is not None else None
+        phase, spent = restored or ("trace", {"trace": 0.0, "errors": 0.0})
+        bars = []
+        if restored and progress is not None:
+            progress.line(f"going on from the checkpoint {checkpoint.name} at lambda "
+                          f"{tracer.segments[-1].cont.points[-1].p:.6g}"
+                          + (", to its error bars" if phase == "errors" else ""))
+        end = expected_end(model, settings)
+
+        def pause(tr, stage: str = "trace") -> None:
+            """Where the state is whole: a checkpoint may be saved, progress said."""
+            walls = {**spent, stage: spent[stage] + time.perf_counter() - (t0 if stage == "trace" else t1)}
+            if checkpoint is not None:
+                checkpoint.pause(tr, stage, walls)
+            if progress is not None and progress.due():
+                done = sum(f.estimate is not None for _, f in bars)
+                progress.update(*(_status(tr, lam0, end) if stage == "trace" else
+                                  (done / len(bars), f"error bars: {done} of {len(bars)} events done")))
+
+        if phase == "trace":
+            segments = tracer.run(lam0, started, pause)
+            jumps([seg.finder for seg in segments], Problem.stable)
+            spent["trace"] += time.perf_counter() - t0
+        else:
+            segments = tracer.segments
+            if started:
+                started()
+        wall = spent["trace"]
+        if request.error_bars:
+            t1 = time.perf_counter()
+            bars = [(seg, f) for seg in segments for f in seg.finder.found if kept(f.label)]
+            if progress is not None:
+                progress.reset()
+            for seg, found in bars:
+                pause(tracer, "errors")
+                if found.estimate is None:
+                    found.estimate = error_bars.event_errors(tracer, seg, found, request.target_error)
+            errors_wall = spent["errors"] + time.perf_counter() - t1
+        res = results.curve(segments, request.profiles)
+        mpi = comm.tompi4py()
+        states = res.pop("states")
+        law = tracer.segments[0].problem.law
+        res["grid_warning"] = mpi.bcast(resolution.check(model, law, states, res["folds"])
+                                        if mpi.Get_rank() == 0 else None)
+        res["warnings"], res["incomplete"] = results.assess(segments, res, request.at_lambda)
+    finally:
+        tracer.destroy()
+    res["events"] = [e for e in res["events"] if kept(e["kind"])]
+    if not kept("F_min"):
+        res["pull_off"] = None
+    res |= {"wall_time_s": wall, "lambda_start": lam0}
+    if request.error_bars:
+        res["error_estimate"] = {"wall_time_s": errors_wall, "target_error": request.target_error,
+                                 "levels": sorted({k for e in res["events"] for k in e.get("levels", ())})}
+    head = _head(comm, model, {"r": res["grid"], **res["grids"]})
+    return mpi.bcast(Curve.from_result(res, head) if mpi.Get_rank() == 0 else None, root=0)
+
+
+def solve_at(lam: float, model, grid_choice: GridChoice = GridChoice(), solver: SolverChoice = SolverChoice(),
+             guess: tuple | None = None, comm=None, started=None) -> Solution:
+    """The state at the one approach ``lam`` (eq. 12 by Newton, the solver without options prefix; collective).
+
+    The grid that follows the contact edge is centred on the rigid sphere's edge at ``lam``.  ``guess``:
+    (r, H) of an earlier state, interpolated as the initial guess (its deformation H - r^2/2 linearly); the
+    rigid state of eq. (27) by default.  ``started``: called once the solver has read its options.
+    RuntimeError when Newton does not converge.
+    """
+    _init()
+    from petsc4py import PETSc
+
+    comm = comm or PETSc.COMM_WORLD
+    model = _domain(model, grid_choice)
+    r = grid_choice.nodes(model.rmax)
+    r = grid_for(model, rigid_edge(lam), rmax=model.rmax).nodes() if r is None else r
+    problem, newton, H = discretize(model, r, solver.strategy(), comm), None, None
+    try:                    # on failure too: the shell's context holds a cycle that gc cannot free
+        newton = Newton(problem, "", pc_reuse_its=solver.pc_reuse_its)
+        H = problem.rigid(lam, problem.create_vec())
+        if guess is not None:
+            r0, h0 = guess
+            H.setArray(np.interp(r[problem.lo:problem.hi], r0, h0))
+        t0 = time.perf_counter()
+        ok = newton.solve(lam, H)
+        wall = time.perf_counter() - t0
+        if started:
+            started()
+        if not ok:
+            raise RuntimeError(f"Newton did not converge at lambda = {lam:g} "
+                               f"(reason {newton.snes.getConvergedReason()}); try -adh_guess or -snes_monitor")
+        pressure, _ = problem.pressure(H)
+        Hall = problem.gather(H.getArray(readonly=True))
+        its, kits = newton.iterations
+        res = {"lambda": lam, "F": problem.load(H, lam), "F_beyond": problem.far_load(lam), "H0": float(Hall[0]),
+               "H": Hall, "P": problem.gather(pressure), "snes_iterations": its, "ksp_iterations": kits,
+               "wall_time_s": wall}
+    finally:
+        for obj in (H, newton, problem):
+            if obj is not None:
+                obj.destroy()
+    return Solution.from_result(res, _head(comm, model, {"r": r}))
+
+
+def expected_end(model, settings) -> float:
+    """Where a curve is expected to stop in lambda, for its progress lines: ``settings.p_max`` (-cont_lambda_max), or sooner
+    where JKR's load (Johnson, Kendall & Roberts 1971) on its stable branch reaches the stop load
+    ``settings.observable_max`` (-cont_F_max; at JKR's pull-off when that is below it); 0 for a rigid
+    sphere (mu = 0), whose load rises steeply at contact.
+
+    The fraction of a curve done is lambda's progress from the start towards this: rough,
+    since the steps crowd where the contact forms and about the turning points (where
+    lambda turns back and the fraction stands still), and JKR's stop misses a rough
+    surface's; the time left it gives is a guide to its order of magnitude, too low on the
+    approach and steadier past the snap-on.
+    """
+    end = 0.0
+    if model.mu > 0 and math.isfinite(settings.observable_max):
+        pull = (9.0 * math.pi / 8.0) ** (1.0 / 3.0) * math.sqrt(model.mu)     # JKR's least load
+        hi = 2.0 * pull
+        while jkr_load(hi, model.mu) < settings.observable_max:
+            hi *= 2.0
+        A = pull if settings.observable_max <= jkr_load(pull, model.mu) else \
+            brent.root(lambda a: jkr_load(a, model.mu) - settings.observable_max, pull, hi)
+        end = float(jkr_approach(A, model.mu))
+    return min(end, settings.p_max)
+
+
+def _status(tracer, lam0: float, end: float) -> tuple[float, str]:
+    """(fraction done, text) of a curve being traced from ``lam0`` towards ``end``: the furthest lambda
+    reached, the steps and the events so far."""
+    segments = tracer.segments
+    reached = max(p.p for seg in segments for p in seg.cont.points)
+    steps = sum(len(seg.cont.points) - 1 for seg in segments)
+    events = sum(len(seg.finder.found) for seg in segments)
+    done = (reached - lam0) / (end - lam0) if end > lam0 else 0.0
+    return min(max(done, 0.0), 0.99), (f"lambda {reached:.4g} (the curve should stop near {end:.3g}), "
+                                       f"{steps} steps, {events} event{'s' * (events != 1)}")

@@ -1,0 +1,286 @@
+"""The load-approach curve on grids that follow the contact edge (the default grid).
+
+At large mu the cohesive zone at the contact edge is about 0.75 mu^-1.5 wide
+and needs several nodes across it, but only where the edge is, and the edge
+travels from r = 0 outward along the curve (to about 2.4 mu^0.5 at zero
+load, further under compression).  The curve is traced in segments, each on
+one grid, of two kinds:
+
+* ``edge``: the physical frame, an :class:`~petsc_adhesion.discretization.grid.EdgeGrid`
+  centred on the edge (fine, zone / NODES_PER_ZONE and at most
+  CONTACT_SPACING, within BAND of it; graded beyond; geometric out to RMAX,
+  where the attraction left out carries |F| < 1e-8).  A new segment when the
+  edge has travelled more than ``travel`` from the grid's centre.
+* ``scaled``: once a sharp edge (zone / NODES_PER_ZONE < CONTACT_SPACING)
+  has formed a contact of radius A_SWITCH,
+  the frame of the edge (:mod:`petsc_adhesion.discretization.edge_frame`): the grid in rho = r/a
+  follows the contact radius a by itself, and a new segment is needed only
+  when a has changed by the factor GROW.
+
+A point is carried to the next segment's grid by interpolating its
+deformation H - r^2/2 and a zero-length arclength correction there (regular
+at folds).  Events are located within a segment, on one discrete problem,
+never across a change of grid: a change waits while any event's test
+function has a different sign on the two grids at the carried point (it is
+close to an event), unless the old grid no longer resolves the edge.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from mpi4py import MPI
+
+from ..core.continuation import Continuation, Settings
+from ..core.events import EventFinder
+from ..discretization import grid
+from ..discretization.edge_frame import EdgeFrameProblem, edge_level
+from ..discretization.influence import create_influence
+from ..discretization.problem import Problem
+from .edge_grids import (
+    A_SWITCH,
+    BAND,
+    GROW,
+    REACH,
+    RMAX,
+    _zone,
+    grid_for,
+    scaled_band,
+    scaled_grid_for,
+    sharp,
+)
+
+__all__ = ["edge_of", "contact_radius", "Segment", "Tracer", "carry"]
+
+
+def edge_of(problem, x: np.ndarray) -> float:
+    """The contact edge of a state: the radius of peak attraction (most negative P); collective."""
+    pressure, _ = problem.law(problem.separation(x))
+    k = int(np.argmin(pressure))
+    best = (float(pressure[k]), float(problem.nodes(x)[problem.lo + k]))
+    return problem.comm.tompi4py().allreduce(best, op=MPI.MIN)[1]
+
+
+def contact_radius(problem, x: np.ndarray) -> float:
+    """Where H first rises through the edge level from the centre (0 when H(0) is above it); collective."""
+    r, H = problem.nodes(x), problem.gather(problem.separation(x))
+    level = edge_level(problem.law)
+    if H[0] >= level:
+        return 0.0
+    k = int(np.argmax(H >= level))
+    return float(r[k - 1] + (level - H[k - 1]) / (H[k] - H[k - 1]) * (r[k] - r[k - 1]))
+
+
+@dataclass
+class Segment:
+    """A stretch of the curve on one grid: its problem, continuation and events."""
+
+    kind: str             # "fixed", "edge" or "scaled"
+    grid: object          # the EdgeGrid (None for a fixed grid)
+    problem: object
+    cont: Continuation
+    finder: EventFinder
+
+    def destroy(self) -> None:
+        """Free the segment's PETSc objects."""
+        self.cont.destroy()
+        self.problem.destroy()
+
+
+def _carry(old, new, x: np.ndarray, scale: float, xdot: np.ndarray | None = None) -> np.ndarray:
+    """The state x of ``old`` (or, with ``xdot``, its tangent's nodal part) on ``new``'s local nodes,
+    ``new``'s nodes taken at contact radius ``scale`` if it is in the frame of the edge.
+
+    H grows like r^2/2 (eq. 27): its deformation D = H - r^2/2 is interpolated
+    instead, since the far grid's spacing h would cost the quadratic h^2/8, and
+    is what the frame of the edge takes as its unknown.  A tangent carries over
+    linearly: its nodal part (dH/ds, or dD/ds in the frame of the edge).
+    """
+    r_old = old.nodes(x)
+    scaled = isinstance(new, EdgeFrameProblem)
+    r_new = (scale * new.rho if scaled else new.r)[new.lo:new.hi]
+    if xdot is not None:
+        return np.interp(r_new, r_old, old.gather(xdot[:old.hi - old.lo]))
+    field = old.gather(old.separation(x) - 0.5 * r_old[old.lo:old.hi] ** 2)
+    return np.interp(r_new, r_old, field) + (0.0 if scaled else 0.5 * r_new * r_new)
+
+
+def carry(old: Segment, new: Segment, pt, scale: float | None = None):
+    """The point ``pt`` of ``old``'s curve put on ``new``'s: interpolated, then a zero-length arclength
+    correction there (regular at folds), its tangent oriented like pt's; None when that fails.
+
+    ``scale``: the contact radius to start from in the frame of the edge (default: pt's own,
+    or where its H rises through the edge level).
+    """
+    src, dst = old.problem, new.problem
+    scaled = isinstance(dst, EdgeFrameProblem)
+    if scaled and scale is None:
+        scale = src.radius(pt.x) if isinstance(src, EdgeFrameProblem) else contact_radius(src, pt.x)
+    shaped, slope = _carry(src, dst, pt.x, scale), _carry(src, dst, pt.x, scale, pt.xdot)
+    if scaled and dst.last:
+        adot = src.radius(pt.xdot) if isinstance(src, EdgeFrameProblem) else 0.0
+        shaped, slope = np.append(shaped, scale), np.append(slope, adot)
+    elif scaled:
+        src.radius(pt.xdot) if isinstance(src, EdgeFrameProblem) else None   # collective
+    x = dst.create_vec()
+    x.setArray(shaped)
+    out = new.cont.project(x, pt.p, slope, pt.pdot)
+    x.destroy()
+    return out
+
+
+class _Regrid:
+    """The ``until`` criterion of a segment: the edge has travelled; the next segment, ready."""
+
+    def __init__(self, tracer, seg: Segment):
+        self.tracer, self.seg, self.next = tracer, seg, None
+        zone = _zone(seg.problem.model)
+        self.travel = min(BAND / 2 + zone, REACH / 3)
+        self.forced = min(BAND + 2 * zone, 2 * REACH / 3)
+
+    def target(self, b) -> tuple | None:
+        """(kind, where, forced) of the next segment, or None to stay."""
+        seg, tr = self.seg, self.tracer
+        edge = edge_of(seg.problem, b.x)
+        if seg.kind == "scaled":
+            a = seg.problem.radius(b.x)
+            ratio = a / seg.grid.edge
+            return None if 1 / GROW <= ratio <= GROW else ("scaled", a, not 1 / GROW**2 <= ratio <= GROW**2, edge)
+        # a contact, and the peak attraction off the centre (a rough centre may still attract most)
+        a = contact_radius(seg.problem, b.x)
+        if tr.sharp and min(edge, a) >= A_SWITCH:
+            return "scaled", a, False, edge
+        moved = abs(edge - seg.grid.edge)
+        return None if moved <= self.travel else ("edge", edge, moved > self.forced, edge)
+
+    def __call__(self, a, b) -> bool:
+        where = self.target(b)
+        if where is None:
+            return False
+        kind, at, forced, peak = where
+        band = scaled_band(self.seg.problem.model, at, peak) if kind == "scaled" else None
+        new = self.tracer.segment(kind, at, self.seg, band=band)
+        try:
+            pt = carry(self.seg, new, b, at if kind == "scaled" else None)
+        except BaseException:           # a failed carry: the new segment is no one's
+            new.destroy()
+            raise
+        same = pt is not None and all(np.sign(ev.test(b)) == np.sign(ev.test(pt)) != 0
+                                      for ev in self.tracer.events)
+        if same or (pt is not None and forced):
+            self.next = (new, pt)
+            return True
+        new.destroy()
+        if forced:
+            raise RuntimeError(f"cannot carry the curve to a new grid at lambda = {b.p:.6g}")
+        return False
+
+
+class Tracer:
+    """Trace a curve in segments: on a fixed grid (one segment), or on grids that follow the edge."""
+
+    def __init__(self, model, settings: Settings, events, tol=None, nodes=None, pmat=None, level: int = 0,
+                 rmax: float = RMAX, comm=None):
+        """``nodes``: a fixed grid, or None for grids following the edge at refinement ``level`` out to
+        ``rmax``; ``pmat``: the preconditioning strategy of every segment's problem; ``comm``: the
+        communicator of every segment (PETSc.COMM_WORLD by default)."""
+        self.model, self.set, self.events, self.tol, self.comm = model, settings, list(events), tol, comm
+        self.nodes, self.pmat, self.level, self.rmax = nodes, pmat, level, rmax
+        self.segments: list[Segment] = []
+        self.sharp = None
+
+    def segment(self, kind: str, at: float | None = None, before: Segment | None = None,
+                level: int | None = None, settings: Settings | None = None, band: float | None = None) -> Segment:
+        """A segment of ``kind`` (fixed, edge, scaled) centred on ``at`` at refinement ``level`` (default:
+        the tracer's), continuing ``before``'s budget, or with ``settings`` of its own; ``band``: the
+        fine band of a scaled segment (:func:`scaled_band`)."""
+        level = self.level if level is None else level
+        if kind == "fixed":
+            nodes = grid.nested(self.nodes, level - self.level)
+            problem, design = Problem(self.model, nodes, create_influence(nodes, self.comm), self.pmat), None
+        elif kind == "edge":
+            design = grid_for(self.model, at, level, self.rmax)
+            r = design.nodes()
+            problem = Problem(self.model, r, create_influence(r, self.comm), self.pmat)
+        else:
+            design = scaled_grid_for(self.model, at, level, self.rmax, band)
+            rho = design.nodes() / at
+            problem = EdgeFrameProblem(self.model, rho, create_influence(rho, self.comm), at, self.pmat)
+        s = settings or self.set
+        if before is not None:
+            steps = sum(len(g.cont.points) - 1 for g in self.segments)
+            folds = sum(g.cont.folds for g in self.segments)
+            s = replace(s, ds=before.cont.ds, max_steps=max(1, s.max_steps - steps),
+                        max_folds=s.max_folds - folds)
+        try:                    # a solver option refused: the problem's shell holds a cycle that gc cannot free
+            cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments) if before else 0)
+        except BaseException:
+            problem.destroy()
+            raise
+        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, *([self.tol] if self.tol else [])))
+
+    def run(self, lam0: float, started=None, pause=None) -> list[Segment]:
+        """The curve from lam0, starting from the rigid state (eq. 27); ``started()`` after the first point.
+
+        A tracer whose segments were restored from a checkpoint (:mod:`petsc_adhesion.app.checkpoint`)
+        goes on from its last segment's state instead.  ``pause(tracer)``: before every step
+        attempt (:meth:`~petsc_adhesion.core.continuation.Continuation.run`).
+        """
+        self.sharp = self.nodes is None and sharp(self.model)
+        start = None
+        if not self.segments:
+            seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)
+            self.segments.append(seg)
+            x = seg.problem.rigid(lam0, seg.problem.create_vec())
+            try:
+                start = seg.cont.start(x, lam0)
+            except RuntimeError as e:
+                raise RuntimeError(f"{e}; give -cont_lambda_start further apart") from None
+            finally:
+                x.destroy()
+        seg = self.segments[-1]
+        if started:
+            started()
+        hook = (lambda: pause(self)) if pause else None
+        while True:
+            regrid = _Regrid(self, seg) if seg.kind != "fixed" else None
+            if start is None:
+                seg.cont.resume(on_step=seg.finder, until=regrid, pause=hook)
+            else:
+                seg.cont.run(start, on_step=seg.finder, until=regrid, pause=hook)
+            if regrid is None or regrid.next is None:
+                return self.segments
+            seg, start = regrid.next
+            self.segments.append(seg)
+
+    def state(self, solvers: bool = True) -> dict:
+        """The curve traced so far as plain data, local parts of its vectors included (a checkpoint saves it):
+        every segment's kind, the grid it was made for, its continuation (with ``solvers``: what its
+        solvers keep of their preconditioners) and the events found on it (their error bars once
+        computed).  :meth:`restore` on a tracer made alike goes on as this one would."""
+        index = {id(seg.finder): k for k, seg in enumerate(self.segments)}
+        return {"segments": [{"kind": seg.kind, "at": seg.grid.edge if seg.grid is not None else None,
+                              "band": seg.grid.band if seg.kind == "scaled" else None, "N": seg.problem.layout.N,
+                              "guarded": seg.problem.guarded, "continuation": seg.cont.state(solvers),
+                              "events": seg.finder.state(lambda f: index[id(f)])} for seg in self.segments]}
+
+    def restore(self, state: dict) -> None:
+        """Rebuild the segments of :meth:`state` (collective).  ValueError when a segment's grid has not the
+        number of nodes it had (another version of the grids)."""
+        for k, st in enumerate(state["segments"]):
+            cont = st["continuation"]
+            settings = Settings(**{**cont["settings"], "monitor": self.set.monitor})
+            seg = self.segment(st["kind"], st["at"], settings=settings, band=st["band"])
+            self.segments.append(seg)
+            if seg.problem.layout.N != st["N"]:
+                raise ValueError(f"segment {k + 1} has {st['N']} nodes, this version makes {seg.problem.layout.N}")
+            seg.problem.guarded = st["guarded"]
+            seg.cont.restore(cont)
+        for seg, st in zip(self.segments, state["segments"]):
+            seg.finder.restore(st["events"], lambda k: self.segments[k].finder)
+
+    def destroy(self) -> None:
+        """Free every segment's PETSc objects."""
+        for seg in self.segments:
+            seg.destroy()
+        self.segments = []
