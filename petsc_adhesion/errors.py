@@ -3,9 +3,10 @@
 Every module may import this one; it imports nothing of the package.  :func:`collective` makes a
 check's refusal every rank's, so that no rank is left waiting in a collective call.
 """
+import os
 import sys
 
-__all__ = ["InputError", "Interrupted", "say", "first_line", "printable", "collective"]
+__all__ = ["InputError", "Interrupted", "say", "first_line", "printable", "collective", "tell"]
 
 
 def say(text: str, stream=None) -> None:
@@ -24,6 +25,27 @@ def first_line(e: BaseException) -> str:
     """The first line of an exception's message, or its type's name when it has none."""
     text = str(e).strip()
     return text.splitlines()[0] if text else type(e).__name__
+
+
+def tell(text: str, stream=None) -> None:
+    """``text`` and a newline on ``stream`` (stdout), flushed at once.
+
+    A reader that went away (``petsc-adhesion ... | head -1``: a broken pipe) loses the rest,
+    which is no error: later output goes to the null device, and the run ends with its own
+    status.  Any other failure (a full device) raises OSError naming standard output: the report
+    was the output asked for.
+    """
+    stream = stream or sys.stdout
+    try:
+        stream.write(text + "\n")
+        stream.flush()
+    except BrokenPipeError:
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
+        except (OSError, ValueError):
+            pass
+    except OSError as e:
+        raise OSError(e.errno, e.strerror, "standard output") from None
 
 
 class InputError(Exception):

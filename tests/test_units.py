@@ -103,7 +103,7 @@ def test_solve_and_rms(tmp_path):
     (SOFT + ("-phys_rms", 1e-10, "-adh_sigma", 0.2), "-adh_sigma: not with the -phys_ options"),
     (SOFT + ("-phys_poisson1", 0.7), "-phys_poisson1: expected"),
     (("-phys_radius", 1e-3, "-phys_young1", 1e3, "-phys_poisson1", 0, "-phys_gamma", 1, "-phys_epsilon", 1e-10),
-     "-phys_radius: with the other -phys_ options gives mu"),
+     "-phys_young1: with the other -phys_ options gives mu"),          # the modulus 1e-6 of a polymer's
     (SOFT + ("-phys_rms", 1e-8), "-phys_rms: gives sigma = rms / epsilon = 25")])
 def test_physical_bad_input(tmp_path, args, line):
     proc = run_cli(*args, "-out", tmp_path / "x.h5")

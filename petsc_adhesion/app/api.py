@@ -16,7 +16,7 @@ unknown options refused, before any work), and the library computes
 (``arc_snes_rtol=1e-10``, ``pc_type="lu"``) reach its solvers, and
 ``PETSC_OPTIONS`` and ``.petscrc`` are read as at the command line's start.
 Each call has an options database of its own, so calls in one process do not
-see each other's options, nor the caller's; a call destroys the PETSc objects it
+see each other's options, nor the caller's (calls from several threads run one at a time); a call destroys the PETSc objects it
 makes, failed calls too (a PETSc type name that does not exist,
 ``pc_type="nonesuch"``, included).  ``out=``, ``summary=`` and ``plot=`` write
 the command line's files, all or nothing.  Without options, the library's own
@@ -28,8 +28,9 @@ the whole result; rank 0 writes the files.
 """
 from __future__ import annotations
 
+import math
 import re
-import sys
+import threading
 import warnings
 
 import numpy as np
@@ -61,6 +62,8 @@ def solve(lam: float, mu: float | None = None, sigma: float | None = None, **opt
     As :func:`curve`; the Newton solver's options have no prefix (``snes_rtol=1e-12``),
     and ``adh_guess`` names an ``out=`` file of an earlier solve as the initial guess.
     """
+    if isinstance(lam, bool) or not isinstance(lam, (int, float, np.integer, np.floating)) or not math.isfinite(lam):
+        raise InputError(f"-adh_lambda: solve(lam) needs the approach lam, a finite real; got {lam!r}")
     return _run(_argv(options, adh_lambda=lam, adh_mu=mu, adh_sigma=sigma))
 
 
@@ -107,6 +110,10 @@ def _argv(options: dict, **named) -> list[str]:
 
 
 # -- a run --------------------------------------------------------------------------------------
+#: One run at a time in a process: PETSc's options database is the process's, and a run reads its options
+#: from it while it runs; two threads calling at once would read each other's.  The second call waits.
+_ONE_AT_A_TIME = threading.RLock()
+
 def _run(argv: list[str]):
     """The run of ``argv`` in an options database of its own: the library's result, on every rank.  Its
     errors raise: InputError for bad input, RuntimeError otherwise."""
@@ -115,10 +122,9 @@ def _run(argv: list[str]):
     bad = input_error(argv)
     if bad:
         raise InputError(bad)
-    import petsc4py
+    from ..core.start import start_petsc
 
-    if "petsc4py.PETSc" not in sys.modules:         # options are the run's own: none at start-up
-        petsc4py.init(["petsc_adhesion"])
+    start_petsc(["petsc_adhesion"])                 # options are the run's own: none at start-up
     from petsc4py import PETSc
 
     from ..core import capi
@@ -128,7 +134,7 @@ def _run(argv: list[str]):
     from .options.reading import AppOptions
 
     failed = result = None
-    with capi.options_from(argv):
+    with _ONE_AT_A_TIME, capi.options_from(argv):
         try:
             opts = AppOptions()
             if collective(PETSc.COMM_WORLD, run.is_study, opts):

@@ -38,11 +38,12 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..errors import InputError, Interrupted, collective, printable
+from ..errors import InputError, Interrupted, collective, first_line, printable
+from ..io.inputs import check_input
 from ..io.resultset import ResultSet, atomic_write, check_targets
 from ..version import __version__
 
-__all__ = ["Checkpoint", "open_checkpoint", "default_path", "fingerprint", "write_file", "read_file", "MAGIC", "FORMAT", "INTERVAL", "FREE"]
+__all__ = ["Checkpoint", "open_checkpoint", "default_path", "fingerprint", "write_file", "read_file", "is_checkpoint", "MAGIC", "FORMAT", "INTERVAL", "FREE"]
 
 #: The first line of every checkpoint.
 MAGIC = b"petsc-adhesion checkpoint\n"
@@ -157,12 +158,27 @@ def write_file(path: str, header: dict, tree: dict) -> None:
         os.close(folder)
 
 
+def _study_state(tree) -> bool:
+    """Whether ``tree`` is a study's saved state: its finished cases, each with its number and values."""
+    return isinstance(tree, dict) and tree.get("phase") == "study" and isinstance(tree.get("cases"), list) and all(
+        isinstance(r, dict) and isinstance(r.get("case"), int) and isinstance(r.get("values"), dict)
+        for r in tree["cases"])
+
+
+def is_checkpoint(path: str) -> bool:
+    """Whether ``path`` is a file of ours (it starts with MAGIC): only such a file is ever replaced by a save."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(len(MAGIC)) == MAGIC
+    except OSError:
+        return False
+
+
 def read_file(path: str, option: str = "cont_restart") -> tuple[dict, dict, bytes]:
     """(header, tree, JSON of the tree) of a checkpoint; InputError naming ``option`` for a missing,
     foreign or damaged file."""
     name = printable(path)
-    if not os.path.exists(path):
-        raise InputError(f"-{option}: no file '{name}'")
+    check_input(option, path)
     try:
         with open(path, "rb") as f:
             magic = f.read(len(MAGIC))
@@ -279,10 +295,17 @@ class Checkpoint:
         if self.saved is None:
             return None
         tree = self.saved
+        if not isinstance(tree, dict) or tree.get("phase") not in ("trace", "errors") or not isinstance(tree.get("wall"), dict) or \
+                not isinstance(tree.get("tracer"), dict) or not tree["tracer"].get("segments"):
+            raise InputError(f"-cont_restart: the checkpoint '{self.name}' holds no curve's state this version can "
+                             f"take up (no segments, or no phase it knows)")
         try:
             tracer.restore(_scatter(self.mpi, tree["tracer"]))
         except ValueError as e:
-            raise InputError(f"-cont_restart: the checkpoint's {e}") from None
+            raise InputError(f"-cont_restart: the checkpoint '{self.name}' holds {e}") from None
+        except (KeyError, TypeError, IndexError, AttributeError) as e:
+            raise InputError(f"-cont_restart: the checkpoint '{self.name}' holds a state this version cannot take up "
+                             f"({type(e).__name__}: {first_line(e)})") from None
         return tree["phase"], tree["wall"]
 
     # -- a study: its finished cases ---------------------------------------------------------------------
@@ -338,19 +361,30 @@ def open_checkpoint(opts, targets: dict, inputs: dict, comm, study: bool = False
     restart = opts.string("cont_restart")
     path = opts.string("cont_checkpoint")
     path = None if path == "none" else path or restart or default_path(targets)
+    if path is None and opts.db.hasName("cont_checkpoint_interval") and opts.string("cont_checkpoint") != "none":
+        raise InputError("-cont_checkpoint_interval: times the saves of a checkpoint, and this run saves none (no "
+                         "-out, -summary or -plot to keep it beside, nor -cont_checkpoint); remove it")
     ck = Checkpoint(path, comm, fp, opts.real("cont_checkpoint_interval"), restart)
 
     def check():
         if comm.getRank() != 0:
             return None
+        if restart is not None:
+            check_input("cont_restart", restart)
         if path:
             check_targets({**targets, "cont_checkpoint": path}, inputs)
+            if path != restart and os.path.lexists(path) and not is_checkpoint(path):
+                raise InputError(f"-cont_checkpoint: '{printable(path)}' exists and is not a petsc-adhesion "
+                                 f"checkpoint: it is not overwritten; give another name, or none")
         if restart is None:
             return None
         header, tree, meta = read_file(restart)
-        why = _difference(header.get("fingerprint", {}), fp)
+        why = _difference(header.get("fingerprint", {}) if isinstance(header.get("fingerprint"), dict) else {}, fp)
         if why:
             raise InputError(f"-cont_restart: the checkpoint '{printable(restart)}' {why}")
+        if study and not _study_state(tree):
+            raise InputError(f"-cont_restart: the checkpoint '{printable(restart)}' holds no study's cases this "
+                             f"version can take up")
         return tree, meta
 
     got = collective(comm, check)

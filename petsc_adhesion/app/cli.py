@@ -5,21 +5,22 @@
 
 Exit status: 0 done; 1 failed (no result); 2 bad input (one line naming the
 option, nothing written); 3 result written but not what was asked for
-(a stalled curve, an event not reached: its warnings say why); 130 and 143
-interrupted by SIGINT or SIGTERM (nothing written; one that comes once the
-results are in place is said in one line, and the run ends with its own
-status).  Every error is one line
+(a stalled curve, an event not reached: its warnings say why); 129, 130 and
+143 interrupted by SIGHUP, SIGINT or SIGTERM (nothing written; one that comes
+once the results are in place is said in one line, and the run ends with its
+own status).  Every error is one line
 on stderr from rank 0; no traceback reaches the user.
 """
 from __future__ import annotations
 
+import os
 import signal
 import sys
 from contextlib import nullcontext
 
-from ..errors import Interrupted, first_line, printable, say
+from ..errors import Interrupted, first_line, printable, say, tell
 from ..io.resultset import said_after
-from .optionsfile import environment_error, file_error, options_files, stray_word
+from .optionsfile import environment_error, file_error, named_file_error, options_files, stray_word
 
 __all__ = ["main", "input_error", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
 
@@ -31,11 +32,13 @@ def _on_signal(signum, frame):
 
 
 def _say(msg: str) -> None:
-    """One line on rank 0's stderr."""
-    from mpi4py import MPI
+    """One line on rank 0's stderr (every process's, before MPI is there to ask)."""
+    if "mpi4py.MPI" in sys.modules:
+        from mpi4py import MPI
 
-    if MPI.COMM_WORLD.Get_rank() == 0:
-        say(f"error: {printable(msg)}")
+        if MPI.COMM_WORLD.Get_rank() != 0:
+            return
+    say(f"error: {printable(msg)}")
 
 
 
@@ -58,7 +61,7 @@ def main(argv: list[str] | None = None) -> int:
     if argv[1:2] == ["plot"]:                       # a figure from a result file: no MPI, no PETSc
         from ..io.plot.command import command
         return command(argv[2:])
-    old = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    old = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
     try:
         return _main(argv)
     except Interrupted as e:
@@ -98,6 +101,11 @@ def input_error(argv: list[str]) -> str | None:
         bad = file_error(path)
         if bad:
             return bad
+    for i, a in enumerate(argv):
+        if a == "-options_file_yaml":
+            bad = named_file_error(a, argv[i + 1] if i + 1 < len(argv) else "")
+            if bad:
+                return bad
     return environment_error(argv)
 
 
@@ -113,32 +121,56 @@ def _program(argv: list[str]) -> int:
     opts = AppOptions()
     helping = opts.db.hasName("help")
     if helping and PETSc.COMM_WORLD.getRank() == 0:
-        print_help(sys.stdout)
+        print_help()
     if collective(PETSc.COMM_WORLD, run.is_study, opts):
         return study.main(opts, argv, helping)
     return run.main(opts, argv, helping)
 
 
+def environment() -> str | None:
+    """What in the process's surroundings would make MPI or PETSc fail with a page of text, in one line, or None:
+    a working directory that was removed (PETSc reads .petscrc there), a TMPDIR Open MPI cannot write its
+    session files into."""
+    try:
+        os.getcwd()
+    except OSError:
+        return "the working directory no longer exists (it was removed): change to one that does"
+    tmp = os.environ.get("TMPDIR")
+    if tmp is not None and not (os.path.isdir(tmp) and os.access(tmp, os.W_OK | os.X_OK)):
+        return f"TMPDIR: '{printable(tmp)}' is not a writable directory (MPI keeps its session files there): " \
+               f"set it to one that is, or unset it"
+    return None
+
+
 def _main(argv: list[str]) -> int:
     bad = input_error(argv)
+    fresh = "petsc4py.PETSc" not in sys.modules
+    if not bad and fresh:
+        bad = environment()
     if bad:
         _say(bad)
         return EXIT_INPUT
-    import petsc4py
-    fresh = "petsc4py.PETSc" not in sys.modules
-    if fresh:
-        petsc4py.init(argv)
+    try:
+        from ..core.start import start_petsc
+
+        start_petsc(argv)                 # the handlers of SIGINT, SIGTERM, SIGHUP, SIGPIPE kept
+        from petsc4py import PETSc        # PETSc's own libraries, found through PETSC_DIR
+    except ImportError as e:
+        _say(f"petsc4py cannot be loaded ({first_line(e)}); with PETSC_DIR = "
+             f"'{printable(os.environ.get('PETSC_DIR', ''))}': set it to the PETSc petsc4py was built with, or "
+             f"unset it (./run sets it up)")
+        return EXIT_FAILED
     from mpi4py import MPI
-    from petsc4py import PETSc
 
     from ..core import capi
     from ..errors import InputError
     from .options.checks import petsc_error
 
-    if "-version" in argv:
-        PETSc.Sys.Print(_version())
-        return EXIT_OK
     try:
+        if "-version" in argv:
+            if PETSc.COMM_WORLD.getRank() == 0:
+                tell(_version())
+            return EXIT_OK
         # PETSc runs already in this process (a notebook, a test): the run's own options database
         with nullcontext() if fresh else capi.options_from(argv):
             return _program(argv)

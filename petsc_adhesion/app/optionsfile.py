@@ -10,8 +10,12 @@ from __future__ import annotations
 import os
 
 from ..errors import printable
+from ..io.inputs import file_problem
 
-__all__ = ["options_files", "file_error", "environment_error", "stray_word"]
+#: The largest options file read (16 MiB): options files are a few lines.
+MAX_OPTIONS_BYTES = 16 << 20
+
+__all__ = ["options_files", "file_error", "named_file_error", "environment_error", "stray_word", "MAX_OPTIONS_BYTES"]
 
 
 def _is_value(token: str) -> bool:
@@ -51,7 +55,7 @@ def options_files(argv: list[str]) -> list[str]:
         if path in out:
             continue
         out.append(path)
-        if path and os.path.isfile(path) and os.access(path, os.R_OK):
+        if file_problem(path, MAX_OPTIONS_BYTES) is None:
             todo += [t[1] for _, _, t in _lines(path) if len(t) == 2 and t[0] == "-options_file"]
     return out
 
@@ -64,8 +68,9 @@ def file_error(path: str, opened: tuple = ()) -> str | None:
     them refused.
     """
     shown = printable(path)
-    if not path or not os.path.isfile(path) or not os.access(path, os.R_OK):
-        return f"-options_file: cannot read '{shown}'"
+    why = file_problem(path, MAX_OPTIONS_BYTES)
+    if why:
+        return f"-options_file: '{shown}' {why}"
     real = os.path.realpath(path)
     if real in opened:
         return f"-options_file {shown}: includes itself (through -options_file)"
@@ -89,11 +94,23 @@ def environment_error(argv: list[str]) -> str | None:
     word = stray_word(env)
     if word is not None:
         return f"PETSC_OPTIONS: '{printable(word)}' is neither an option (they start with '-') nor an option's value"
+    for i, t in enumerate(env):
+        if t in ("-options_file", "-options_file_yaml"):
+            bad = file_error(env[i + 1] if i + 1 < len(env) else "") if t == "-options_file" else \
+                named_file_error(t, env[i + 1] if i + 1 < len(env) else "")
+            if bad:
+                return f"PETSC_OPTIONS: {bad}"
     if "-skip_petscrc" in argv + env:
         return None
     for rc in (os.path.join(os.path.expanduser("~"), ".petscrc"), ".petscrc", "petscrc"):
-        if os.path.isfile(rc):
+        if os.path.lexists(rc):
             bad = file_error(rc)
             if bad:
                 return bad.replace("-options_file", f"{rc} (read by PETSc at start-up)", 1)
     return None
+
+
+def named_file_error(option: str, path: str) -> str | None:
+    """A file option PETSc reads at start-up, judged by what it is."""
+    why = file_problem(path, MAX_OPTIONS_BYTES)
+    return f"{option}: '{printable(path)}' {why}" if why else None

@@ -92,9 +92,7 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
     model = read_model(opts)
     grid_choice = read_grid(opts, model)
     lam = opts.real("adh_lambda")
-    nodes = grid_choice.nodes(model.rmax)
-    if nodes is not None:
-        check_memory(nodes.size, opts.choice("adh_pmat"), lam is None, comm.getSize())
+    check_memory(grid_choice, opts.choice("adh_pmat"), lam is None, comm.getSize())
     if opts.string("adh_guess") is not None and lam is None:
         raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
     opts.read_all()
@@ -140,15 +138,13 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         if comm.getRank() == 0:
             given = opts.given()
             with ck.on_interrupt() if ck else nullcontext(), written(req.targets, ck.paths() if ck else ()) as files:
-                if req.lam is None:
-                    write_curve(result, given, files)
-                else:
-                    write_solve(result, given, files)
-            if report:
-                if req.lam is None:
-                    report_curve(result.summary)
-                else:
-                    report_solve(result.summary, result.summary.get("physical"))
+                (write_curve if req.lam is None else write_solve)(result, given, files, commit=False)
+                if report:       # before the files go in place: a report that cannot be written fails the run
+                    if req.lam is None:
+                        report_curve(result.summary)
+                    else:
+                        report_solve(result.summary, result.summary.get("physical"))
+                files.commit()
         PETSc.garbage_cleanup()
     except Interrupted as e:
         mark_done(e, files, status)

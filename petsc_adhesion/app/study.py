@@ -31,6 +31,7 @@ uninterrupted run's.  A case cut off mid-way runs again from its start.
 from __future__ import annotations
 
 import itertools
+import math
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -57,6 +58,8 @@ __all__ = ["Case", "cases", "cost", "assign", "spread", "main", "KINDS"]
 #: The event kinds each -study_compute reports (None: all) and whether it stops at equilibrium.
 KINDS = {"curve": (None, False), "events": (None, True), "pull_off": (("F_min", "equilibrium"), True),
          "folds": (("snap_on", "snap_off"), True)}
+#: The most cases of one study (each a curve of seconds to minutes).
+MAX_CASES = 10_000
 #: Options a study sets for its cases or writes itself; a -study_option cannot be one of them.
 _OWN = ("adh_mu", "adh_sigma", "adh_lambda", "out", "summary", "plot")
 _TAG = 17
@@ -113,6 +116,11 @@ def _check(opts: AppOptions) -> tuple[list, str]:
                          f"{PETSc.COMM_WORLD.getSize()} ranks of the run")
     if not axes:
         raise InputError("-study_mu: a study needs -study_mu, -study_sigma or -study_option")
+    count = math.prod(len(v) for _, v in axes)
+    if count > MAX_CASES:
+        name = {"adh_mu": "study_mu", "adh_sigma": "study_sigma"}.get(axes[0][0], "study_values")
+        raise InputError(f"-{name}: the study has {count} cases ({' x '.join(str(len(v)) for _, v in axes)}); "
+                         f"a study runs at most {MAX_CASES}")
     return axes, swept
 
 
@@ -278,9 +286,16 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
                 study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
                          "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
                 status = 3 if failed or any(r["incomplete"] for r in done) else 0
-                with written(targets, journal.paths()) as files:
-                    write_study({**program_record(world), "options": opts.given()}, study, done, sorted(failed, key=lambda r: r["case"]), files)
-        return mpi.bcast(status, root=0)
+                if not done:                 # nothing to replace an earlier result set with
+                    status = None
+                else:
+                    with written(targets, journal.paths()) as files:
+                        write_study({**program_record(world), "options": opts.given()}, study, done,
+                                    sorted(failed, key=lambda r: r["case"]), files)
+        status = mpi.bcast(status, root=0)
+        if status is None:
+            raise RuntimeError(f"none of the {len(todo)} cases ran (each is said above); nothing written")
+        return status
     except Interrupted as e:
         mark_done(e, files, status)
         raise
@@ -363,10 +378,17 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
                 study = {"compute": "critical", "axes": [n for n, _ in axes],
                          "ranks_per_case": opts.int("study_ranks"), "cases": len(todo), "plot": "critical"}
                 status = 3 if failed else 0
-                with written(targets, journal.paths()) as files:
-                    write_critical({**program_record(world), "options": opts.given()}, study, done, failed, files)
+                if not done:                 # nothing to replace an earlier result set with
+                    status = None
+                else:
+                    with written(targets, journal.paths()) as files:
+                        write_critical({**program_record(world), "options": opts.given()}, study, done, failed,
+                                       files)
         check_unused()
-        return mpi.bcast(status, root=0)
+        status = mpi.bcast(status, root=0)
+        if status is None:
+            raise RuntimeError(f"none of the {len(todo)} cases ran (each is said above); nothing written")
+        return status
     except Interrupted as e:
         mark_done(e, files, status)
         raise

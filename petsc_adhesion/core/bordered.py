@@ -170,11 +170,18 @@ class Bordered:
 
     def restore(self, state: dict) -> None:
         """Fill the preconditioning matrix where :meth:`state`'s solver last filled it (as
-        :meth:`~petsc_adhesion.core.newton.Newton.restore`)."""
+        :meth:`~petsc_adhesion.core.newton.Newton.restore`); ValueError for a state that is not one."""
+        if not isinstance(state["pending"], bool):
+            raise ValueError("a preconditioner's state that is not one")
         if state["at"] is not None:
-            x, self.p, xdot, pdot = state["at"]
+            x, p, xdot, pdot = state["at"]
+            x, xdot = np.asarray(x, dtype=float), np.asarray(xdot, dtype=float)
+            if x.shape != (self.nloc,) or xdot.shape != x.shape or not (np.isfinite(x).all() and np.isfinite(xdot).all()
+                                                                        and np.isfinite([float(p), float(pdot)]).all()):
+                raise ValueError("a preconditioner filled at a point that is not one")
             self.x.setArray(x)
-            self.set_border(xdot, pdot)
+            self.p = float(p)
+            self.set_border(xdot, float(pdot))
             self.linearize(True)
         self.reuse.stale = state["pending"]
 

@@ -26,14 +26,15 @@ first point), the arclength corrector ``arc_`` (also every tangent along it).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 from petsc4py import PETSc
 
+from ..errors import tell
 from .bordered import Bordered
 from .newton import PC_REUSE_ITS, Newton, krylov_retry
-from .protocol import POINT_FIELDS, Point
+from .protocol import POINT_FIELDS, Point, check_point
 
 __all__ = ["Settings", "Continuation", "NATURAL_PREFIX", "CORRECTORS"]
 
@@ -72,6 +73,28 @@ class Settings:
     max_folds: int = 12             # stop after more than this many turning points
     pc_reuse_its: int = PC_REUSE_ITS
     monitor: bool = False           # one line a step
+
+    @classmethod
+    def from_state(cls, d: dict) -> Settings:
+        """The settings of ``asdict(settings)`` as a checkpoint kept them; ValueError for what are not settings."""
+        if not isinstance(d, dict) or set(d) != {f.name for f in fields(cls)}:
+            raise ValueError("settings that are not the continuation's")
+        for f in fields(cls):
+            v, default = d[f.name], f.default
+            if isinstance(default, bool):
+                ok = isinstance(v, bool)
+            elif isinstance(default, int):
+                ok = isinstance(v, int) and not isinstance(v, bool) and v >= 0
+            elif isinstance(default, float):
+                ok = isinstance(v, (int, float)) and not isinstance(v, bool) and not math.isnan(v) and \
+                    (math.isfinite(v) or math.isinf(default) or f.name in ("observable_max", "p_max", "p_min"))
+            else:
+                ok = v is None or isinstance(v, str)
+            if not ok:
+                raise ValueError(f"the setting {f.name} = {v!r}")
+        if not 0 < d["ds_min"] <= d["ds"] <= d["ds_max"] or d["corrector"] not in CORRECTORS:
+            raise ValueError("step lengths or a corrector the continuation cannot take")
+        return cls(**d)
 
 
 class Continuation:
@@ -307,8 +330,9 @@ class Continuation:
         """One line a point with -cont_monitor (rank 0)."""
         if self.set.monitor:
             obs = "".join(f" {k} {v: .10e}" for k, v in pt.values.items())
-            PETSc.Sys.Print(f"{self.index0 + len(self.points) - 1:4d} CONT {self.pb.parameter} {pt.p: .10e}{obs} ds {pt.ds:.3e} "
-                            f"{pt.corrector[:3]} Newton {pt.newton_its} KSP {pt.ksp_its}", comm=self.pb.comm)
+            if self.pb.comm.getRank() == 0:
+                tell(f"{self.index0 + len(self.points) - 1:4d} CONT {self.pb.parameter} {pt.p: .10e}{obs} ds {pt.ds:.3e} "
+                            f"{pt.corrector[:3]} Newton {pt.newton_its} KSP {pt.ksp_its}")
 
     def state(self, solvers: bool = True) -> dict:
         """Everything the run depends on, as plain data (a checkpoint saves it): the settings, the points
@@ -325,12 +349,31 @@ class Continuation:
         return out
 
     def restore(self, state: dict) -> None:
-        """Take up :meth:`state` (its settings are this continuation's own, given at its making)."""
-        self.index0, self.ds, self.rejected, self.folds = state["index0"], state["ds"], state["rejected"], state["folds"]
-        self.stop = tuple(state["stop"]) if state["stop"] is not None else None
+        """Take up :meth:`state` (its settings are this continuation's own, given at its making).  ValueError for
+        a state this continuation could not go on from (a crafted or damaged one): its checks run first."""
+        size = self._x.getLocalSize()
+        counts = [state[k] for k in ("index0", "rejected", "folds")]
+        if not all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in counts):
+            raise ValueError("counters that are not counts")
+        if not (isinstance(state["ds"], (int, float)) and math.isfinite(state["ds"]) and state["ds"] > 0):
+            raise ValueError(f"a next step {state['ds']!r} that is not a finite positive real")
+        stop = state["stop"]
+        if stop is not None and not (isinstance(stop, (list, tuple)) and len(stop) == 2 and isinstance(stop[0], str)):
+            raise ValueError("a stop that is not (reason, value)")
         pts = state["points"]
-        self.points = [Point(x=pts["x"][i].copy(), xdot=pts["xdot"][i].copy(), **{k: pts[k][i] for k in POINT_FIELDS})
-                       for i in range(len(pts["p"]))]
+        x, xdot = np.asarray(pts["x"], dtype=float), np.asarray(pts["xdot"], dtype=float)
+        n = len(pts["p"])
+        if n < 1 or x.shape != (n, size) or xdot.shape != (n, size) or any(len(pts[k]) != n for k in POINT_FIELDS):
+            raise ValueError(f"points of {x.shape} unknowns where ({n}, {size}) are expected")
+        points = []
+        for i in range(n):
+            fields = {k: pts[k][i] for k in POINT_FIELDS}
+            check_point(x[i], xdot[i], fields, size)
+            points.append(Point(x=x[i].copy(), xdot=xdot[i].copy(), **fields))
+        self.index0, self.ds, self.rejected, self.folds = state["index0"], float(state["ds"]), state["rejected"], \
+            state["folds"]
+        self.stop = tuple(stop) if stop is not None else None
+        self.points = points
         if "newton" in state:
             self.newton.restore(state["newton"])
             self.bordered.restore(state["bordered"])

@@ -294,13 +294,26 @@ class EventFinder:
                  "landing_step": f.landing_step, "estimate": f.estimate} for f in self.found]
 
     def restore(self, state: list[dict], finder_at) -> None:
-        """Take up :meth:`state`; ``finder_at(number)``: the finder of that number."""
-        self.found = []
+        """Take up :meth:`state`; ``finder_at(number)``: the finder of that number (IndexError for none).
+        ValueError for events that are not this finder's."""
+        found, size, steps = [], self.cont._x.getLocalSize(), len(self.cont.points) - 1
         for d in state:
-            by = finder_at(d["landing_by"]) if d["landing_by"] is not None else None
-            self.found.append(Found(self.events[d["event"]], d["label"], Point.from_state(d["point"]), d["segment"],
-                                    d["before"], landing=Point.from_state(d["landing"]) if by is not None else None,
-                                    landing_by=by, landing_step=d["landing_step"], estimate=d["estimate"]))
+            ints = (d["event"], d["segment"], d["landing_step"])
+            if not all(isinstance(i, int) and not isinstance(i, bool) for i in ints) or \
+                    not 0 <= d["event"] < len(self.events) or not 0 <= d["segment"] < max(steps, 1) or \
+                    not isinstance(d["label"], str) or not isinstance(d["before"], (int, float)) or \
+                    not np.isfinite(d["before"]) or not (d["estimate"] is None or isinstance(d["estimate"], dict)):
+                raise ValueError("an event that is not one of this curve's")
+            by = None
+            if d["landing_by"] is not None:
+                if not isinstance(d["landing_by"], int) or d["landing_by"] < 0:
+                    raise ValueError("a landing on no segment")
+                by = finder_at(d["landing_by"])
+            landing = Point.from_state(d["landing"], by.cont._x.getLocalSize()) if by is not None else None
+            found.append(Found(self.events[d["event"]], d["label"], Point.from_state(d["point"], size), d["segment"],
+                               float(d["before"]), landing=landing, landing_by=by, landing_step=d["landing_step"],
+                               estimate=d["estimate"]))
+        self.found = found
 
 
 def jumps(finders, stable) -> None:

@@ -229,11 +229,18 @@ class Newton:
     def restore(self, state: dict) -> None:
         """Fill the preconditioning matrix where :meth:`state`'s solver last filled it: the same
         preconditioner gives the same Newton and Krylov iterates (a fresh one would change them by the
-        solver tolerances, and a continuation's step control with them)."""
+        solver tolerances, and a continuation's step control with them).  ValueError for a state that is not
+        one."""
+        if not isinstance(state["pending"], bool):
+            raise ValueError("a preconditioner's state that is not one")
         if state["at"] is not None:
-            x, self.p = state["at"]
+            x, p = state["at"]
             v = self.pb.create_vec()
             try:
+                x = np.asarray(x, dtype=float)
+                if x.shape != (v.getLocalSize(),) or not np.isfinite(x).all() or not np.isfinite(float(p)):
+                    raise ValueError("a preconditioner filled at a point that is not one")
+                self.p = float(p)
                 v.setArray(x)
                 self.linearize(v, True)
             finally:

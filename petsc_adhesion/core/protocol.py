@@ -22,12 +22,13 @@ Bratu and a cusp.  Each is checked against finite differences of its residual
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, fields, replace
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["Point", "ContinuationProblem", "TracedProblem", "FoldBase", "POINT_FIELDS"]
+__all__ = ["Point", "ContinuationProblem", "TracedProblem", "FoldBase", "POINT_FIELDS", "check_point"]
 
 
 @runtime_checkable
@@ -176,9 +177,31 @@ class Point:
         return {"x": self.x, "xdot": self.xdot, **{k: getattr(self, k) for k in POINT_FIELDS}}
 
     @classmethod
-    def from_state(cls, d: dict) -> Point:
-        """The point of :meth:`state`."""
-        return cls(x=np.array(d["x"]), xdot=np.array(d["xdot"]), **{k: d[k] for k in POINT_FIELDS})
+    def from_state(cls, d: dict, size: int | None = None) -> Point:
+        """The point of :meth:`state`; ValueError for one that is not a point's (of ``size`` local unknowns)."""
+        x, xdot = np.asarray(d["x"], dtype=float), np.asarray(d["xdot"], dtype=float)
+        check_point(x, xdot, {k: d[k] for k in POINT_FIELDS}, size)
+        return cls(x=x.copy(), xdot=xdot.copy(), **{k: d[k] for k in POINT_FIELDS})
+
+
+def _real(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def check_point(x: np.ndarray, xdot: np.ndarray, fields: dict, size: int | None = None) -> None:
+    """ValueError unless (x, xdot, fields) make a point of ``size`` local unknowns: finite vectors of that
+    length, finite p, pdot, ds and deviation, counts that are counts, observables and rates of finite reals."""
+    if x.ndim != 1 or xdot.shape != x.shape or (size is not None and x.size != size):
+        raise ValueError(f"a point of {x.shape} unknowns where {size} are expected")
+    if not (np.isfinite(x).all() and np.isfinite(xdot).all()):
+        raise ValueError("a point whose state is not finite")
+    if not all(_real(fields[k]) for k in ("p", "pdot", "ds", "deviation")) or fields["ds"] < 0:
+        raise ValueError("a point whose parameter, tangent or step is not a finite real")
+    if not all(isinstance(fields[k], int) and fields[k] >= 0 for k in ("newton_its", "ksp_its")):
+        raise ValueError("a point whose iteration counts are not counts")
+    if not all(isinstance(fields[k], dict) and all(isinstance(n, str) and _real(v) for n, v in fields[k].items())
+               for k in ("values", "rates")) or not isinstance(fields["corrector"], str):
+        raise ValueError("a point whose observables are not finite reals")
 
 
 assert set(POINT_FIELDS) | {"x", "xdot"} == {f.name for f in fields(Point)}

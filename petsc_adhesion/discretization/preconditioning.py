@@ -26,12 +26,13 @@ factorization itself.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["Layout", "Dense", "Band", "Shell", "KINDS", "BAND", "REDUNDANT_MAX", "create"]
+__all__ = ["Layout", "Dense", "Band", "Shell", "KINDS", "BAND", "REDUNDANT_MAX", "create", "MATRICES", "BASE_BYTES", "memory_needed", "memory_available"]
 
 #: Half bandwidth of the near field kept by ``band``.
 BAND = 64
@@ -183,6 +184,42 @@ class Shell:
 
 
 KINDS = ("dense", "band", "shell")
+
+#: N x N doubles a rank holds at once, by preconditioning kind, for a curve and for a fixed-approach solve:
+#: the influence matrix, and with dense the assembled G_x, the bordered matrix and their LU factors (measured:
+#: 2564 MiB at N = 8000 on one rank with dense, 1323 MiB with band; docs/performance.md, scaling).
+MATRICES = {("dense", True): 5.0, ("dense", False): 3.0, ("band", True): 2.0, ("band", False): 2.0,
+            ("shell", True): 1.5, ("shell", False): 1.5}
+#: What a run holds besides them (the interpreter, numpy, PETSc, MPI, h5py, the curve's points): about 350 MiB.
+BASE_BYTES = 350 << 20
+
+
+def memory_needed(n: int, kind: str, curve: bool = True, ranks: int = 1) -> float:
+    """Bytes a rank needs for a problem of n nodes with the preconditioning ``kind``.
+
+    >>> round(memory_needed(8000, "dense") / 2**20)     # measured 2564 MiB
+    2791
+    """
+    return BASE_BYTES + MATRICES[(kind, curve)] * 8.0 * n * n / ranks
+
+
+def memory_available() -> float:
+    """Bytes this process may still use: the kernel's MemAvailable, within the control group's limit."""
+    have = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    try:
+        with open("/proc/meminfo") as f:
+            info = {ln.split(":")[0]: ln.split()[1] for ln in f}
+        have = float(info["MemAvailable"]) * 1024
+    except (OSError, KeyError, ValueError, IndexError):
+        pass
+    for limit, used in (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                        ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes")):
+        try:
+            with open(limit) as f, open(used) as g:
+                have = min(have, float(f.read().strip()) - float(g.read().strip()))
+        except (OSError, ValueError):
+            continue
+    return have
 
 
 def create(kind: str, band: int = BAND):

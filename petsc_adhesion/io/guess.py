@@ -1,11 +1,10 @@
 """The initial guess of a fixed-approach solve, read from the HDF5 file of an earlier one (-adh_guess)."""
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from ..errors import InputError, first_line, printable
+from .inputs import check_input
 
 __all__ = ["read_guess"]
 
@@ -14,8 +13,7 @@ def read_guess(path: str, wall: float) -> tuple[np.ndarray, np.ndarray]:
     """(r, H) of the -out file of a fixed-approach solve at ``path``, checked: two real vectors of one length, r
     finite and increasing, H finite and above ``wall`` (the pressure law's); one line naming -adh_guess else."""
     shown = printable(path)
-    if not os.path.isfile(path):
-        raise InputError(f"-adh_guess: '{shown}' is not a regular file")
+    check_input("adh_guess", path)
     try:
         import h5py
         with h5py.File(path, "r") as f:

@@ -1,7 +1,7 @@
 """The console report of a run: the curve's events with their bars, in the model's units and in SI."""
 from __future__ import annotations
 
-from petsc4py import PETSc
+from ..errors import tell
 
 __all__ = ["report_curve", "report_solve"]
 
@@ -38,7 +38,7 @@ def report_curve(s: dict) -> None:
         out += _physical_lines(s["physical"])
     for w in s["warnings"]:
         out.append(f"  WARNING: {w}")
-    PETSc.Sys.Print("\n".join(out), comm=PETSc.COMM_SELF)
+    tell("\n".join(out))
 
 
 def _nm_nN(e: dict, key: str, unit: str) -> str:
@@ -69,4 +69,4 @@ def report_solve(res: dict, physical: dict | None = None) -> None:
     if physical:
         line += (f"\n  in physical units (mu = {physical['mu']:.4g}): lambda = {physical['lambda_nm']:.5g} nm  "
                  f"F = {physical['F_nN']:.5g} nN  H0 = {physical['H0_nm']:.5g} nm")
-    PETSc.Sys.Print(line, comm=PETSc.COMM_SELF)
+    tell(line)

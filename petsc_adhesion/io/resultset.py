@@ -2,13 +2,18 @@
 
 Each output is written to a temporary beside its target, ``.NAME.partial-HOST-PID``,
 created with the umask's mode.  When every output of the run is complete, a
-journal ``.NAME.commit`` (next to the first output) lists the renames; the
-temporaries are renamed into place with SIGINT and SIGTERM held, and the
-journal is removed, and with it what the set replaces (the run's checkpoint).  A run that fails or is killed before the journal leaves
-the earlier set untouched; one killed (kill -9) within the microseconds of
-the renames leaves its journal, and the next run that writes any of those
-names completes them first (roll forward).  Temporaries of dead runs on this
-host are removed then too, so they do not accumulate.
+journal ``.NAME.commit`` (next to the first output) lists the renames; then, with
+SIGINT, SIGTERM and SIGHUP held, each earlier file is moved aside to
+``.NAME.previous-HOST-PID`` and each temporary renamed into place.  If any of
+these renames fails (a file that may not be replaced, such as an immutable one),
+the ones done are undone, the earlier set is back, the journal goes and the
+run fails with one line: never a mixed set.  Once all are in place the earlier
+files, the journal and what the set replaces (the run's checkpoint) are removed.
+A run that fails or is killed before the journal leaves the earlier set
+untouched; one killed (kill -9) within the microseconds of the renames leaves
+its journal, and the next run that writes any of those names completes them
+first (roll forward).  Temporaries of dead runs on this host are removed then
+too, so they do not accumulate.
 
 Targets are checked before any work (:func:`check_targets`): regular files or
 new names only (no device, FIFO, directory or symbolic link), in a writable
@@ -26,11 +31,20 @@ from contextlib import contextmanager
 
 from ..errors import InputError, Interrupted, printable, say
 
-__all__ = ["check_targets", "ResultSet", "written", "mark_done", "said_after", "atomic_write", "PLOT_FORMATS", "printable",
+__all__ = ["check_targets", "ResultSet", "written", "mark_done", "said_after", "atomic_write", "PLOT_FORMATS", "plot_format",
            "JOURNAL"]
 
 #: Figure formats by file extension.
 PLOT_FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
+
+
+def plot_format(path: str) -> str | None:
+    """The figure format a file name ends in (``-plot .png`` too: a hidden file named by its format), or None.
+
+    >>> plot_format("a/b.PDF"), plot_format(".png"), plot_format("fig.jpg")
+    ('pdf', 'png', None)
+    """
+    return next((fmt for ext, fmt in PLOT_FORMATS.items() if path.lower().endswith(ext)), None)
 #: What a journal of ours says it is (a file of that name that does not is left alone).
 JOURNAL = "petsc-adhesion journal"
 
@@ -128,6 +142,11 @@ def _journal(path: str) -> str:
     return os.path.join(folder, f".{base}.commit")
 
 
+def _previous_name(path: str) -> str:
+    folder, base = os.path.split(os.path.abspath(path))
+    return os.path.join(folder, f".{base}.previous-{socket.gethostname()}-{os.getpid()}")
+
+
 def _read_journal(path: str) -> list | None:
     """The renames a journal of ours lists, or None for any other file (left alone)."""
     try:
@@ -144,7 +163,7 @@ def _read_journal(path: str) -> list | None:
 
 @contextmanager
 def _signals_held():
-    held = {signal.SIGINT, signal.SIGTERM}
+    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
     old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
     try:
         yield
@@ -182,6 +201,10 @@ class ResultSet:
                 for tmp, final in renames:
                     if os.path.exists(tmp):
                         os.replace(tmp, final)
+                for _, final in renames:             # the earlier files the dead run moved aside
+                    folder_, base = os.path.split(final)
+                    for old in glob.glob(os.path.join(glob.escape(folder_), f".{glob.escape(base)}.previous-*")):
+                        os.remove(old)
                 for other in {_journal(final) for _, final in renames}:
                     if os.path.exists(other) and _read_journal(other) is not None:
                         os.remove(other)
@@ -215,9 +238,27 @@ class ResultSet:
                     f.flush()
                     os.fsync(f.fileno())
         with _signals_held():
-            for tmp, final in renames:
-                os.replace(tmp, final)
+            aside, placed = [], []
+            try:
+                for _, final in renames:              # the earlier set moved aside: each may refuse
+                    if os.path.lexists(final):
+                        os.rename(final, _previous_name(final))
+                        aside.append(final)
+                for tmp, final in renames:
+                    os.rename(tmp, final)
+                    placed.append((tmp, final))
+            except OSError as e:                      # undone: the earlier set back, no journal, one line
+                refused = final
+                for tmp, done in reversed(placed):
+                    os.rename(done, tmp)
+                for done in reversed(aside):
+                    os.rename(_previous_name(done), done)
+                for journal in journals.values():
+                    os.remove(journal)
+                raise OSError(e.errno, f"{e.strerror}; the earlier files are kept", refused) from None
             self.committed = True
+            for final in aside:
+                os.remove(_previous_name(final))
             for journal in journals.values():
                 os.remove(journal)
             for path in self.drop:

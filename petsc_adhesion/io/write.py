@@ -8,7 +8,6 @@ the files of one run are written into the temporaries of a
 from __future__ import annotations
 
 import json
-import os
 
 import numpy as np
 
@@ -21,7 +20,7 @@ from .layout import (
     solve_tree,
     study_table,
 )
-from .resultset import PLOT_FORMATS, ResultSet
+from .resultset import ResultSet, plot_format
 
 __all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study", "write_critical"]
 
@@ -90,29 +89,32 @@ def write_json(path: str, summary: dict) -> None:
         f.write("\n")
 
 
-def write_curve(curve, options: dict, files: ResultSet) -> None:
+def write_curve(curve, options: dict, files: ResultSet, commit: bool = True) -> None:
     """The files of a :class:`~petsc_adhesion.tracing.curve.Curve` (``options``: its run's, as given),
-    committed together."""
+    committed together (``commit`` False: the caller commits, once the run's other output is out)."""
     tree = curve_tree(curve, options)
     if "out" in files.targets:
         write_h5(files.temp("out"), tree)
     if "plot" in files.targets:
         from .plot.curve import curve_figure
 
-        fmt = PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()]
+        fmt = plot_format(files.targets["plot"])
         curve_figure(tree, files.temp("plot"), fmt)
     if "summary" in files.targets:
         write_json(files.temp("summary"), curve.summary)
-    files.commit()
+    if commit:
+        files.commit()
 
 
-def write_solve(solution, options: dict, files: ResultSet) -> None:
-    """The files of a :class:`~petsc_adhesion.tracing.curve.Solution`, committed together."""
+def write_solve(solution, options: dict, files: ResultSet, commit: bool = True) -> None:
+    """The files of a :class:`~petsc_adhesion.tracing.curve.Solution`, committed together (``commit``: as
+    :func:`write_curve`)."""
     if "out" in files.targets:
         write_h5(files.temp("out"), solve_tree(solution, options))
     if "summary" in files.targets:
         write_json(files.temp("summary"), solution.summary)
-    files.commit()
+    if commit:
+        files.commit()
 
 
 def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
@@ -137,7 +139,7 @@ def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict]
     if "plot" in files.targets:
         from .plot.study import critical_figure
 
-        critical_figure(tree, files.temp("plot"), PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()])
+        critical_figure(tree, files.temp("plot"), plot_format(files.targets["plot"]))
     if "summary" in files.targets:
         write_json(files.temp("summary"), summ)
     files.commit()
@@ -162,7 +164,7 @@ def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], f
     if "plot" in files.targets:
         from .plot.study import study_figure
 
-        fmt = PLOT_FORMATS[os.path.splitext(files.targets["plot"])[1].lower()]
+        fmt = plot_format(files.targets["plot"])
         study_figure(tree, files.temp("plot"), study["plot"], fmt)
     if "summary" in files.targets:
         write_json(files.temp("summary"), summ)

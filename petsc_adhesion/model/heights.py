@@ -26,6 +26,11 @@ def _check(S: np.ndarray, what: str) -> None:
         raise HeightFileError(f"{what}: {bad} of {S.size} heights are not finite")
     if S.size < 2 or S.min() == S.max():
         raise HeightFileError(f"{what}: all heights are equal, no roughness")
+    with np.errstate(over="ignore", invalid="ignore"):
+        spread = float(S.max() - S.min()) + float(np.sqrt(np.mean((S - np.mean(S)) ** 2)))
+    if not np.isfinite(spread):
+        raise HeightFileError(f"{what}: heights from {S.min():.3g} to {S.max():.3g}: their spread overflows double "
+                              f"precision")
 
 
 #: Length units accepted from a file header, in metres.
@@ -157,6 +162,9 @@ def _read_npy(path: str) -> np.ndarray:
         Z = np.load(path, allow_pickle=False)
     except (ValueError, EOFError) as e:
         raise HeightFileError(f"not a NumPy array file ({str(e).splitlines()[0]})") from None
+    if not isinstance(Z, np.ndarray):           # an .npz archive of several arrays
+        Z.close()
+        raise HeightFileError("is an .npz archive of several arrays, not one NumPy array (.npy)")
     if Z.ndim not in (1, 2) or Z.dtype.kind not in "iuf":
         raise HeightFileError(f"holds a {Z.ndim}-D {Z.dtype} array, not 1-D or 2-D real numbers")
     if Z.ndim == 2 and min(Z.shape) < 2:

@@ -39,7 +39,7 @@ import numpy as np
 from scipy.special import gamma, roots_jacobi
 
 from .. import brent
-from .heights import _check
+from .heights import HeightFileError, _check
 
 __all__ = ["TruncatedGaussian", "Weibull", "Measured", "WallQuadrature", "DISTRIBUTIONS", "NEAR_POINTS", "PANEL_POINTS", "panel_points", "distribution"]
 
@@ -101,7 +101,7 @@ class TruncatedGaussian:
         self.sigma, self.cutoff = float(sigma), float(cutoff)
         K = self.cutoff
         self._mass = math.erf(K / math.sqrt(2))
-        self.rms = self.sigma * math.sqrt(1 - 2 * K * math.exp(-K * K / 2) / (math.sqrt(2 * math.pi) * self._mass))
+        self.rms = self.sigma * math.sqrt(_truncated_variance(K))
         self.top, self.bottom = K * self.sigma, -K * self.sigma
         self.near_width = self.rms / 20
 
@@ -130,6 +130,27 @@ class TruncatedGaussian:
             ul, wl = _panels(np.linspace(c, U, math.ceil((U - c) / (6 * self.sigma)) + 1), n)
             u, w = np.concatenate([u, ul]), np.concatenate([w, wl])
         return u, w * self.depth_pdf(u)
+
+
+def _truncated_variance(K: float) -> float:
+    """The variance of the standard normal truncated to [-K, K]: 1 - 2 K phi(K) / (2 Phi(K) - 1).
+
+    Below K = 0.5 that difference cancels (it tends to K^2 / 3, a math domain error below
+    K = 1e-8): there the ratio of the two moments' Taylor series, which has no cancellation.
+
+    >>> round(_truncated_variance(3.0), 6), round(_truncated_variance(1e-9) / 1e-18, 12)
+    (0.973337, 0.333333333333)
+    """
+    if K >= 0.5:
+        return 1 - 2 * K * math.exp(-K * K / 2) / (math.sqrt(2 * math.pi) * math.erf(K / math.sqrt(2)))
+    # integral_0^K z^2 e^(-z^2/2) dz / integral_0^K e^(-z^2/2) dz, term by term
+    num = den = 0.0
+    term = 1.0                      # (-1/2)^n / n!
+    for n in range(30):
+        num += term * K ** (2 * n + 3) / (2 * n + 3)
+        den += term * K ** (2 * n + 1) / (2 * n + 1)
+        term *= -0.5 / (n + 1)
+    return num / den
 
 
 class Weibull:
@@ -252,6 +273,13 @@ class WallQuadrature:
         return g, self._w * V * self._pdf(u) * g
 
 
+#: The smallest rms of measured heights (units of epsilon).  The histogram's exact average sums terms of
+#: the size of the density's jumps, about bins / rms, whose rounding grows as 1 / rms: at rms = 1e-4 it
+#: is 5e-11 of P, at 1e-6 already 5e-9, more than the roughness changes P (about rms^2), and Newton
+#: stalls on that noise (1e-11 to 5e-8).  Below it the heights are smooth to the model.
+SMALLEST_RMS = 1e-4
+
+
 class Measured:
     """Measured heights, averaged through their histogram.
 
@@ -281,6 +309,9 @@ class Measured:
         S = S - S.mean()
         self.samples = S.size
         self.rms = self.sigma = float(np.sqrt(np.mean(S * S)))
+        if not self.rms >= SMALLEST_RMS:
+            raise HeightFileError(f"heights: rms {self.rms:.3g} epsilon, below {SMALLEST_RMS:g}: the histogram's average "
+                                  f"would round to more than the roughness changes (a smooth surface: -adh_roughness none)")
         self.skewness = float(np.mean(S ** 3)) / self.rms ** 3
         self.top, self.bottom = float(S.max()), float(S.min())
         if bins is None:

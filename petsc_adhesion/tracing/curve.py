@@ -29,7 +29,7 @@ __all__ = ["Event", "Curve", "Solution", "program_record", "model_record", "curv
 EVENT_KINDS = ("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda")
 #: The keys of an event (and of a landing) that a summary keeps.
 _BRIEF = ("kind", "lambda", "F", "H0", "contact_radius", "stable", "lambda_err", "F_err", "lambda_grid", "F_grid",
-          "F_beyond", "levels", "target_met", "error_note")
+          "F_beyond", "levels", "target_met", "error_note", "refinement_note")
 _LANDING = ("lambda", "F", "H0", "contact_radius", "F_err", "F_grid")
 
 

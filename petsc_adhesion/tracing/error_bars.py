@@ -20,10 +20,10 @@ from dataclasses import replace
 import numpy as np
 
 from ..core.events import EventFinder, ParameterValue
+from ..discretization.preconditioning import memory_available, memory_needed
 from ..discretization.resolution import NODES_PER_ZONE, cohesive_zone
 
-__all__ = ["relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE",
-           "MAX_LEVEL"]
+__all__ = ["relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE", "MAX_LEVEL", "too_large"]
 
 #: Steps a local trace may take to pass the event on another level.
 LOCAL_STEPS = 40
@@ -137,6 +137,22 @@ def coarse_levels(segments) -> tuple:
     return COARSE[:keep]
 
 
+def too_large(tracer, seg, level: int) -> str | None:
+    """Why the grid of ``seg`` at refinement ``level`` cannot be held in memory, or None when it can.
+
+    Its grid has (N - 1) 2^level + 1 nodes for the N of level 0 (nested levels), and
+    :func:`~petsc_adhesion.discretization.preconditioning.memory_needed` of them must fit in what the
+    machine has left (:func:`~petsc_adhesion.discretization.preconditioning.memory_available`).
+    """
+    n = (seg.problem.layout.N - 1) * 2 ** (level - tracer.level) + 1
+    need = memory_needed(n, getattr(tracer.pmat, "kind", "dense"), True, seg.problem.comm.getSize())
+    have = memory_available()
+    if need <= have:
+        return None
+    return f"refinement stopped before level {level}: its {n} nodes need {need / 2**30:.1f} GiB a rank, " \
+           f"this machine has {have / 2**30:.1f} GiB available"
+
+
 def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
     """Best values and error bars of one event's lambda and F (and its landing's F) from its levels.
 
@@ -174,14 +190,17 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
             out["landing"] = extrapolate(land)
         return out
 
-    est = bars()
+    est, stop = bars(), None
     while target_error and max(bar for _, bar in est.values()) > target_error and max(points) < MAX_LEVEL:
-        if not add(max(points) + 1):
+        stop = too_large(tracer, seg, max(points) + 1)
+        if stop or not add(max(points) + 1):
             break
         est = bars()
     out = {"lambda": est["lambda"][0], "lambda_err": est["lambda"][1], "F": est["F"][0], "F_err": est["F"][1],
            "levels": sorted(points),
            "target_met": not target_error or max(bar for _, bar in est.values()) <= target_error}
+    if stop and not out["target_met"]:
+        out["refinement"] = stop
     if "landing" in est:
         out["landing"] = {"F": est["landing"][0], "F_err": est["landing"][1], "F_grid": found.landing.values["F"]}
     return out

@@ -88,6 +88,8 @@ def event_record(problem, found, profiles: bool) -> dict:
     far = far_deflection(rm, model.coupling) if model.farfield else 0.0
     ev |= {"lambda_grid": ev["lambda"], "F_grid": ev["F"], "levels": est["levels"], "target_met": est["target_met"],
            "F_beyond": float(load_beyond(rm, ev["lambda"])) if model.farfield else 0.0}
+    if est.get("refinement"):
+        ev["refinement_note"] = est["refinement"]
     beyond = far + quadrature_error(problem, found.point)
     if found.label == "lambda":
         ev |= {"F": est["F"], "F_err": est["F_err"] + beyond, "lambda_err": 0.0}
@@ -234,9 +236,10 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
     missed = [e for e in res["events"] if e.get("target_met") is False]
     if missed:
         e = max(missed, key=lambda e: max(e.get("lambda_err", 0), e.get("F_err", 0)))
+        note = next((f"; {m['refinement_note']}" for m in missed if m.get("refinement_note")), "")
         short.append(f"-target_error not reached for {len(missed)} event(s): {e['kind']} at lambda = {e['lambda']:.6g} "
                      f"has lambda +- {e.get('lambda_err', 0):.1e}, F +- {e.get('F_err', 0):.1e} on levels up to "
-                     f"{max(e['levels'])}, the finest tried")
+                     f"{max(e['levels'])}, the finest tried{note}")
     found = [e["lambda"] for e in res["events"] if e["kind"] == "lambda"]
     for t in at_lambda:
         if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):

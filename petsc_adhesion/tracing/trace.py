@@ -29,6 +29,7 @@ import numpy as np
 
 from .. import brent
 from ..core.continuation import Continuation, Settings
+from ..core.start import start_petsc
 from ..core.events import EVENT_TOL, jumps
 from ..core.newton import PC_REUSE_ITS, Newton
 from ..discretization import grid, preconditioning, resolution
@@ -76,6 +77,13 @@ class GridChoice:
         if self.kind == "given":
             return float(self.r[-1])
         return RMAX if self.kind == "edge" else grid.PAPER_RMAX
+
+    @property
+    def size(self) -> int | None:
+        """The number of nodes, known before any is made; None for grids that follow the edge (made along the
+        curve, each a few hundred to a few thousand nodes)."""
+        return {"uniform": self.n, "paper": self.paper_uniform + self.paper_extra * (self.paper_split - 1),
+                "given": None if self.r is None else len(self.r)}.get(self.kind)
 
     def nodes(self, rmax: float) -> np.ndarray | None:
         """The nodes on [0, rmax]; None for grids that follow the contact edge (made along the curve)."""
@@ -144,12 +152,7 @@ def discretize(model, r: np.ndarray, pmat=None, comm=None) -> Problem:
 def _init() -> None:
     """PETSc, on a library call from a process that has not started it (the options of the caller's argv
     are not read: a program reading them calls petsc4py.init itself first)."""
-    import sys
-
-    if "petsc4py.PETSc" not in sys.modules:
-        import petsc4py
-
-        petsc4py.init([sys.argv[0] if sys.argv and sys.argv[0] else "petsc_adhesion"])
+    start_petsc()
 
 
 def _domain(model, grid_choice: GridChoice):

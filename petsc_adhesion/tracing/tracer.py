@@ -26,6 +26,7 @@ close to an event), unless the old grid no longer resolves the edge.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -266,14 +267,23 @@ class Tracer:
 
     def restore(self, state: dict) -> None:
         """Rebuild the segments of :meth:`state` (collective).  ValueError when a segment's grid has not the
-        number of nodes it had (another version of the grids)."""
+        number of nodes it had (another version of the grids), or for a state that is not a curve's."""
         for k, st in enumerate(state["segments"]):
             cont = st["continuation"]
-            settings = Settings(**{**cont["settings"], "monitor": self.set.monitor})
+            settings = Settings.from_state({**cont["settings"], "monitor": self.set.monitor})
+            if st["kind"] != ("fixed" if self.nodes is not None else st["kind"]) or \
+                    st["kind"] not in ("fixed", "edge", "scaled") or k == 0 and st["kind"] == "scaled":
+                raise ValueError(f"segment {k + 1} of a kind this run does not make ({st['kind']!r})")
+            where = [st["at"]] + ([st["band"]] if st["kind"] == "scaled" else [])
+            if st["kind"] != "fixed" and not all(isinstance(v, (int, float)) and math.isfinite(v) and v >= 0
+                                                 for v in where) or st["kind"] == "scaled" and not where[0] > 0:
+                raise ValueError(f"segment {k + 1} on a grid centred nowhere ({st['at']!r})")
+            if not (isinstance(st["guarded"], int) and st["guarded"] >= 0 and isinstance(st["N"], int)):
+                raise ValueError(f"segment {k + 1}'s counters are not counts")
             seg = self.segment(st["kind"], st["at"], settings=settings, band=st["band"])
             self.segments.append(seg)
             if seg.problem.layout.N != st["N"]:
-                raise ValueError(f"segment {k + 1} has {st['N']} nodes, this version makes {seg.problem.layout.N}")
+                raise ValueError(f"a segment {k + 1} of {st['N']} nodes, where this version makes {seg.problem.layout.N}")
             seg.problem.guarded = st["guarded"]
             seg.cont.restore(cont)
         for seg, st in zip(self.segments, state["segments"]):

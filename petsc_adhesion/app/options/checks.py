@@ -10,6 +10,7 @@ from petsc4py import PETSc
 
 from ... import brent
 from ...core import capi
+from ...discretization.preconditioning import memory_available, memory_needed
 from ...errors import InputError
 from ...model.parameters import Model
 from ...model.reference.jkr import jkr_zero_load
@@ -47,11 +48,11 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
         ignored += [(n, "refines error bars, which -cont_error_estimate false turns off") for n in
                     _given(opts, ["target_error"])]
     kind = opts.choice("grid_type")
-    if kind == "paper":
-        ignored += [(n, "is a -grid_type uniform option") for n in _given(opts, ["grid_n"])]
-    else:
-        ignored += [(n, "is a -grid_type paper option") for n in _given(opts, [n for n in TABLE
-                                                                                if n.startswith("grid_paper_")])]
+    if kind != "uniform":
+        ignored += [(n, f"is a -grid_type uniform option (this run's grid is {kind})") for n in _given(opts, ["grid_n"])]
+    if kind != "paper":
+        ignored += [(n, f"is a -grid_type paper option (this run's grid is {kind})")
+                    for n in _given(opts, [n for n in TABLE if n.startswith("grid_paper_")])]
     for name, kinds in ROUGHNESS_OPTIONS.items():
         if opts.db.hasName(name):
             if model.roughness not in kinds:
@@ -60,6 +61,15 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
                 ignored.append((name, "sets the roughness average, not used at -adh_sigma 0"))
     if opts.choice("adh_pmat") != "band":
         ignored += [(n, "applies to -adh_pmat band") for n in _given(opts, ["adh_pmat_band"])]
+    if opts.choice("adh_pmat") == "shell":
+        ignored += [(n, "keeps a preconditioning matrix, which -adh_pmat shell has none of")
+                    for n in _given(opts, ["adh_pc_reuse_its"])]
+    if opts.string("cont_checkpoint") == "none":
+        ignored += [(n, "times the saves that -cont_checkpoint none turns off")
+                    for n in _given(opts, ["cont_checkpoint_interval"])]
+    if opts.flag("progress") is False:
+        ignored += [(n, "times the progress lines that -progress false turns off")
+                    for n in _given(opts, ["progress_interval"])]
     if ignored:
         name, why = ignored[0]
         raise InputError(f"-{name}: {why}; remove it")
@@ -81,18 +91,20 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
                          f"reach of {DOMAIN_SHARE:.0%} of the attraction)")
 
 
-def check_memory(n: int, pmat: str, curve: bool, ranks: int) -> None:
-    """Refuse a grid whose dense matrices cannot fit: A, and G_H and the bordered
-    matrix when assembled densely, N^2 doubles each, split over the ranks."""
-    import os
-
-    dense = 1 + (pmat == "dense") * (1 + curve)
-    need = 8.0 * n * n * dense / ranks
-    have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    if need > 0.8 * have:
-        raise InputError(f"-grid_n: N = {n} needs {need / 2**30:.0f} GiB a rank for {dense} dense N x N "
-                         f"matrices, this machine has {have / 2**30:.0f} GiB; use fewer nodes, more ranks, "
-                         f"or -adh_pmat band")
+def check_memory(grid_choice, pmat: str, curve: bool, ranks: int) -> None:
+    """Refuse, before any node is made, a grid whose matrices cannot fit in the memory this machine has left:
+    the dense influence matrix and, with -adh_pmat dense, G_H, the bordered matrix and their factors
+    (:func:`~petsc_adhesion.discretization.preconditioning.memory_needed`), split over the ranks."""
+    n = grid_choice.size
+    if n is None:
+        return
+    need, have = memory_needed(n, pmat, curve, ranks), memory_available()
+    if need > have:
+        option = "-grid_n" if grid_choice.kind == "uniform" else "-grid_paper_extra"
+        cheaper = ", or -adh_pmat band" if pmat == "dense" else ""
+        raise InputError(f"{option}: N = {n} nodes need {need / 2**30:.1f} GiB a rank ({'a curve' if curve else 'a solve'}"
+                         f" with -adh_pmat {pmat}), this machine has {have / 2**30:.1f} GiB available; use fewer "
+                         f"nodes, more ranks{cheaper}")
 
 
 # -- PETSc's errors and options ------------------------------------------------------

@@ -1,9 +1,10 @@
 """-help: the application's options in their groups, with defaults, ranges and the solvers' prefixes."""
 from __future__ import annotations
 
+from ...errors import tell
 from .table import SOLVER_PREFIXES, TABLE, Option
 
-__all__ = ["HELP_GROUPS", "help_groups", "shown_default", "print_help"]
+__all__ = ["HELP_GROUPS", "help_groups", "shown_default", "print_help", "help_text"]
 
 
 #: The groups of -help and docs/usage.md: (title, the name prefixes of its options); the last takes the rest.
@@ -32,15 +33,20 @@ def shown_default(o: Option) -> str:
     return str(o.default)
 
 
-def print_help(out) -> None:
-    """Write the application options in their groups and the solvers' prefixes, as PETSc's -help writes its own."""
-    out.write("petsc-adhesion application options (PETSc's follow):\n")
+def help_text() -> str:
+    """The application options in their groups and the solvers' prefixes, as PETSc's -help writes its own."""
+    out = ["petsc-adhesion application options (PETSc's follow):"]
     for title, members in help_groups():
-        out.write(f" {title}:\n")
+        out.append(f" {title}:")
         for o in members:
             default = f" <{shown_default(o)}>" if shown_default(o) else ""
-            out.write(f"  -{o.name}{default}: {o.help}; {o.allowed()}\n")
-    out.write("Solvers, each tuned by PETSc's options under its own prefix (-{prefix}snes_*, -{prefix}ksp_*, "
-              "-{prefix}pc_*):\n")
-    for prefix, what in SOLVER_PREFIXES:
-        out.write(f"  -{prefix}snes_...: {what}\n")
+            out.append(f"  -{o.name}{default}: {o.help}; {o.allowed()}")
+    out.append("Solvers, each tuned by PETSc's options under its own prefix (-{prefix}snes_*, -{prefix}ksp_*, "
+               "-{prefix}pc_*):")
+    out += [f"  -{prefix}snes_...: {what}" for prefix, what in SOLVER_PREFIXES]
+    return "\n".join(out)
+
+
+def print_help(out=None) -> None:
+    """:func:`help_text` on ``out`` (stdout): a closed pipe is no error, a full device is (:func:`~petsc_adhesion.errors.tell`)."""
+    tell(help_text(), out)

@@ -9,8 +9,10 @@ import numpy as np
 from petsc4py import PETSc
 
 from ...errors import InputError, printable
+from ...io.inputs import check_input
 from ...model.heights import HeightFileError, read_heights
 from ...model.parameters import Model
+from ...model.parameters import tabor
 from ...model.physical import Bodies
 from ...model.roughness import Measured
 from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings
@@ -18,6 +20,16 @@ from .table import TABLE, Option
 
 __all__ = ["AppOptions", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
            "read_request", "read_settings"]
+
+
+#: The smallest positive Tabor parameter: below it the coupling mu^(3/2) of eq. (12) and the JKR scales
+#: underflow, and the curve is the rigid sphere's to double precision (mu = 0 is the rigid sphere itself).
+MU_SMALLEST = 1e-12
+#: The longest option value read: petsc4py's PETSc.Options.getString fills a buffer of 1024 bytes and cuts a
+#: longer value there without a word.
+MAX_VALUE = 1023
+#: The most values one option of a study may sweep (a study of that many curves takes days already).
+MAX_SWEEP = 10_000
 
 
 class AppOptions:
@@ -31,7 +43,12 @@ class AppOptions:
             raise KeyError(name)
         if not self.db.hasName(name):
             return None
-        return self.db.getString(name, "")
+        raw = self.db.getString(name, "")
+        if len(raw) >= MAX_VALUE:        # petsc4py reads a value into 1024 bytes: a longer one comes back cut
+            hint = " (a study's values as ranges lo:hi:n)" if TABLE[name].kind == "sweep" else ""
+            raise InputError(f"-{name}: a value of {MAX_VALUE} characters or more, of which PETSc reads only the first "
+                             f"{MAX_VALUE}: give a shorter one{hint}")
+        return raw
 
     def _bad(self, o: Option, raw: str) -> InputError:
         return InputError(f"-{o.name}: expected {o.allowed()}, got '{raw}'")
@@ -72,12 +89,18 @@ class AppOptions:
         o, raw = TABLE[name], self._raw(name)
         if raw is None:
             return o.default
+        items = raw.count(",") + 1
+        if items > MAX_SWEEP:                          # counted before anything is made of them
+            raise InputError(f"-{name}: {items} values; a sweep takes at most {MAX_SWEEP}")
         out = []
         for item in (s.strip() for s in raw.split(",")):
             try:
                 values = self._range(item) if ":" in item else (_strict_float(item),)
             except ValueError:
                 raise self._bad(o, raw) from None
+            except OverflowError:
+                raise InputError(f"-{name}: the range '{item}' has more than {MAX_SWEEP} values; a sweep takes "
+                                 f"at most {MAX_SWEEP}") from None
             out += [self._number(o, repr(x), float) for x in values]
         if not out:
             raise self._bad(o, raw)
@@ -91,6 +114,8 @@ class AppOptions:
         lo, hi, n = _strict_float(parts[0]), _strict_float(parts[1]), _strict_int(parts[2])
         if n < 2 or not lo < hi or (len(parts) == 4 and lo <= 0):
             raise ValueError(item)
+        if n > MAX_SWEEP:
+            raise OverflowError(item)
         xs = np.geomspace(lo, hi, n) if len(parts) == 4 else np.linspace(lo, hi, n)
         return tuple(float(x) for x in np.round(xs, 12))
 
@@ -199,13 +224,43 @@ def read_physical(opts: AppOptions) -> Bodies | None:
     if "rms" in given and opts.choice("adh_roughness") == "measured":
         raise InputError("-phys_rms: not with -adh_roughness measured, whose heights set sigma")
     bodies = Bodies(**given)
-    if not 0 <= bodies.mu <= TABLE["adh_mu"].hi:
-        raise InputError(f"-phys_radius: with the other -phys_ options gives mu = {bodies.mu:.3g} by eq. (9), "
-                         f"outside [0, {TABLE['adh_mu'].hi:g}]")
+    for name, value, why in (("phys_radius2" if "radius2" in given else "phys_radius", lambda: bodies.R,
+                              "the combined radius"),
+                             ("phys_young2" if "young2" in given else "phys_young1", lambda: bodies.E,
+                              "the combined modulus of eq. (2)"),
+                             ("phys_hamaker_cutoff" if "hamaker" in given else "phys_gamma",
+                              lambda: bodies.work_of_adhesion, "the work of adhesion")):
+        if not 0 < _finite(value) < math.inf:
+            raise InputError(f"-{name}: with the other -phys_ options gives no finite positive {why} in double "
+                             f"precision (the inputs under- or overflow); give the bodies' values in SI")
+    mu = _finite(lambda: bodies.mu)
+    # each input's share of log mu (eq. 9), against a 1 um polymer sphere: the option that moved mu most is named
+    shares = {"phys_radius": math.log(bodies.R / 1e-6) / 3,
+              ("phys_gamma" if "gamma" in given else "phys_hamaker"): 2 * math.log(bodies.work_of_adhesion / 0.05) / 3,
+              ("phys_young2" if "young2" in given and bodies.young2 < bodies.young1 else "phys_young1"):
+                  -2 * math.log(bodies.E / 1e9) / 3,
+              "phys_epsilon": -math.log(bodies.epsilon / 4e-10)}
+    logmu = math.log(tabor(1e-6, 0.05, 1e9, 4e-10)) + sum(shares.values())
+    if not mu <= TABLE["adh_mu"].hi:       # an overflow of eq. (9) too: its log says by how much
+        name = max(shares, key=shares.get)
+        raise InputError(f"-{name}: with the other -phys_ options gives mu = {math.exp(min(logmu, 700)):.3g} by "
+                         f"eq. (9), outside [0, {TABLE['adh_mu'].hi:g}]")
+    if mu < MU_SMALLEST:
+        name = min(shares, key=shares.get)
+        raise InputError(f"-{name}: with the other -phys_ options gives mu = {mu:.3g} by eq. (9), below "
+                         f"{MU_SMALLEST:g}: a rigid sphere to double precision; use -adh_mu 0")
     if bodies.sigma is not None and not bodies.sigma <= TABLE["adh_sigma"].hi:
         raise InputError(f"-phys_rms: gives sigma = rms / epsilon = {bodies.sigma:.3g}, above "
                          f"{TABLE['adh_sigma'].hi:g}")
     return bodies
+
+
+def _finite(value) -> float:
+    """``value()``, or nan where it divides by zero or overflows (underflowing inputs)."""
+    try:
+        return float(value())
+    except (ZeroDivisionError, OverflowError, ValueError):
+        return math.nan
 
 
 def read_model(opts: AppOptions) -> Model:
@@ -213,6 +268,9 @@ def read_model(opts: AppOptions) -> Model:
     rule."""
     phys = read_physical(opts)
     mu = phys.mu if phys else opts.real("adh_mu")
+    if 0 < mu < MU_SMALLEST:
+        raise InputError(f"-adh_mu: expected 0 (a rigid sphere) or a real in [{MU_SMALLEST:g}, {TABLE['adh_mu'].hi:g}], "
+                         f"got {mu:g}: below it mu^(3/2) underflows, and the sphere is rigid to double precision")
     rmax = opts.real("adh_rmax")
     if rmax is None:
         rmax = GridChoice(opts.choice("grid_type")).default_rmax
@@ -239,6 +297,7 @@ def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
         raise InputError("-adh_roughness_file: required with -adh_roughness measured: a file of heights")
     if opts.db.hasName("adh_sigma"):
         raise InputError("-adh_sigma: not with -adh_roughness measured, whose heights set it")
+    check_input("adh_roughness_file", path)
     try:
         heights = read_heights(path, epsilon, opts.real("adh_roughness_unit"))
         Measured(heights)

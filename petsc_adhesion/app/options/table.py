@@ -86,7 +86,7 @@ TABLE = {o.name: o for o in [
            choices=("none", *RULES_HERMITE, *DISTRIBUTIONS)),
     Option("adh_hermite_points", "int", Model.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
     Option("adh_roughness_cutoff", "real", Model.roughness_cutoff, "truncated_gaussian: the highest asperity, "
-           "in standard deviations (-adh_sigma) of the untruncated Gaussian", 0.0, 10.0, lo_open=True),
+           "in standard deviations (-adh_sigma) of the untruncated Gaussian", 1e-6, 10.0),
     Option("adh_roughness_skewness", "real", Model.roughness_skewness, "weibull: skewness of the heights "
            "(-2: exponential valleys, 0.5: the most symmetric bounded)", *Weibull.SKEWNESS),
     Option("adh_roughness_file", "string", None, "measured: heights, one a line in units of epsilon; a table "

@@ -13,12 +13,12 @@ USAGE = "usage: petsc-adhesion plot RESULT.h5 [-o OUT.png|OUT.pdf|OUT.svg]   (de
 
 def _kind(path: str) -> str:
     """The ``kind`` of a result file; InputError for what is not one."""
-    import os
-
     from ...errors import InputError
+    from ..inputs import file_problem
 
-    if not os.path.isfile(path):
-        raise InputError(f"plot: no file '{path}'")
+    why = file_problem(path)
+    if why:
+        raise InputError(f"plot: no file '{path}'" if why == "does not exist" else f"plot: '{path}' {why}")
     try:
         with h5py.File(path, "r") as f:
             kind = f.attrs.get("kind")
@@ -53,26 +53,39 @@ def command(args: list[str]) -> int:
     """
     import os
 
-    from ...errors import InputError, say
-    from ..resultset import PLOT_FORMATS, check_targets, written
+    from ...errors import InputError, first_line, printable, say, tell
+    from ..resultset import PLOT_FORMATS, check_targets, plot_format, written
 
     if args in (["-h"], ["-help"], ["--help"]):
-        print(USAGE)
+        try:
+            tell(USAGE)
+        except OSError as e:
+            say(f"error: cannot write '{e.filename}': {e.strerror}")
+            return 1
         return 0
     try:
         if len(args) not in (1, 3) or (len(args) == 3 and args[1] != "-o") or args[0].startswith("-"):
             raise InputError(f"plot: expected RESULT.h5 [-o OUT], got '{' '.join(args)}' ({USAGE})")
         src = args[0]
         out = args[2] if len(args) == 3 else os.path.splitext(src)[0] + ".png"
-        ext = os.path.splitext(out)[1].lower()
-        if ext not in PLOT_FORMATS:
+        fmt = plot_format(out)
+        if fmt is None:
             raise InputError(f"-o: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{out}'")
         kind = _kind(src)
         check_targets({"o": out}, {"plot": [src]})
         with written({"o": out}) as files:
-            _draw(kind, src, files.temp("o"), PLOT_FORMATS[ext])
+            try:
+                _draw(kind, src, files.temp("o"), fmt)
+            except (KeyError, TypeError, ValueError, IndexError, AttributeError, OSError) as e:
+                if isinstance(e, OSError) and e.filename:             # our own output
+                    raise
+                raise InputError(f"plot: '{src}' is not a whole {kind} result ({type(e).__name__}: "
+                                 f"{first_line(e)})") from None
             files.commit()
     except InputError as e:
-        say(f"error: {e}")
+        say(f"error: {printable(str(e))}")
         return 2
+    except OSError as e:
+        say(f"error: cannot write '{printable(str(e.filename or out))}': {e.strerror}")
+        return 1
     return 0

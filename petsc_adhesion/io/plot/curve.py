@@ -15,7 +15,7 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
-from .read import from_tree, read
+from .read import figure, from_tree, legend, read
 
 __all__ = ["load_approach", "profiles", "curve_figure", "solve_figure", "MARK"]
 
@@ -54,27 +54,24 @@ def profiles(ax_h, ax_p, r: np.ndarray, H: np.ndarray, P: np.ndarray, label: str
 
 def curve_figure(source, out: str, fmt: str = "png") -> None:
     """The load-approach curve of a result file or tree, with its event profiles when stored."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     res = read(source) if isinstance(source, str) else from_tree(source)
     with_profiles = [e for e in res["events"] if "H" in e]
     if with_profiles:
-        fig, (ax, ax_h, ax_p) = plt.subplots(3, 1, figsize=(6.4, 9.6))
+        fig = figure(figsize=(6.4, 9.6))
+        ax, ax_h, ax_p = fig.subplots(3, 1)
         for ev in with_profiles:
             kind = ev["kind"].decode() if isinstance(ev["kind"], bytes) else ev["kind"]
             profiles(ax_h, ax_p, ev.get("r", res["r"]), ev["H"], ev["P"], f"{kind} lambda = {ev['lambda']:.4f}")
-        ax_h.legend(fontsize=7)
+        legend(ax_h, fontsize=7)
     else:
-        fig, ax = plt.subplots(figsize=(6.4, 4.8))
+        fig = figure(figsize=(6.4, 4.8))
+        ax = fig.subplots()
     load_approach(ax, res)
-    ax.legend(fontsize=8)
+    legend(ax, fontsize=8)
     if res.get("physical"):
         _physical_axes(ax, res["physical"], ax_p if with_profiles else None)
     fig.tight_layout()
     fig.savefig(out, dpi=120, format=fmt)
-    plt.close(fig)
 
 
 def _physical_axes(ax, phys: dict, ax_p=None) -> None:
@@ -94,21 +91,17 @@ def _physical_axes(ax, phys: dict, ax_p=None) -> None:
 
 def solve_figure(path: str, out: str, fmt: str = "png") -> None:
     """H(r) and P(r) of a fixed-approach solve's file."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     with h5py.File(path, "r") as f:
         r, sol = f["grid/r"][()], f["solution"]
         H, P, lam, F = sol["H"][()], sol["P"][()], sol.attrs["lambda"], sol.attrs["F"]
         mu = f["model"].attrs["mu"]
-    fig, (ax_h, ax_p) = plt.subplots(2, 1, figsize=(6.4, 6.4), sharex=True)
+    fig = figure(figsize=(6.4, 6.4))
+    ax_h, ax_p = fig.subplots(2, 1, sharex=True)
     # out to where the stress has died away (the domain reaches r = 150)
     live = r[np.abs(P) > 1e-3 * np.abs(P).max()] if np.any(P) else r[:1]
     profiles(ax_h, ax_p, r, H, P, f"mu = {mu:g}, lambda = {lam:g}: F = {F:.6g}",
              rmax=min(float(r[-1]), max(4.0, 1.5 * float(live.max()))))
-    ax_h.legend(fontsize=8)
+    legend(ax_h, fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=120, format=fmt)
-    plt.close(fig)
 

@@ -1,9 +1,38 @@
-"""Result files read back for their figures: a curve's layout from an HDF5 file or group, or from a tree."""
+"""Result files read back for their figures (a curve's layout from an HDF5 file or group, or from a tree), and the
+figure they are drawn on."""
 from __future__ import annotations
+
+import os
+import sys
 
 import h5py
 
-__all__ = ["from_tree", "read", "read_group"]
+__all__ = ["from_tree", "read", "read_group", "figure", "legend"]
+
+
+def figure(**kw):
+    """A matplotlib Figure drawn by Agg into files, whatever the session's backend and MPLBACKEND say.
+
+    No pyplot: the figure belongs to no window and switches no backend of a notebook's; and an
+    MPLBACKEND that names no backend (matplotlib refuses to import then) is set aside while matplotlib
+    is first imported, since nothing here shows a window.
+    """
+    saved = None if "matplotlib" in sys.modules else os.environ.pop("MPLBACKEND", None)
+    try:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+    finally:
+        if saved is not None:
+            os.environ["MPLBACKEND"] = saved
+    fig = Figure(**kw)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def legend(ax, **kw) -> None:
+    """The legend of ``ax`` when something on it has a label (matplotlib warns on an empty one)."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(**kw)
 
 
 def from_tree(tree: dict) -> dict:

@@ -19,7 +19,7 @@ from collections import defaultdict
 import numpy as np
 
 from .curve import load_approach, profiles
-from .read import from_tree, read_group
+from .read import figure, from_tree, legend, read_group
 
 __all__ = ["read_study", "study_figure", "pull_offs", "read_critical", "critical_figure", "KINDS"]
 
@@ -78,7 +78,7 @@ def _curves(fig, tree):
     ax = fig.add_subplot(111)
     for c in _cases(tree):
         load_approach(ax, c, label=_label(c["values"]))
-    ax.legend(fontsize=7)
+    legend(ax, fontsize=7)
 
 
 def _folds(fig, tree):
@@ -118,7 +118,7 @@ def _profiles(fig, tree):
             land = e.get("landing", {})
             if "H" in land:
                 profiles(ax_h, ax_p, land["r"], land["H"], land["P"], name.replace("before", "after"), rmax=reach)
-    ax_h.legend(fontsize=6)
+    legend(ax_h, fontsize=6)
 
 
 def _series(tree: dict, x: str):
@@ -148,7 +148,7 @@ def _pull_off(fig, tree):
     ax.set_xscale("log")
     ax.set_xlabel("Tabor parameter mu")
     ax.set_ylabel("pull-off F_p / (2 pi R gamma)")
-    ax.legend(fontsize=7)
+    legend(ax, fontsize=7)
 
 
 def _reduction(fig, tree):
@@ -165,7 +165,7 @@ def _reduction(fig, tree):
         ax.errorbar(x, 100 * phi, yerr=100 * bar, marker="o", ms=3, capsize=2, label=label)
     ax.set_xlabel("roughness sigma")
     ax.set_ylabel("reduction of the pull-off, 1 - F_p / F_p(0)  (%)")
-    ax.legend(fontsize=7)
+    legend(ax, fontsize=7)
 
 
 KINDS = {"curves": _curves, "folds": _folds, "profiles": _profiles, "pull_off": _pull_off,
@@ -186,12 +186,9 @@ def read_critical(path: str) -> dict:
 def critical_figure(source, out: str, fmt: str = "png") -> None:
     """The boundary of hysteresis in (mu, sigma): sigma_c(mu) and mu_c(sigma) with their error bars,
     from a critical study's tree or file."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     tree = read_critical(source) if isinstance(source, str) else source
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    fig = figure(figsize=(6.4, 4.8))
+    ax = fig.subplots()
     rough, crit = tree.get("critical_roughness"), tree.get("critical_mu")
     if rough is not None and rough["mu"].size:
         ax.errorbar(rough["mu"], rough["sigma_c"], yerr=rough["sigma_c_err"], marker="o", ms=4, capsize=2,
@@ -204,24 +201,18 @@ def critical_figure(source, out: str, fmt: str = "png") -> None:
     ax.set_ylabel("roughness sigma / epsilon")
     ax.text(0.97, 0.05, "snap-on and snap-off\n(hysteresis)", transform=ax.transAxes, ha="right", fontsize=8)
     ax.text(0.03, 0.93, "no turning points", transform=ax.transAxes, va="top", fontsize=8)
-    ax.legend(fontsize=7, loc="upper center")
+    legend(ax, fontsize=7, loc="upper center")
     fig.tight_layout()
     fig.savefig(out, dpi=120, format=fmt)
-    plt.close(fig)
 
 
 def study_figure(source, out: str, kind: str, fmt: str = "png") -> None:
     """Draw ``kind`` (one of KINDS) from a study tree or file into ``out``."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     tree = read_study(source) if isinstance(source, str) else source
-    fig = plt.figure(figsize=(6.4, 4.8))
+    fig = figure(figsize=(6.4, 4.8))
     KINDS[kind](fig, tree)
     fig.tight_layout()
     fig.savefig(out, dpi=120, format=fmt)
-    plt.close(fig)
 
 
 if __name__ == "__main__":

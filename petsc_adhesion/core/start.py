@@ -1,0 +1,40 @@
+"""PETSc started for this program: its options read from a command line, the process's signal handlers kept.
+
+PETSc's start-up installs handlers of its own for SIGHUP, SIGPIPE, SIGINT and other
+signals: on SIGHUP or a broken pipe (``petsc-adhesion ... | head -1``) a run would
+end in PETSc's error page and MPI_Abort.  It is started with
+``-no_signal_handler`` (taken out of the options database again, so that no file
+records it), and the handlers the process had before (Python's: SIGPIPE ignored,
+so a write to a closed pipe is an error the writer sees; the command line's:
+SIGINT, SIGTERM and SIGHUP end the run in one line) are kept.
+"""
+from __future__ import annotations
+
+import importlib
+import signal
+import sys
+
+__all__ = ["start_petsc", "KEPT_SIGNALS"]
+
+#: The signals whose handlers the process keeps through PETSc's start-up.
+KEPT_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP", "SIGPIPE") if hasattr(signal, name))
+
+
+def start_petsc(argv: list[str] | None = None) -> bool:
+    """Initialise PETSc with ``argv`` (its options) unless it runs already; True when it was started here."""
+    if "petsc4py.PETSc" in sys.modules:
+        return False
+    import petsc4py
+
+    kept = {s: signal.getsignal(s) for s in KEPT_SIGNALS}
+    argv = list(argv if argv is not None else [sys.argv[0] if sys.argv and sys.argv[0] else "petsc_adhesion"])
+    asked = "-no_signal_handler" in argv
+    # PETSc installs its handlers early in its start-up, before it prints -help: none at all
+    petsc4py.init(argv if asked else argv + ["-no_signal_handler"])
+    PETSc = importlib.import_module("petsc4py.PETSc")     # initialises PETSc
+    if not asked:                                          # not the run's option: not in its files
+        PETSc.Options().delValue("no_signal_handler")
+    for s, handler in kept.items():
+        if handler is not None:
+            signal.signal(s, handler)
+    return True
