@@ -418,16 +418,16 @@ def _summary(data: dict) -> list[str]:
                 ratios.append(r["median_s"] / best[0]["median_s"])
     met = [f"{r['quantity']} {_t(r['median_s'])} (target {_t(r['target_s'])}: {'met' if r['met'] else 'missed'})"
            for r in sp.values()]
-    return ["- Item 5, work-precision diagrams: mu = 1, mu = 2 with sigma = 0.2 and mu = 5, every method asked for; "
+    return ["- Work-precision diagrams: mu = 1, mu = 2 with sigma = 0.2 and mu = 5, every method asked for; "
             "uniform grids reach N = 4001 at mu = 1 only (1601 and 801 in the other cases, for the time budget).",
-            f"- Item 6, against what users would use instead: the numpy/scipy code agrees with ours on the paper grid "
+            f"- Against what users would use instead: the numpy/scipy code agrees with ours on the paper grid "
             f"to 1e-10 and takes {npy['median_s'] / paper['median_s']:.1f} times our time there; ContactMechanics + "
             f"Adhesion (stored) takes {_t(min(cm_t))} to {_t(max(cm_t))} per curve for errors of {min(cm_e):.0e} to "
             f"{max(cm_e):.0e}, which our default grid matches in {_t(min(ours_t))} to {_t(max(ours_t))} (time ratios "
             f"{min(ratios):.0f} to {max(ratios):.0f} at equal accuracy), and it cannot locate the folds or follow "
             f"the unstable branch.",
-            "- Item 7, speed: " + "; ".join(met) + ".",
-            "- Item 8, scaling: N = 100 to 4000 on 1 and 2 ranks, dense and band"
+            "- Speed: " + "; ".join(met) + ".",
+            "- Scaling: N = 100 to 4000 on 1 and 2 ranks, dense and band"
             + (f"; N = 8000 measured for {', '.join(done8000)}" if done8000 else "; N = 8000 predicted over the time budget, not run")
             + (f"; the band preconditioner is faster from N = {n_cross} on one rank." if n_cross else ".")]
 
@@ -437,7 +437,7 @@ def render(data: dict) -> str:
     m = data["machine"]
     L = [f"<!-- made by: {COMMAND} (petsc_adhesion/benchmarks/workprecision); do not edit by hand -->",
          "# Performance: error against run time", "",
-         "Issue 9, items 5 to 8: work-precision diagrams, the comparison with what users would use instead, "
+         "Work-precision diagrams, the comparison with what users would use instead, "
          "speed and scaling.  Everything on this page (tables, figures, the statements with numbers) is written "
          "by one command,", "", "```sh", COMMAND, "```", "",
          f"(the opt-in part of `./run bench`; `./run bench -bench_workprecision` runs it after the default parts).  "
