@@ -41,7 +41,7 @@ def case(mu: float, sigma: float) -> list[dict]:
     petsc4py.init([sys.argv[0]])
     from ..core.events import jumps
     from ..discretization import preconditioning
-    from ..discretization.problem import Problem, far_approach
+    from ..discretization.problem import far_approach
     from ..model.parameters import Model
     from ..tracing import error_bars as error_estimate
     from ..tracing import results
@@ -55,7 +55,7 @@ def case(mu: float, sigma: float) -> list[dict]:
     out = []
     try:
         segments = tracer.run(far_approach(model))
-        jumps([seg.finder for seg in segments], Problem.stable)
+        jumps([seg.finder for seg in segments])
         for seg in segments:
             for f in seg.finder.found:
                 owners = [seg] + [s for s in segments if f.landing is not None and s.finder is f.landing_by]

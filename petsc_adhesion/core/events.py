@@ -8,16 +8,20 @@ corrector solve, eq. 24-25), never taken as the nearest computed point.
 =====================  =======================  ==========================================
 event                  test function            labels (by the sign before the zero)
 =====================  =======================  ==========================================
-:class:`Fold`          pdot                     + to -: p is largest; - to +: smallest
+:class:`Fold`          cdot = pdot + w v'       + to -: c is largest; - to +: smallest
 :class:`Extremum`      d(observable)/ds         - to +: minimum; + to -: maximum
 :class:`Zero`          observable - level       one label
-:class:`ParameterValue` p - target              one label
+:class:`ParameterValue` c - target              one label
 =====================  =======================  ==========================================
 
-Where the control is the parameter p, the solution jumps at a fold to
-another stable branch at the same p: forward along the curve from a fold
-where p is largest, backward from one where it is smallest
-(:meth:`EventFinder.jumps`).
+The control c = p + w v is what the experimenter sets: the parameter p itself
+(w = 0), or p behind a spring, c = p + v / K with v the load the spring
+carries and K its stiffness (an AFM cantilever's base position).  Where c is
+the control, the solution jumps at a turning point of c to another stable
+branch at the same c: forward along the curve from a fold where c is
+largest, backward from one where it is smallest (:meth:`EventFinder.jumps`);
+a point is stable where cdot > 0 (the curve starts on a stable branch with c
+growing; stability changes only at turning points of c).
 """
 from __future__ import annotations
 
@@ -49,21 +53,32 @@ class _Below(Exception):
 
 @dataclass(frozen=True)
 class Fold:
-    """Turning point in p: pdot changes sign. ``labels``: (p largest, p smallest).
+    """Turning point of the control c = p + ``weight`` v (v the observable ``name``): cdot changes sign.
+    ``labels``: (c largest, c smallest).  The default weight 0 is a turning point in p.
 
-    Two folds inside one step leave pdot with one sign at both ends; the
-    :class:`EventFinder` looks for them where the sampled pdot dips toward zero.
+    Two folds inside one step leave cdot with one sign at both ends; the
+    :class:`EventFinder` looks for them where the sampled cdot dips toward zero.
     """
 
     labels: tuple = ("fold_max", "fold_min")
+    weight: float = 0.0
+    name: str = "F"
     needs_tangent = True
 
+    def value(self, pt) -> float:
+        """The control at a point: c = p + weight v (needs no tangent)."""
+        return pt.p + self.weight * pt.values[self.name] if self.weight else pt.p
+
     def test(self, pt) -> float:
-        """The test function at a point: pdot."""
-        return pt.pdot
+        """The test function at a point: cdot = pdot + weight dv/ds."""
+        return pt.pdot + self.weight * pt.rates[self.name] if self.weight else pt.pdot
+
+    def stable(self, pt) -> bool:
+        """Stable under control of c: cdot > 0."""
+        return self.test(pt) > 0
 
     def label(self, before: float) -> str:
-        """The name of the fold, by the sign of pdot before it."""
+        """The name of the fold, by the sign of cdot before it."""
         return self.labels[0] if before > 0 else self.labels[1]
 
 
@@ -107,15 +122,18 @@ class Zero:
 
 @dataclass(frozen=True)
 class ParameterValue:
-    """The parameter crosses ``target``."""
+    """The control c = p + ``weight`` v (v the observable ``name``; the parameter p itself by default)
+    crosses ``target``."""
 
     target: float
     tag: str = "p"
+    weight: float = 0.0
+    name: str = "F"
     needs_tangent = False
 
     def test(self, pt) -> float:
-        """The test function at a point: p - target."""
-        return pt.p - self.target
+        """The test function at a point: c - target."""
+        return (pt.p + self.weight * pt.values[self.name] if self.weight else pt.p) - self.target
 
     def label(self, before: float) -> str:
         """The event's one name."""
@@ -281,7 +299,7 @@ class EventFinder:
         a = self.cont.points[f.segment]
         return self.cont.inner(a.xdot, f.point.x - a.x) + a.pdot * (f.point.p - a.p)
 
-    def jumps(self, stable) -> None:
+    def jumps(self, stable=None) -> None:
         """For each fold, the state it jumps to (``Found.landing``): :func:`jumps` on this one curve."""
         jumps([self], stable)
 
@@ -316,45 +334,50 @@ class EventFinder:
         self.found = found
 
 
-def jumps(finders, stable) -> None:
+def jumps(finders, stable=None) -> None:
     """For each fold found by ``finders`` (the segments of one curve, in order), the state on another
-    stable branch at the same p (``Found.landing``).
+    stable branch at the same control c (``Found.landing``).
 
-    Under control of p the state jumps forward along the curve from a fold
-    where p is largest, backward from one where it is smallest: the first
-    crossing of the fold's p on a step whose ends are ``stable(point)`` in that
+    Under control of c the state jumps forward along the curve from a fold
+    where c is largest, backward from one where it is smallest: the first
+    crossing of the fold's c on a step whose ends are stable under c in that
     direction is where it lands, located on that step's own segment.  Steps
     between segments (a change of discretization) are not crossings.
+    ``stable(point)``: stability under control of c (default :meth:`Fold.stable`,
+    cdot > 0: for a curve that starts stable with c growing).
     """
     steps = [(f, j) for f in finders for j in range(len(f.cont.points) - 1)]
-    for k, finder in enumerate(finders):
+    for finder in finders:
         for ev in finder.found:
             if not isinstance(ev.event, Fold):
                 continue
+            fold = ev.event
+            ok = stable or fold.stable
             at = steps.index((finder, ev.segment))
-            pf = ev.point.p
+            cf = fold.value(ev.point)
             order = steps[at + 1:] if ev.before > 0 else steps[at - 1::-1] if at else []
-            if _near_landing(finder, ev, stable):
+            if _near_landing(finder, ev, ok):
                 continue
             for owner, j in order:
                 a, b = owner.cont.points[j], owner.cont.points[j + 1]
-                if stable(a) and stable(b) and (a.p - pf) * (b.p - pf) <= 0:
-                    ev.landing = owner.locate(a, b, lambda pt: pt.p, level=pf, tangent=False)
+                if ok(a) and ok(b) and (fold.value(a) - cf) * (fold.value(b) - cf) <= 0:
+                    ev.landing = owner.locate(a, b, fold.value, level=cf, tangent=False)
                     ev.landing_by, ev.landing_step = owner, j
                     break
 
 
 def _near_landing(finder: EventFinder, ev: Found, stable) -> bool:
-    """The landing of the fold ``ev`` on the step of the next fold (forward jump) or of the one before
-    (backward), whose other end is unstable: on the arc that fold was located on, beyond it (before
-    it), then, for a pair inside one step, from that arc's end to the step's end (from the step's
+    """The landing of the fold ``ev`` on the step of the next fold of its control (forward jump) or of the
+    one before (backward), whose other end is unstable: on the arc that fold was located on, beyond it
+    (before it), then, for a pair inside one step, from that arc's end to the step's end (from the step's
     start to the arc's start).  Found or not."""
-    folds = [f for f in finder.found if isinstance(f.event, Fold)]
+    fold = ev.event
+    folds = [f for f in finder.found if f.event is fold]
     k = next(i for i, f in enumerate(folds) if f is ev) + (1 if ev.before > 0 else -1)
     other = folds[k] if 0 <= k < len(folds) else None
     if other is None or other.arc is None:
         return False
-    pts, pf = finder.cont.points, ev.point.p
+    pts, cf = finder.cont.points, fold.value(ev.point)
     point, s0, at, s1 = other.arc
     pieces = [(point, at, s1)] if ev.before > 0 else [(point, s0, at)]
     if other.segment == ev.segment:
@@ -362,10 +385,12 @@ def _near_landing(finder: EventFinder, ev: Found, stable) -> bool:
     for piece in pieces:
         if len(piece) == 3:
             arc, lo, hi = piece
-            if (arc(lo).p - pf) * (arc(hi).p - pf) <= 0 and stable(arc(hi if ev.before > 0 else lo)):
-                ev.landing = arc(finder._root(arc, lo, hi, lambda pt: pt.p, pf), True)
-        elif stable(piece[0]) and stable(piece[1]) and (piece[0].p - pf) * (piece[1].p - pf) <= 0:
-            ev.landing = finder.locate(*piece, lambda pt: pt.p, level=pf, tangent=False)
+            if (fold.value(arc(lo)) - cf) * (fold.value(arc(hi)) - cf) <= 0 and \
+                    stable(arc(hi if ev.before > 0 else lo)):
+                ev.landing = arc(finder._root(arc, lo, hi, fold.value, cf), True)
+        elif stable(piece[0]) and stable(piece[1]) and \
+                (fold.value(piece[0]) - cf) * (fold.value(piece[1]) - cf) <= 0:
+            ev.landing = finder.locate(*piece, fold.value, level=cf, tangent=False)
         if ev.landing is not None:
             ev.landing_by, ev.landing_step = finder, other.segment
             return True

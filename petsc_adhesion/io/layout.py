@@ -11,11 +11,13 @@ _EPS, _LOAD, _RAD, _PRES = "epsilon", "2 pi R gamma", "sqrt(epsilon R)", "8 gamm
 _STATE = f"lambda, H0: {_EPS}; F: {_LOAD}"
 
 
-_ERRORS = f"lambda_err, lambda_grid: {_EPS}; F_err, F_grid, F_beyond: {_LOAD}; contact_radius: {_RAD}"
+_ERRORS = (f"lambda_err, lambda_grid, Z, Z_err, Z_grid: {_EPS}; F_err, F_grid, F_beyond: {_LOAD}; "
+           f"contact_radius, contact_radius_err, contact_radius_grid: {_RAD}")
 
 
 _PHYS = ("R_m, epsilon_m: m; E_Pa: Pa; gamma_J_m2: J/m^2; mu: 1; sigma: epsilon; force_nN: nN per 2 pi R gamma; "
-         "approach_nm: nm per epsilon; radius_nm: nm per sqrt(epsilon R); pressure_MPa: MPa per 8 gamma / (3 epsilon)")
+         "approach_nm: nm per epsilon; radius_nm: nm per sqrt(epsilon R); pressure_MPa: MPa per 8 gamma / (3 epsilon); "
+         "work_aJ: aJ per 2 pi R gamma epsilon")
 
 
 #: path pattern (numbered groups as *) -> (units, one-line description), for every group and dataset
@@ -45,17 +47,22 @@ DESCRIBE = {
     "curve/H0": (_EPS, "separation at r = 0"),
     "curve/lambdadot": ("1", "d lambda / ds of the unit tangent (s: pseudo-arclength)"),
     "curve/stable": ("", "stable under displacement control (lambdadot > 0)"),
+    "curve/contact_radius": (_RAD, "contact radius: where the separation first rises through the edge level "
+                                   "(docs/numerics.md), on the grid of the point"),
+    "curve/Z": (_EPS, "base position of the spring (-afm_spring K): Z = lambda + F / K"),
+    "curve/stable_spring": ("", "stable behind the spring (dZ/ds > 0)"),
     "curve/ds": ("1", "the step that reached the point (0 at the start)"),
     "curve/newton_its": ("", "Newton iterations of the corrector"),
     "curve/ksp_its": ("", "Krylov iterations of the corrector and the tangent"),
     "curve/corrector": ("", "start, natural (eq. 21-22) or arclength (eq. 24-25)"),
     "events": ("", "events located on the curve, in the order found"),
     "events/*": (f"{_STATE}; {_ERRORS}", "one event: kind (snap_on, snap_off, F_min, F_max, equilibrium, "
-                 "lambda), its state, stability, error estimates"),
+                 "lambda; behind a spring jump_in, jump_off), its state, stability, error estimates"),
     "events/*/r": (_RAD, "the nodes of the grid the event was located on (-profiles)"),
     "events/*/H": (_EPS, "separation at the nodes at the event (-profiles)"),
     "events/*/P": (_PRES, "pressure at the nodes at the event (-profiles)"),
-    "events/*/landing": (_STATE, "where the jump from this fold lands: the other stable branch at its lambda"),
+    "events/*/landing": (f"{_STATE}; {_ERRORS}", "where the jump from this fold lands: the other stable branch "
+                         "at its lambda (behind a spring: at its Z)"),
     "events/*/landing/r": (_RAD, "the nodes of the grid the landing was located on (-profiles)"),
     "events/*/landing/H": (_EPS, "separation at the nodes after the jump (-profiles)"),
     "events/*/landing/P": (_PRES, "pressure at the nodes after the jump (-profiles)"),
@@ -67,7 +74,8 @@ DESCRIBE = {
     "cases/*/values": ("", "the options this case sets (name without the dash: value)"),
     "failed": ("", "the cases of a study that did not run or failed, each with its one-line reason"),
     "table": (f"{_STATE}; {_ERRORS}", "every case's events, one row each: case number, the swept options, kind, "
-              "best lambda and F with their error bars (NaN: none), the single-grid values"),
+              "best lambda and F with their error bars (NaN: none), the single-grid values, Z behind a spring, "
+              "the contact radius with its bar"),
     "table/*": ("", "one column of the table (units as the table's)"),
     "critical_roughness": (f"mu: 1; sigma_c*: {_EPS}; lambda_c*: {_EPS}; F_c*: {_LOAD}; wall_time_s: s",
                            "the critical roughness sigma_c(mu), above which the curve has no turning points: one "
@@ -124,7 +132,8 @@ def study_table(done: list[dict], axes: list[str]) -> dict:
     cols = {"case": np.array([r["case"] for r, _ in rows], dtype=int)}
     cols |= {name: np.array([r["values"][name] for r, _ in rows], dtype=float) for name in axes}
     cols["kind"] = np.array([e["kind"] for _, e in rows], dtype="S12")
-    for k in ("lambda", "lambda_err", "F", "F_err", "lambda_grid", "F_grid"):
+    for k in ("lambda", "lambda_err", "F", "F_err", "lambda_grid", "F_grid", "Z", "Z_err", "contact_radius",
+              "contact_radius_err"):
         cols[k] = np.array([e.get(k, np.nan) for _, e in rows], dtype=float)
     return cols
 

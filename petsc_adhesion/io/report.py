@@ -17,6 +17,14 @@ def _note(e: dict) -> str:
     return "  (no error bar: not found again on the nested levels)" if e.get("error_note") else ""
 
 
+def _energy(s: dict) -> str:
+    """The energy of a cycle with its bar and the number of loops, or why there is none."""
+    if s["energy"] is None:
+        return f"none: {s.get('energy_note', 'no cycle')}"
+    loops = f"{s['loops']} hysteresis loop{'s' * (s['loops'] != 1)}"
+    return f"{_pm(s, 'energy', 8)}  ({loops})"
+
+
 def report_curve(s: dict) -> None:
     """The console lines of a curve's summary (rank 0)."""
     out = []
@@ -34,6 +42,15 @@ def report_curve(s: dict) -> None:
         out.append(f"  equilibrium F = 0       {_pm(e, 'lambda')}{_note(e)}")
     for e in s["at_lambda"]:
         out.append(f"  at lambda               {_pm(e, 'lambda')}  {_pm(e, 'F')}{_note(e)}")
+    out.append(f"  energy of a cycle       {_energy(s)}  (rigid machine)")
+    sp = s.get("spring")
+    if sp:
+        for f in sp["jumps"]:
+            land = f.get("landing")
+            to = f"  -> lands at {_pm(land, 'lambda')}  {_pm(land, 'F')}" if land else ""
+            out.append(f"  {f['kind']:<8} (K = {sp['K']:.4g})  {_pm(f, 'Z')}  {_pm(f, 'lambda')}  {_pm(f, 'F')}{to}"
+                       f"{_note(f)}")
+        out.append(f"  energy of a cycle       {_energy(sp)}  (spring K = {sp['K']:.4g})")
     if "physical" in s:
         out += _physical_lines(s["physical"])
     for w in s["warnings"]:
@@ -54,10 +71,17 @@ def _physical_lines(p: dict) -> list[str]:
     out = [f"  in physical units: R = {radius}, E = {p['E_Pa'] / 1e9:.4g} GPa, gamma = "
            f"{p['gamma_J_m2'] * 1e3:.4g} mJ/m^2, epsilon = {p['epsilon_m'] * 1e9:.4g} nm: mu = {p['mu']:.4g}{sigma}"]
     events = ([("pull-off", p["pull_off"])] if p["pull_off"] else []) + \
-        [(e["kind"], e) for k in ("folds", "equilibria", "at_lambda") for e in p[k]]
+        [(e["kind"], e) for k in ("folds", "equilibria", "at_lambda") for e in p[k]] + \
+        [(e["kind"], e) for e in p.get("spring", {}).get("jumps", [])]
     for name, e in events:
         force = f"  {_nm_nN(e, 'F', 'nN')}" if "F_nN" in e and name != "equilibrium" else ""
-        out.append(f"    {name:<21}  {_nm_nN(e, 'lambda', 'nm')}{force}  contact radius {e['contact_radius_nm']:.4g} nm")
+        base = f"  {_nm_nN(e, 'Z', 'nm')}" if "Z_nm" in e else ""
+        out.append(f"    {name:<21}{base}  {_nm_nN(e, 'lambda', 'nm')}{force}  contact radius "
+                   f"{e['contact_radius_nm']:.4g} nm")
+    for name, q in (("rigid machine", p), (f"spring k = {p['spring']['k_N_m']:.4g} N/m", p.get("spring")) if "spring" in p
+                    else (None, None)):
+        if name and "energy_aJ" in q:
+            out.append(f"    energy of a cycle, {name}: {_nm_nN(q, 'energy', 'aJ')}")
     return out
 
 

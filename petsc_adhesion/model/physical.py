@@ -24,7 +24,7 @@ __all__ = ["Bodies", "HAMAKER_CUTOFF", "UNITS", "in_units"]
 #: Israelachvili's cut-off distance D0 between contacting solids (m).
 HAMAKER_CUTOFF = 0.165e-9
 #: The units results are reported in, with their value in SI.
-UNITS = {"nN": 1e-9, "nm": 1e-9, "MPa": 1e6}
+UNITS = {"nN": 1e-9, "nm": 1e-9, "MPa": 1e6, "aJ": 1e-18}
 
 
 @dataclass(frozen=True)
@@ -73,6 +73,11 @@ class Bodies:
         """The rms roughness in units of epsilon (None when not given)."""
         return None if self.rms is None else self.rms / self.epsilon
 
+    def spring_stiffness(self, k: float) -> float:
+        """The dimensionless stiffness K = k epsilon / (2 pi R gamma) of a spring of k N/m (a cantilever):
+        its force k delta in units of 2 pi R gamma for an extension delta in units of epsilon."""
+        return k * self.epsilon / (2 * math.pi * self.R * self.work_of_adhesion)
+
     def scales(self) -> dict:
         """The SI values of the model's units (:func:`~petsc_adhesion.model.parameters.scales`)."""
         return scales(self.R, self.work_of_adhesion, self.E, self.epsilon)
@@ -87,13 +92,17 @@ class Bodies:
         return {"inputs": given, "R_m": self.R, "E_Pa": self.E, "gamma_J_m2": self.work_of_adhesion,
                 "epsilon_m": self.epsilon, "mu": self.mu, **({"sigma": self.sigma} if self.rms is not None else {}),
                 "force_nN": sc["force_N"] / UNITS["nN"], "approach_nm": sc["approach_m"] / UNITS["nm"],
-                "radius_nm": sc["radius_m"] / UNITS["nm"], "pressure_MPa": sc["pressure_Pa"] / UNITS["MPa"]}
+                "radius_nm": sc["radius_m"] / UNITS["nm"], "pressure_MPa": sc["pressure_Pa"] / UNITS["MPa"],
+                "work_aJ": sc["force_N"] * sc["approach_m"] / UNITS["aJ"]}
 
 
 #: event key -> (the scale it is in, the suffix of its physical key)
 _CONVERT = {"lambda": ("approach_nm", "nm"), "lambda_err": ("approach_nm", "nm"), "lambda_grid": ("approach_nm", "nm"),
             "H0": ("approach_nm", "nm"), "F": ("force_nN", "nN"), "F_err": ("force_nN", "nN"),
-            "F_grid": ("force_nN", "nN"), "contact_radius": ("radius_nm", "nm")}
+            "F_grid": ("force_nN", "nN"), "contact_radius": ("radius_nm", "nm"),
+            "contact_radius_err": ("radius_nm", "nm"), "contact_radius_grid": ("radius_nm", "nm"),
+            "Z": ("approach_nm", "nm"), "Z_err": ("approach_nm", "nm"), "Z_grid": ("approach_nm", "nm"),
+            "energy": ("work_aJ", "aJ"), "energy_err": ("work_aJ", "aJ")}
 
 
 def _event(e: dict, d: dict) -> dict:
@@ -105,8 +114,16 @@ def _event(e: dict, d: dict) -> dict:
 
 
 def in_units(summary: dict, d: dict) -> dict:
-    """The ``physical`` object of a curve's summary: ``d`` (:meth:`Bodies.describe`) and every event of
+    """The ``physical`` object of a curve's summary: ``d`` (:meth:`Bodies.describe`), every event of
     ``summary`` in nm and nN (``lambda_nm``, ``F_nN``, their ``_err`` and ``_grid``, ``H0_nm``,
-    ``contact_radius_nm``)."""
+    ``contact_radius_nm``), the energy of a cycle in aJ (``energy_aJ``, ``energy_err_aJ``) and, behind a
+    spring, its stiffness in N/m (``k_N_m``), its jumps (``Z_nm`` too) and energy."""
     lists = {k: [_event(e, d) for e in summary[k]] for k in ("folds", "equilibria", "load_extrema", "at_lambda")}
-    return {**d, "pull_off": _event(summary["pull_off"], d) if summary["pull_off"] else None, **lists}
+    out = {**d, "pull_off": _event(summary["pull_off"], d) if summary["pull_off"] else None, **lists,
+           **_event({k: summary[k] for k in ("energy", "energy_err")}, d)}
+    if summary.get("spring"):
+        sp = summary["spring"]
+        out["spring"] = {"k_N_m": sp["K"] * d["force_nN"] / d["approach_nm"],
+                         "jumps": [_event(e, d) for e in sp["jumps"]],
+                         **_event({k: sp[k] for k in ("energy", "energy_err")}, d)}
+    return out

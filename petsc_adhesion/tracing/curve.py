@@ -26,11 +26,13 @@ __all__ = ["Event", "Curve", "Solution", "program_record", "model_record", "curv
            "EVENT_KINDS"]
 
 #: The kinds of events of a curve (:mod:`~petsc_adhesion.tracing.results` names them).
-EVENT_KINDS = ("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda")
+EVENT_KINDS = ("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda", "jump_in", "jump_off")
 #: The keys of an event (and of a landing) that a summary keeps.
-_BRIEF = ("kind", "lambda", "F", "H0", "contact_radius", "stable", "lambda_err", "F_err", "lambda_grid", "F_grid",
-          "F_beyond", "levels", "target_met", "error_note", "refinement_note")
-_LANDING = ("lambda", "F", "H0", "contact_radius", "F_err", "F_grid")
+_BRIEF = ("kind", "lambda", "F", "Z", "H0", "contact_radius", "stable", "lambda_err", "F_err", "Z_err",
+          "contact_radius_err", "lambda_grid", "F_grid", "Z_grid", "contact_radius_grid", "F_beyond", "levels",
+          "target_met", "error_note", "refinement_note")
+_LANDING = ("lambda", "F", "Z", "H0", "contact_radius", "lambda_err", "F_err", "Z_err", "contact_radius_err",
+            "lambda_grid", "F_grid")
 
 
 def program_record(comm) -> dict:
@@ -56,13 +58,15 @@ class Event:
 
     ``kind``: snap_on, snap_off (the turning points in lambda), F_min, F_max (the
     extrema of the load; the most tensile F_min is the pull-off under load control),
-    equilibrium (F = 0) or lambda (a state asked for).  ``lam`` and ``F`` are the best
+    equilibrium (F = 0), lambda (a state asked for), or behind a spring jump_in and
+    jump_off (the turning points of its base Z = lambda + F / K, ``Z`` and ``Z_err``
+    its value and bar; stable is then None, the state marginal under the spring).  ``lam`` and ``F`` are the best
     values (Richardson-extrapolated over nested grids), ``lam_err`` and ``F_err`` their
     error bars, ``lam_grid`` and ``F_grid`` the values on the grid the event was located
     on (None, like the bars, without an error estimate: ``note`` says why).  ``stable``
     is None at a fold (marginal).  ``landing``: where the jump from a fold lands (kind
     ``"landing"``).  ``contact_radius``: where the separation rises through the edge
-    level, on that grid (no bar).  ``r``, ``H``, ``P``: the profiles of eq. (12) and (14)
+    level (docs/numerics.md), its best value with ``contact_radius_err`` its bar.  ``r``, ``H``, ``P``: the profiles of eq. (12) and (14)
     when asked for, else None.
     """
 
@@ -81,6 +85,9 @@ class Event:
     target_met: bool | None = None
     note: str | None = None
     landing: Event | None = None
+    Z: float | None = None
+    Z_err: float | None = None
+    contact_radius_err: float | None = None
     r: np.ndarray | None = field(default=None, repr=False)
     H: np.ndarray | None = field(default=None, repr=False)
     P: np.ndarray | None = field(default=None, repr=False)
@@ -93,7 +100,8 @@ class Event:
         return cls(kind=e["kind"], lam=float(e["lambda"]), F=float(e["F"]), H0=float(e["H0"]),
                    stable=None if e.get("stable") is None else bool(e["stable"]), lam_err=num("lambda_err"),
                    F_err=num("F_err"), lam_grid=num("lambda_grid"), F_grid=num("F_grid"), F_beyond=num("F_beyond"),
-                   contact_radius=num("contact_radius"), levels=tuple(int(k) for k in e.get("levels", ())),
+                   contact_radius=num("contact_radius"), contact_radius_err=num("contact_radius_err"),
+                   Z=num("Z"), Z_err=num("Z_err"), levels=tuple(int(k) for k in e.get("levels", ())),
                    target_met=e.get("target_met"), note=e.get("error_note"),
                    landing=cls.from_record({"kind": "landing", **e["landing"]}) if e.get("landing") else None,
                    r=e.get("r"), H=e.get("H"), P=e.get("P"))
@@ -126,10 +134,16 @@ def _common(head: dict) -> dict:
     return {**flat, **head["model"], "n_nodes": int(max(sizes))}
 
 
+def _cycle(c: dict) -> dict:
+    return {"energy": c["energy"], "energy_err": c["energy_err"], "loops": c["loops"],
+            **({"energy_note": c["energy_note"]} if "energy_note" in c else {})}
+
+
 def curve_summary(res: dict, head: dict) -> dict:
     """The summary of a traced curve (``res``: :func:`~.trace.trace_curve`'s record; ``head``: the program,
     model, grid and physical inputs)."""
     ev, po = res["events"], res["pull_off"]
+    cycles = res["cycles"]
     s = {**_common(head),
          "pull_off": _brief(po) if po else None,
          "folds": [_brief(e) for e in ev if e["kind"] in ("snap_on", "snap_off")],
@@ -137,6 +151,10 @@ def curve_summary(res: dict, head: dict) -> dict:
                         for e in ev if e["kind"] == "equilibrium"],
          "load_extrema": [_brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
          "at_lambda": [_brief(e) for e in ev if e["kind"] == "lambda"],
+         **_cycle(cycles["rigid"]),
+         **({"spring": {"K": cycles["spring"]["K"],
+                        "jumps": [_brief(e) for e in ev if e["kind"] in ("jump_in", "jump_off")],
+                        **_cycle(cycles["spring"])}} if "spring" in cycles else {}),
          "wall_gap": res["wall_gap"],
          "steps": res["steps"], "rejected_steps": res["rejected_steps"], "regrids": res["regrids"],
          **{k: res[k] for k in ("guard_activations", "smallest_step", "most_newton_its", "most_ksp_its")},
@@ -166,8 +184,9 @@ class Curve:
 
     ``lam``, ``F``, ``H0`` and ``stable`` hold one entry a computed point, in the order
     traced (lambda = alpha / epsilon, F in 2 pi R gamma by eq. (26), H0 = H(0), stable
-    under displacement control); ``branch`` holds those and the step statistics of
-    every point (docs/output.md, the HDF5 group ``curve``).  ``events`` in the order
+    under displacement control); ``branch`` holds those, the contact radius, behind a
+    spring Z and the stability under it, and the step statistics of every point
+    (docs/output.md, the HDF5 group ``curve``).  ``events`` in the order
     found; ``pull_off`` the most tensile load minimum (load control).  ``summary`` is
     the dict a ``-summary`` file holds; ``head`` the program, model, grid and physical
     inputs it was computed with; ``records`` the events as the result files hold them.
@@ -195,8 +214,29 @@ class Curve:
         return list(self.summary["warnings"])
 
     def events_of(self, kind: str) -> tuple:
-        """The events of one kind: snap_on, snap_off, F_min, F_max, equilibrium or lambda."""
+        """The events of one kind: snap_on, snap_off, F_min, F_max, equilibrium, lambda, jump_in or jump_off."""
         return tuple(e for e in self.events if e.kind == kind)
+
+    @property
+    def contact_radius(self) -> np.ndarray:
+        """The contact radius of every computed point (docs/numerics.md; units sqrt(epsilon R))."""
+        return self.branch["contact_radius"]
+
+    @property
+    def Z(self) -> np.ndarray | None:
+        """Behind a spring, its base position Z = lambda + F / K at every computed point (else None)."""
+        return self.branch.get("Z")
+
+    @property
+    def energy(self) -> tuple:
+        """(energy, bar) dissipated in one approach-retract cycle with a rigid machine (units 2 pi R gamma
+        epsilon; 0 without hysteresis; None when the cycle cannot be closed or has no bar)."""
+        return self.summary["energy"], self.summary["energy_err"]
+
+    @property
+    def spring(self) -> dict | None:
+        """Behind a spring: {K, jumps, energy, energy_err, loops} as the summary holds it (else None)."""
+        return self.summary.get("spring")
 
     @classmethod
     def from_result(cls, res: dict, head: dict) -> Curve:
@@ -206,7 +246,13 @@ class Curve:
                   "stable": np.array([p.pdot > 0 for p in pts]), "ds": np.array([p.ds for p in pts]),
                   "newton_its": np.array([p.newton_its for p in pts]), "ksp_its": np.array([p.ksp_its for p in pts]),
                   "H0": np.array([p.x[0] for p in pts]), "lambdadot": np.array([p.pdot for p in pts]),
-                  "corrector": np.array([p.corrector for p in pts], dtype="S9")}
+                  "corrector": np.array([p.corrector for p in pts], dtype="S9"),
+                  "contact_radius": np.array(res["contact_radius"], dtype=float)}
+        spring = res["cycles"].get("spring")
+        if spring is not None:            # behind a spring: its base Z = lambda + F / K, stable where dZ/ds > 0
+            K = spring["K"]
+            branch["Z"] = branch["lambda"] + branch["F"] / K
+            branch["stable_spring"] = np.array([p.pdot + p.rates["F"] / K > 0 for p in pts])
         records = [{k: v for k, v in e.items() if k != "segment"} for e in res["events"]]
         summary = curve_summary(res, head)
         events = [Event.from_record(e) for e in records]

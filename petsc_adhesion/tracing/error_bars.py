@@ -22,6 +22,7 @@ import numpy as np
 from ..core.events import EventFinder, ParameterValue
 from ..discretization.preconditioning import memory_available, memory_needed
 from ..discretization.resolution import NODES_PER_ZONE, cohesive_zone
+from .tracer import carry, contact_radius
 
 __all__ = ["relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE", "MAX_LEVEL", "too_large"]
 
@@ -45,15 +46,18 @@ def relocate(tracer, seg, found, level: int, target=None):
     sigma = 0.2, the pull-off moved back past the step's first point), carried
     to that level, and traces with steps no longer than the step that found the
     event until the event's test function changes sign; of several such events,
-    the one nearest in lambda.  ``target``: for a landing, the approach to find
-    (the fold's own at that level), from the step's first point.  Returns the
-    located point, or None.
+    the one nearest in lambda.  ``target``: for a landing, the control to find
+    (the fold's own at that level: its lambda, or its base position Z behind a
+    spring), from the step's first point.  Returns the located point with its
+    contact radius on that level's grid among its values (``contact_radius``),
+    or None.
     """
     j = found.segment if target is None else found.landing_step
     owner = seg if target is None else next(s for s in tracer.segments if s.finder is found.landing_by)
     a, b = owner.cont.points[j], owner.cont.points[j + 1]
     back = owner.cont.points[j - 1] if target is None and j > 0 else a
-    event = found.event if target is None else ParameterValue(target, "landing")
+    fold = found.event
+    event = fold if target is None else ParameterValue(target, "landing", fold.weight, fold.name)
     length = max(b.ds, 1e-3) if b.ds else 0.05
     settings = replace(tracer.set, ds=length / 2, ds_max=length, max_steps=LOCAL_STEPS, max_folds=10**6,
                        monitor=False)
@@ -65,7 +69,8 @@ def relocate(tracer, seg, found, level: int, target=None):
         if start is None:
             return None
         finder = EventFinder(new.cont, [event], tracer.tol or 1e-10)
-        if target is not None and (a.p - target) * (b.p - target) > 0 and abs(a.p - target) > 2 * length:
+        if target is not None and (fold.value(a) - target) * (fold.value(b) - target) > 0 and \
+                abs(fold.value(a) - target) > 2 * length:
             return None
         behind = a.ds if back is not a and a.ds else 0.0        # an event found there may be another
 
@@ -77,14 +82,15 @@ def relocate(tracer, seg, found, level: int, target=None):
 
         new.cont.run(start, on_step=finder, until=far)
         hits = [f for f in finder.found if f.label == found.label] if target is None else finder.found
-        return min(hits, key=lambda f: abs(f.point.p - found.point.p)).point if hits else None
+        if not hits:
+            return None
+        pt = min(hits, key=lambda f: abs(f.point.p - found.point.p)).point
+        return replace(pt, values={**pt.values, "contact_radius": contact_radius(new.problem, pt.x)})
     finally:
         new.destroy()
 
 
 def _carry_start(old, new, pt):
-    from .tracer import carry
-
     return carry(old, new, pt)
 
 
@@ -154,16 +160,27 @@ def too_large(tracer, seg, level: int) -> str | None:
 
 
 def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
-    """Best values and error bars of one event's lambda and F (and its landing's F) from its levels.
+    """Best values and error bars of one event's lambda, F and contact radius (and its landing's) from its
+    levels.
 
     Levels 0, -1, -2 by default, as far as they resolve the edge (:func:`coarse_levels`), then finer ones;
     where a coarse level does not yield the event, 0,
-    1, 2; with ``target_error``, finer levels up to MAX_LEVEL until every bar is
-    below it (``target_met`` says whether it was).  Returns {lambda, F,
-    lambda_err, F_err, levels, target_met} and, for a fold with a landing,
-    {landing: {F, F_err, F_grid}}; {} when no other level yields the event.
+    1, 2; with ``target_error``, finer levels up to MAX_LEVEL until every bar of lambda and F is
+    below it (``target_met`` says whether it was).  Returns {lambda, F, contact_radius, their
+    ``_err``, levels, target_met}, for a turning point of a spring's control also {Z, Z_err}, and for
+    a fold with a landing {landing: {F, F_err, F_grid, contact_radius, contact_radius_err}} (behind a
+    spring, whose landing moves in lambda, also {lambda, lambda_err, lambda_grid}); {} when no other
+    level yields the event.
     """
-    points, landing = {0: found.point}, {0: found.landing}
+    fold = found.event
+    spring = bool(getattr(fold, "weight", 0.0))
+    points = {0: replace(found.point, values={**found.point.values,
+                                              "contact_radius": contact_radius(seg.problem, found.point.x)})}
+    landing = {}
+    if found.landing is not None:
+        land = found.landing
+        landing[0] = replace(land, values={**land.values,
+                                           "contact_radius": contact_radius(found.landing_by.cont.pb, land.x)})
 
     def add(level: int) -> bool:
         pt = relocate(tracer, seg, found, level)
@@ -171,7 +188,7 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
             return False
         points[level] = pt
         if found.landing is not None:
-            landing[level] = relocate(tracer, seg, found, level, target=pt.p)
+            landing[level] = relocate(tracer, seg, found, level, target=fold.value(pt))
         return True
 
     owners = [seg] + [s for s in tracer.segments if found.landing is not None and s.finder is found.landing_by]
@@ -182,25 +199,40 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
         if not add(max(points) + 1):
             return {}
 
+    def series(pts, key):
+        return {k: (p.p if key == "lambda" else fold.value(p) if key == "Z" else p.values[key])
+                for k, p in pts.items() if p is not None}
+
     def bars():
-        out = {"lambda": extrapolate({k: p.p for k, p in points.items()}),
-               "F": extrapolate({k: p.values["F"] for k, p in points.items()})}
-        land = {k: p.values["F"] for k, p in landing.items() if p is not None}
-        if found.landing is not None and len(land) >= 2:
-            out["landing"] = extrapolate(land)
+        out = {key: extrapolate(series(points, key)) for key in ("lambda", "F", "contact_radius")}
+        if spring:
+            out["Z"] = extrapolate(series(points, "Z"))
+        land = {key: series(landing, key) for key in ("lambda", "F", "contact_radius")}
+        if found.landing is not None and len(land["F"]) >= 2:
+            out["landing"] = {key: extrapolate(v) for key, v in land.items()}
         return out
 
+    def largest(est) -> float:
+        """The bar -target_error watches: lambda and F, of the event and its landing."""
+        return max([est[k][1] for k in ("lambda", "F")] +
+                   ([est["landing"][k][1] for k in ("F", *(("lambda",) if spring else ()))] if "landing" in est else []))
+
     est, stop = bars(), None
-    while target_error and max(bar for _, bar in est.values()) > target_error and max(points) < MAX_LEVEL:
+    while target_error and largest(est) > target_error and max(points) < MAX_LEVEL:
         stop = too_large(tracer, seg, max(points) + 1)
         if stop or not add(max(points) + 1):
             break
         est = bars()
-    out = {"lambda": est["lambda"][0], "lambda_err": est["lambda"][1], "F": est["F"][0], "F_err": est["F"][1],
-           "levels": sorted(points),
-           "target_met": not target_error or max(bar for _, bar in est.values()) <= target_error}
+    out = {k: v for key in ("lambda", "F", "contact_radius", "Z") if key in est
+           for k, v in ((key, est[key][0]), (f"{key}_err", est[key][1]))}
+    out |= {"levels": sorted(points), "target_met": not target_error or largest(est) <= target_error}
     if stop and not out["target_met"]:
         out["refinement"] = stop
     if "landing" in est:
-        out["landing"] = {"F": est["landing"][0], "F_err": est["landing"][1], "F_grid": found.landing.values["F"]}
+        land = est["landing"]
+        out["landing"] = {"F": land["F"][0], "F_err": land["F"][1], "F_grid": found.landing.values["F"],
+                          "contact_radius": land["contact_radius"][0], "contact_radius_err": land["contact_radius"][1]}
+        if spring:
+            out["landing"] |= {"lambda": land["lambda"][0], "lambda_err": land["lambda"][1],
+                               "lambda_grid": found.landing.p}
     return out

@@ -8,6 +8,8 @@ kind           core event              meaning
 =============  ======================  =============================================
 snap_on        fold, lambda largest    jump-in on approach (displacement control)
 snap_off       fold, lambda smallest   jump-out on retraction
+jump_in        fold of Z, Z largest    behind a spring of stiffness K, Z = lambda + F / K: jump-in
+jump_off       fold of Z, Z smallest   ... and jump-off (K -> 0: the pull-off; K -> inf: snap_on, snap_off)
 F_min, F_max   extremum of F           the most tensile F_min is the load-controlled pull-off
 equilibrium    F = 0                   zero load
 lambda         lambda = target         state asked for by -cont_at_lambda
@@ -15,7 +17,8 @@ lambda         lambda = target         state asked for by -cont_at_lambda
 
 Under displacement control a point is stable when lambdadot > 0; a fold's
 landing is the state on the other stable branch at the same lambda after the
-jump (Figs. 6, 7).
+jump (Figs. 6, 7).  Behind a spring (an AFM cantilever, its base at Z) a point
+is stable when dZ/ds > 0, and a jump lands at the same Z.
 """
 from __future__ import annotations
 
@@ -27,18 +30,26 @@ from mpi4py import MPI
 from ..core.events import Extremum, Fold, ParameterValue, Zero
 from ..discretization import grid
 from ..model.reference.rigid import far_deflection, load_beyond
+from . import energy
 from .tracer import contact_radius
 
-__all__ = ["curve_events", "curve", "stop_reason", "assess", "WALL_GAP", "event_record", "QUADRATURE_MARGIN", "quadrature_error", "EDGE_SHARE", "PEAK_ATTRACTION"]
+__all__ = ["curve_events", "spring_fold", "curve", "stop_reason", "assess", "WALL_GAP", "event_record", "QUADRATURE_MARGIN", "quadrature_error", "EDGE_SHARE", "PEAK_ATTRACTION"]
 
 #: Closer than this to the wall of the roughness rule, a state is set by its smallest weights.
 WALL_GAP = 1e-3
 
 
-def curve_events(at_lambda=()) -> list:
-    """The events of a load-approach curve, in the order they are tested at every step."""
+def curve_events(at_lambda=(), spring: float | None = None) -> list:
+    """The events of a load-approach curve, in the order they are tested at every step; with a ``spring``
+    of stiffness K (units 2 pi R gamma / epsilon), the turning points of its base Z = lambda + F / K too."""
     return [Fold(("snap_on", "snap_off")), Extremum("F", ("F_min", "F_max")), Zero("F", "equilibrium"),
-            *(ParameterValue(t, "lambda") for t in at_lambda)]
+            *(ParameterValue(t, "lambda") for t in at_lambda),
+            *([Fold(("jump_in", "jump_off"), 1.0 / spring, "F")] if spring else [])]
+
+
+def spring_fold(events) -> Fold | None:
+    """The turning points of a spring's base among ``events`` (None without a spring)."""
+    return next((e for e in events if isinstance(e, Fold) and e.weight), None)
 
 
 def _H0(problem, pt) -> float:
@@ -52,8 +63,10 @@ def _whole(problem, local: np.ndarray):
     return np.concatenate(parts) if parts is not None else None
 
 
-def _state(problem, pt, profiles: bool) -> dict:
+def _state(problem, pt, profiles: bool, spring=None) -> dict:
     out = {"lambda": pt.p, "F": pt.values["F"], "H0": _H0(problem, pt), "contact_radius": contact_radius(problem, pt.x)}
+    if spring is not None:
+        out["Z"] = spring.value(pt)
     if profiles:
         r = problem.nodes(pt.x)
         H = _whole(problem, problem.separation(pt.x))
@@ -72,11 +85,12 @@ def event_record(problem, found, profiles: bool) -> dict:
     remainder, the deflection that attraction causes inside, enters both bars
     (:func:`~petsc_adhesion.model.reference.far_deflection`).
     """
-    ev = {"kind": found.label, **_state(problem, found.point, profiles), "segment": found.segment}
-    if not isinstance(found.event, Fold):          # at a fold lambdadot = 0: marginal
+    spring = found.event if isinstance(found.event, Fold) and found.event.weight else None
+    ev = {"kind": found.label, **_state(problem, found.point, profiles, spring), "segment": found.segment}
+    if not isinstance(found.event, Fold):          # at a fold of its control the state is marginal
         ev["stable"] = bool(problem.stable(found.point))
     if found.landing is not None:
-        ev["landing"] = _state(found.landing_by.cont.pb, found.landing, profiles)
+        ev["landing"] = _state(found.landing_by.cont.pb, found.landing, profiles, spring)
     est = getattr(found, "estimate", None)
     if est is None:
         return ev
@@ -87,7 +101,9 @@ def event_record(problem, found, profiles: bool) -> dict:
     rm = float(problem.nodes(found.point.x)[-1])
     far = far_deflection(rm, model.coupling) if model.farfield else 0.0
     ev |= {"lambda_grid": ev["lambda"], "F_grid": ev["F"], "levels": est["levels"], "target_met": est["target_met"],
-           "F_beyond": float(load_beyond(rm, ev["lambda"])) if model.farfield else 0.0}
+           "F_beyond": float(load_beyond(rm, ev["lambda"])) if model.farfield else 0.0,
+           "contact_radius_grid": ev["contact_radius"], "contact_radius": est["contact_radius"],
+           "contact_radius_err": est["contact_radius_err"]}
     if est.get("refinement"):
         ev["refinement_note"] = est["refinement"]
     beyond = far + quadrature_error(problem, found.point)
@@ -98,10 +114,16 @@ def event_record(problem, found, profiles: bool) -> dict:
     else:
         ev |= {"lambda": est["lambda"], "lambda_err": est["lambda_err"] + beyond, "F": est["F"],
                "F_err": est["F_err"] + beyond}
+    if spring is not None:
+        ev |= {"Z_grid": ev["Z"], "Z": est["Z"], "Z_err": est["Z_err"] + beyond * (1 + spring.weight)}
     if "landing" in ev and "landing" in est:
         land = est["landing"]
         ev["landing"] |= {"lambda": ev["lambda"], "F": land["F"], "F_err": land["F_err"] + beyond,
-                          "F_grid": land["F_grid"]}
+                          "F_grid": land["F_grid"], "contact_radius": land["contact_radius"],
+                          "contact_radius_err": land["contact_radius_err"]}
+        if spring is not None:              # the same Z; lambda moves by the spring's extension
+            ev["landing"] |= {"lambda": land["lambda"], "lambda_err": land["lambda_err"] + beyond,
+                              "lambda_grid": land["lambda_grid"], "Z": ev["Z"], "Z_err": ev["Z_err"]}
     return ev
 
 
@@ -152,8 +174,19 @@ def curve(segments, profiles: bool = False) -> dict:
     Collective.  ``profiles`` (rank 0, else empty): the nodes and the pressure of
     every point, for the resolution check.
     """
-    events = [event_record(seg.problem, f, profiles) for seg in segments for f in seg.finder.found]
+    found = [(seg, f) for seg in segments for f in seg.finder.found]
+    events = [event_record(seg.problem, f, profiles) for seg, f in found]
     pts = [p for seg in segments for p in seg.cont.points]
+    radii = [contact_radius(seg.problem, p.x) for seg in segments for p in seg.cont.points]
+    record = {id(f): e for (_, f), e in zip(found, events)}
+    cycles = {}
+    for fold in (e for e in segments[0].finder.events if isinstance(e, Fold)):
+        cyc = energy.cycle(segments, fold)
+        bar = energy.energy_bar(cyc, fold, lambda f: record[id(f)])
+        cycles["spring" if fold.weight else "rigid"] = {
+            "energy": cyc["energy"], "energy_err": bar, "loops": cyc.get("loops", 0),
+            **({"energy_note": cyc["note"]} if "note" in cyc else {}),
+            **({"K": 1.0 / fold.weight} if fold.weight else {})}
     states = []
     for seg in segments:
         pb = seg.problem
@@ -164,7 +197,7 @@ def curve(segments, profiles: bool = False) -> dict:
     mins = [e for e in events if e["kind"] == "F_min"]
     last = segments[-1].cont
     lowest = min(float(seg.problem.separation(p.x).min()) for seg in segments for p in seg.cont.points)
-    return {"points": pts, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
+    return {"points": pts, "contact_radius": radii, "cycles": cycles, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
             "wall_gap": segments[-1].problem.comm.tompi4py().allreduce(lowest, op=MPI.MIN) - segments[-1].problem.law.wall,
             "steps": sum(len(seg.cont.points) - 1 for seg in segments),
             "rejected_steps": sum(seg.cont.rejected for seg in segments),
@@ -240,6 +273,12 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
         short.append(f"-target_error not reached for {len(missed)} event(s): {e['kind']} at lambda = {e['lambda']:.6g} "
                      f"has lambda +- {e.get('lambda_err', 0):.1e}, F +- {e.get('F_err', 0):.1e} on levels up to "
                      f"{max(e['levels'])}, the finest tried{note}")
+    spring = spring_fold(segments[0].finder.events)
+    start = next(seg for seg in segments if not seg.far).cont.points[0]
+    if spring is not None and not spring.stable(start):
+        short.append(f"the curve starts where the spring (K = {1 / spring.weight:.4g}) cannot hold the sphere "
+                     f"(dZ/ds < 0 at lambda = {start.p:.6g}): its jump-in lies before the start; give "
+                     f"-cont_lambda_start further apart, or leave it to the default")
     found = [e["lambda"] for e in res["events"] if e["kind"] == "lambda"]
     for t in at_lambda:
         if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):

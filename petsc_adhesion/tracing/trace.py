@@ -42,7 +42,7 @@ from .edge_grids import RMAX, grid_for
 from .tracer import Tracer
 
 __all__ = ["GridChoice", "SolverChoice", "CurveRequest", "curve_settings", "trace_curve", "solve_at", "rigid_edge",
-           "discretize", "configure_solvers", "expected_end", "F_MAX", "GRID_KINDS"]
+           "discretize", "configure_solvers", "expected_end", "F_MAX", "GRID_KINDS", "spring_start"]
 
 #: The load at which a curve stops by default: past equilibrium, into compression.
 F_MAX = 2.0
@@ -120,7 +120,9 @@ class CurveRequest:
     record the state; ``event_tol``: the location tolerance of events in lambda; ``error_bars``: every event
     located again on nested levels of its grid for its best value and bar, refined to ``target_error`` when
     given; ``profiles``: H(r) and P(r) at every event; ``kinds``: the event kinds reported (None: all; the
-    others are left out, unestimated).
+    others are left out, unestimated); ``spring``: the stiffness K of a spring the approach is driven
+    through (an AFM cantilever, units 2 pi R gamma / epsilon; None: a rigid machine), whose base
+    Z = lambda + F / K jumps at its turning points (events jump_in, jump_off).
     """
 
     lambda_start: float | None = None
@@ -130,6 +132,11 @@ class CurveRequest:
     target_error: float | None = None
     profiles: bool = False
     kinds: tuple | None = None
+    spring: float | None = None
+
+    def __post_init__(self):
+        if self.spring is not None and not (self.spring > 0 and math.isfinite(self.spring)):
+            raise ValueError(f"spring stiffness {self.spring!r}: expected a finite K > 0")
 
 
 def curve_settings(**changes) -> Settings:
@@ -225,9 +232,11 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
     model = _domain(model, grid_choice)
     settings = settings or curve_settings()
     lam0 = far_approach(model) if request.lambda_start is None else request.lambda_start
+    if request.spring and request.lambda_start is None:
+        lam0 = min(lam0, spring_start(request.spring))
     nodes = grid_choice.nodes(model.rmax)
     t0 = t1 = time.perf_counter()
-    tracer = Tracer(model, settings, results.curve_events(request.at_lambda), request.event_tol, nodes=nodes,
+    tracer = Tracer(model, settings, results.curve_events(request.at_lambda, request.spring), request.event_tol, nodes=nodes,
                     pmat=solver.strategy(), rmax=model.rmax, comm=comm)
     kinds = request.kinds
     kept = (lambda label: True) if kinds is None else (lambda label: label in kinds or label == "lambda")
@@ -253,7 +262,9 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
 
         if phase == "trace":
             segments = tracer.run(lam0, started, pause)
-            jumps([seg.finder for seg in segments], Problem.stable)
+            if request.spring:
+                _reach_landings(tracer, results.spring_fold(tracer.events))
+            jumps([seg.finder for seg in segments])
             spent["trace"] += time.perf_counter() - t0
         else:
             segments = tracer.segments
@@ -332,6 +343,25 @@ def solve_at(lam: float, model, grid_choice: GridChoice = GridChoice(), solver: 
             if obj is not None:
                 obj.destroy()
     return Solution.from_result(res, _head(comm, model, {"r": r}))
+
+
+def spring_start(K: float) -> float:
+    """An approach where a spring of stiffness K still holds the sphere well (the default start of a
+    curve behind it): the rigid sphere's load falls like -4 / (3 (1 - lambda)^2) far out (eq. 28), its
+    slope |dF/dlambda| = 8 / (3 (1 - lambda)^3) is K / 2 here, and the jump-in (K + dF/dlambda = 0) lies
+    ahead."""
+    return 1.0 - (16.0 / (3.0 * K)) ** (1.0 / 3.0)
+
+
+def _reach_landings(tracer, fold) -> None:
+    """Trace the curve back from its start (:meth:`~.tracer.Tracer.extend_back`) far enough for the jumps
+    off the contact to land: where the base Z of the spring ``fold`` falls below the smallest Z of its
+    jump-offs (Z < lambda there, the load being tensile)."""
+    offs = [fold.value(f.point) for seg in tracer.segments for f in seg.finder.found
+            if f.event is fold and f.before < 0]
+    first = tracer.segments[0].cont.points[0]
+    if offs and min(offs) <= fold.value(first):
+        tracer.extend_back(min(offs) - 1.0 - 1e-3 * abs(min(offs)))
 
 
 def expected_end(model, settings) -> float:

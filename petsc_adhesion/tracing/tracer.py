@@ -51,7 +51,7 @@ from .edge_grids import (
     sharp,
 )
 
-__all__ = ["edge_of", "contact_radius", "Segment", "Tracer", "carry"]
+__all__ = ["edge_of", "contact_radius", "Segment", "Tracer", "carry", "FAR_STEPS"]
 
 
 def edge_of(problem, x: np.ndarray) -> float:
@@ -81,6 +81,7 @@ class Segment:
     problem: object
     cont: Continuation
     finder: EventFinder
+    far: bool = False     # the far branch traced back from the start (Tracer.extend_back)
 
     def destroy(self) -> None:
         """Free the segment's PETSc objects."""
@@ -177,6 +178,11 @@ class _Regrid:
         return False
 
 
+#: Steps at most of the far branch traced back from the start (:meth:`Tracer.extend_back`); its steps grow
+#: by the continuation's factor 1.5 a step, so 200 reach lambda = -1e15 from a step of 0.05.
+FAR_STEPS = 200
+
+
 class Tracer:
     """Trace a curve in segments: on a fixed grid (one segment), or on grids that follow the edge."""
 
@@ -253,6 +259,48 @@ class Tracer:
                 return self.segments
             seg, start = regrid.next
             self.segments.append(seg)
+
+    def extend_back(self, p_min: float) -> Segment | None:
+        """The curve before its start, down to the approach ``p_min``, as a new first segment (collective).
+
+        Behind a soft spring the jump off the contact lands far out, where the sphere
+        is nearly rigid and the load falls like lambda^-2: the far branch is traced
+        backward from the first point on the first segment's grid, with steps that
+        grow without bound (:data:`FAR_STEPS` at most), and put in front of the curve in
+        its order (tangents reversed).  None when the first point is already there.
+        """
+        first = self.segments[0]
+        a = first.cont.points[0]
+        if a.p <= p_min:
+            return None
+        settings = replace(self.set, ds=self.set.ds, ds_max=1e15, p_min=p_min, p_max=math.inf,
+                           observable_max=math.inf, max_steps=FAR_STEPS, max_folds=0, monitor=False)
+        seg = self.segment(first.kind, first.grid.edge if first.grid is not None else None, settings=settings)
+        try:
+            x = seg.problem.create_vec()
+            x.setArray(a.x)
+            try:
+                start = seg.cont.start(x, a.p, direction=-1)
+            finally:
+                x.destroy()
+            seg.cont.run(start)
+        except BaseException:
+            seg.destroy()
+            raise
+        if seg.cont.stop[0] != "p_min":
+            seg.destroy()
+            raise RuntimeError(f"the far branch could not be traced back to lambda = {p_min:.6g} "
+                               f"({seg.cont.stop[0]} at lambda = {seg.cont.points[-1].p:.6g})")
+        # in the curve's order; a point's step is then the one from the point before it, its length that
+        # point's distance along its own tangent (the corrector of the backward run measured it from the
+        # other end), and "far" marks it so that an event search on it takes that distance
+        pts = [p.reversed() for p in reversed(seg.cont.points)]
+        seg.cont.points = [replace(pts[0], ds=0.0, corrector="start")] + [
+            replace(b, ds=seg.cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p), corrector="far")
+            for a, b in zip(pts, pts[1:])]
+        seg.far = True
+        self.segments.insert(0, seg)
+        return seg
 
     def state(self, solvers: bool = True) -> dict:
         """The curve traced so far as plain data, local parts of its vectors included (a checkpoint saves it):

@@ -43,7 +43,8 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
     if fixed:
         ignored += [(n, "applies to a curve, not with -adh_lambda") for n in
                     _given(opts, [n for n in TABLE if n.startswith(("cont_", "progress"))] + ["profiles", "plot",
-                                                                                     "target_error"])]
+                                                                                     "target_error", "afm_spring",
+                                                                                     "phys_spring"])]
     elif not opts.flag("cont_error_estimate"):
         ignored += [(n, "refines error bars, which -cont_error_estimate false turns off") for n in
                     _given(opts, ["target_error"])]

@@ -19,7 +19,7 @@ from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_setti
 from .table import TABLE, Option
 
 __all__ = ["AppOptions", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
-           "read_request", "read_settings"]
+           "read_request", "read_settings", "read_spring"]
 
 
 #: The smallest positive Tabor parameter: below it the coupling mu^(3/2) of eq. (12) and the JKR scales
@@ -330,13 +330,33 @@ def read_solver(opts: AppOptions) -> SolverChoice:
                         pc_reuse_its=opts.int("adh_pc_reuse_its"))
 
 
-def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = False) -> CurveRequest:
+def read_spring(opts: AppOptions, bodies: Bodies | None) -> float | None:
+    """The stiffness K of the spring the approach is driven through (-afm_spring, or -phys_spring with the
+    bodies: K = k epsilon / (2 pi R gamma)), or None for a rigid machine."""
+    K, k = opts.real("afm_spring"), opts.real("phys_spring")
+    if K is not None and k is not None:
+        raise InputError("-phys_spring: not with -afm_spring; give one of them (the spring's stiffness)")
+    if k is None:
+        return K
+    if bodies is None:
+        raise InputError("-phys_spring: needs the bodies' -phys_ options (radius, young1, poisson1, gamma or "
+                         "hamaker, epsilon) to make K = k epsilon / (2 pi R gamma); or give -afm_spring K")
+    K = _finite(lambda: bodies.spring_stiffness(k))
+    if not 0 < K <= TABLE["afm_spring"].hi:
+        raise InputError(f"-phys_spring: gives K = k epsilon / (2 pi R gamma) = {K:.3g}, outside "
+                         f"(0, {TABLE['afm_spring'].hi:g}]")
+    return K
+
+
+def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = False,
+                 bodies: Bodies | None = None) -> CurveRequest:
     """What a curve reports (-cont_lambda_start, -cont_at_lambda, -cont_event_tol, -cont_error_estimate,
-    -target_error, -profiles); ``kinds`` and ``profiles`` as a study's case asks."""
+    -target_error, -profiles, the spring of -afm_spring or -phys_spring with the ``bodies``); ``kinds`` and
+    ``profiles`` as a study's case asks."""
     return CurveRequest(lambda_start=opts.real("cont_lambda_start"), at_lambda=opts.reals("cont_at_lambda"),
                         event_tol=opts.real("cont_event_tol"), error_bars=opts.flag("cont_error_estimate"),
                         target_error=opts.real("target_error"), profiles=profiles or opts.flag("profiles"),
-                        kinds=kinds)
+                        kinds=kinds, spring=read_spring(opts, bodies))
 
 
 def read_settings(opts: AppOptions):

@@ -169,6 +169,13 @@ TABLE = {o.name: o for o in [
            "on its grid's coarser (or finer) nested levels, Richardson-extrapolated"),
     Option("target_error", "real", None, "refine each event's levels until its error bars (lambda and F) are "
            "below this", 0.0, 1.0, lo_open=True),
+    # the measuring machine (an AFM cantilever)
+    Option("afm_spring", "real", None, "drive the approach through a spring of this stiffness K (units 2 pi R "
+           "gamma / epsilon; an AFM cantilever): its base Z = lambda + F / K jumps in and off where dZ/ds = 0, "
+           "reported with their landings and the energy of a cycle (default: a rigid machine only)", 0.0, 1e12,
+           lo_open=True),
+    Option("phys_spring", "real", None, "spring constant k of the cantilever (N/m), with the other -phys_ "
+           "options: K = k epsilon / (2 pi R gamma), as -afm_spring", 0.0, 1e9, lo_open=True),
     # studies: a sweep over cases (petsc_adhesion.app.study)
     Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 50.0),
     Option("study_sigma", "sweep", (), "study: the roughness sigma of its cases", 0.0, 5.0),
