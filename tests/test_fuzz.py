@@ -128,7 +128,7 @@ from petsc_adhesion.app.options.checks import petsc_names
 
 h5py = pytest.importorskip("h5py")
 
-OUTPUTS = ("out", "summary", "plot")
+OUTPUTS = ("out", "summary", "plot", "csv", "csv_events")
 #: the option sets of the earlier result set (a curve: it has all three files) and of the guess files
 EARLIER_ARGS = ("-adh_mu", "0.77", "-grid_type", "uniform", "-grid_n", "33", "-cont_F_max", "0")
 GUESS_ARGS = ("-adh_mu", "1", "-adh_lambda", "-2", "-grid_type", "uniform", "-grid_n", "41")
@@ -254,11 +254,12 @@ class Generator:
 
     def outputs(self, case: Case, curve: bool, p_plot: float = 0.1) -> None:
         """Outputs at ordinary places, most over an earlier file of the same name."""
-        opts = [o for o in OUTPUTS if o != "plot" or curve]
+        opts = [o for o in OUTPUTS if o in ("out", "summary") or curve]     # plot and CSV: curves only
         for o in opts:
             if (o == "plot" and not self.chance(p_plot)) or (o != "plot" and not self.chance(0.6)):
                 continue
-            ext = {"out": ".h5", "summary": ".json", "plot": self.pick([".png", ".png", ".pdf", ".svg"])}[o]
+            ext = {"out": ".h5", "summary": ".json", "plot": self.pick([".png", ".png", ".pdf", ".svg"]),
+                   "csv": ".csv", "csv_events": ".csv"}[o]
             name = f"r{case['id']}_{o}{ext}"
             where = self.pick(["abs", "abs", "rel", "sub"])
             rel = f"sub/{name}" if where == "sub" else name

@@ -55,7 +55,7 @@ FORMAT = 2
 INTERVAL = 10.0
 #: Options that change no number of the curve (where results go, what is printed, the checkpoint's own):
 #: a restart may differ in these.
-FREE = ("out", "summary", "plot", "profiles", "cont_monitor", "cont_checkpoint", "cont_checkpoint_interval",
+FREE = ("out", "summary", "plot", "csv", "csv_events", "profiles", "cont_monitor", "cont_checkpoint", "cont_checkpoint_interval",
         "cont_restart", "progress", "progress_interval", "options_file", "help")
 #: PETSc options that only print (monitors, viewers, logs), free alike.
 _PRINTING = re.compile(r"monitor|(^|_)view|converged_reason|^log|^info|^options_|^malloc|^memory")
@@ -63,8 +63,8 @@ _PRINTING = re.compile(r"monitor|(^|_)view|converged_reason|^log|^info|^options_
 
 def default_path(targets: dict) -> str | None:
     """The checkpoint of a run writing ``targets`` (option -> path): hidden beside the first of -out,
-    -summary, -plot (``results/x.h5`` -> ``results/.x.h5.checkpoint``); None without them."""
-    for option in ("out", "summary", "plot"):
+    -summary, -plot, -csv, -csv_events (``results/x.h5`` -> ``results/.x.h5.checkpoint``); None without them."""
+    for option in ("out", "summary", "plot", "csv", "csv_events"):
         if targets.get(option):
             folder, base = os.path.split(targets[option])
             return os.path.join(folder, f".{base}.checkpoint")

@@ -58,7 +58,7 @@ from .progress import Progress
 __all__ = ["Request", "read", "execute", "main", "is_study", "refuse_study_options"]
 
 _APP = ("adh_", "grid_", "cont_")
-_OUTPUTS = ("out", "summary", "plot")
+_OUTPUTS = ("out", "summary", "plot", "csv", "csv_events")
 
 
 def is_study(opts: AppOptions) -> bool:

@@ -21,6 +21,7 @@ from .layout import (
     study_table,
 )
 from .resultset import ResultSet, plot_format
+from .text import write_curve_csv, write_events_csv, write_table_csv
 
 __all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study", "write_critical"]
 
@@ -102,6 +103,10 @@ def write_curve(curve, options: dict, files: ResultSet, commit: bool = True) -> 
         curve_figure(tree, files.temp("plot"), fmt)
     if "summary" in files.targets:
         write_json(files.temp("summary"), curve.summary)
+    if "csv" in files.targets:
+        write_curve_csv(files.temp("csv"), curve)
+    if "csv_events" in files.targets:
+        write_events_csv(files.temp("csv_events"), curve)
     if commit:
         files.commit()
 
@@ -147,7 +152,8 @@ def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict]
 
 
 def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
-    """The files of a study (:mod:`petsc_adhesion.app.study`), committed together; returns the summary.
+    """The files of a study (:mod:`petsc_adhesion.app.study`), its table of events as CSV among them (``csv``),
+    committed together; returns the summary.
 
     ``done``: each case that ran as {case, values, summary, tree}; ``failed``: {case, values, error}.
     """
@@ -168,5 +174,7 @@ def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], f
         study_figure(tree, files.temp("plot"), study["plot"], fmt)
     if "summary" in files.targets:
         write_json(files.temp("summary"), summ)
+    if "csv" in files.targets:
+        write_table_csv(files.temp("csv"), tree["table"])
     files.commit()
     return summ

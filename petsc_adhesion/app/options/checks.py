@@ -43,6 +43,7 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
     if fixed:
         ignored += [(n, "applies to a curve, not with -adh_lambda") for n in
                     _given(opts, [n for n in TABLE if n.startswith(("cont_", "progress"))] + ["profiles", "plot",
+                                                                                     "csv", "csv_events",
                                                                                      "target_error", "afm_spring",
                                                                                      "phys_spring"])]
     elif not opts.flag("cont_error_estimate"):

@@ -200,6 +200,11 @@ TABLE = {o.name: o for o in [
     Option("summary", "string", None, "JSON summary file"),
     Option("profiles", "flag", False, "store H(r) and P(r) at every event"),
     Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
+    Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, Z and stable_spring "
+           "behind a spring, contact radius, stable (0/1), and in nm and nN with -phys_ inputs; a study: its table "
+           "of events (default with -out X.h5: X.csv beside it); not with -adh_lambda"),
+    Option("csv_events", "string", None, "CSV of the curve's events, a row each: kind, best values, error bars, "
+           "landing, single-grid values (in nm and nN too with -phys_ inputs); not with -adh_lambda nor in a study"),
     Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "
            "events, time elapsed and an estimate of the time left (default: when stderr is a terminal)"),
     Option("progress_interval", "real", progress.INTERVAL, "least seconds between two progress lines", 0.0, 1e6,
