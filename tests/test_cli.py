@@ -89,10 +89,10 @@ def plain_error(proc) -> str:
 R = re.escape
 # id: (arguments, the option named, regexes of what the message must also say)
 BAD = {
-    "mu_negative": (["-adh_mu", "-1"], "-adh_mu", [R("[0, 50]")]),
-    "mu_nan": (["-adh_mu", "nan"], "-adh_mu", [R("[0, 50]"), "finite"]),
-    "mu_inf": (["-adh_mu", "inf"], "-adh_mu", [R("[0, 50]"), "finite"]),
-    "mu_not_a_number": (["-adh_mu", "abc"], "-adh_mu", [R("[0, 50]"), "abc"]),
+    "mu_negative": (["-adh_mu", "-1"], "-adh_mu", [R("[0, 1000]")]),
+    "mu_nan": (["-adh_mu", "nan"], "-adh_mu", [R("[0, 1000]"), "finite"]),
+    "mu_inf": (["-adh_mu", "inf"], "-adh_mu", [R("[0, 1000]"), "finite"]),
+    "mu_not_a_number": (["-adh_mu", "abc"], "-adh_mu", [R("[0, 1000]"), "abc"]),
     "sigma_negative": (["-adh_sigma", "-0.1"], "-adh_sigma", [R("[0, 5]")]),
     "rmax_zero": (["-adh_rmax", "0"], "-adh_rmax", [R("(0, 1000]")]),
     "rmax_negative": (["-adh_rmax", "-3"], "-adh_rmax", [R("(0, 1000]")]),
@@ -213,7 +213,7 @@ def test_options_file_error_inside(tmp_path):
     opts.write_text("-adh_mu -1  # oops\n-adh_lambda -2\n-grid_type uniform\n-grid_n 101\n")
     proc = run_cli("-options_file", opts, "-summary", tmp_path / "S.json")
     line = plain_error(proc)
-    assert "-adh_mu" in line and "[0, 50]" in line
+    assert "-adh_mu" in line and "[0, 1000]" in line
     assert files(tmp_path) == {"bad.opts"}
 
 

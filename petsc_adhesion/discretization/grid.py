@@ -110,8 +110,8 @@ class EdgeGrid:
 
     The spacing h(r) is ``fine`` within ``band`` of the edge, grows by ``grading``
     times the distance beyond, and is capped by ``contact`` within ``reach`` of
-    the forces (by ``interior`` times r inside the contact), growing by ``far``
-    times the distance beyond that, out to ``rmax``.  The nodes are the mapping
+    the forces (by ``interior`` times r, or ``core`` where that is larger, inside the
+    contact), growing by ``far`` times the distance beyond that, out to ``rmax``.  The nodes are the mapping
     xi = integral_0^r dr / h at equal steps of xi, so refinement levels are nested:
     every other node of ``level`` + 1 is a node of ``level`` (spacing / 2^level).
     """
@@ -125,12 +125,13 @@ class EdgeGrid:
     interior: float = 0.01
     reach: float = 3.0
     far: float = 0.1
+    core: float = 0.0
     level: int = 0
 
     def spacing(self, r: np.ndarray) -> np.ndarray:
         """h(r) at level 0."""
         d = np.abs(r - self.edge)
-        cap = np.where(r < self.edge, np.maximum(self.contact, self.interior * r),
+        cap = np.where(r < self.edge, np.maximum(np.maximum(self.contact, self.interior * r), self.core),
                        self.contact + self.far * np.maximum(0.0, r - self.edge - self.reach))
         return np.minimum(np.maximum(self.fine, self.grading * (d - self.band)), np.maximum(cap, self.fine))
 

@@ -78,7 +78,7 @@ _S = Settings
 
 TABLE = {o.name: o for o in [
     # model (paper eq. 9-14)
-    Option("adh_mu", "real", Model.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
+    Option("adh_mu", "real", Model.mu, "Tabor parameter mu (eq. 9)", 0.0, 1000.0),
     Option("adh_sigma", "real", Model.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
     Option("adh_roughness", "choice", Model.roughness, "height distribution averaged over (eq. 7, 10): the "
            "paper's Gaussian by its Gauss-Hermite rule (eq. 14), whose rule is the model; Gaussian truncated at "
@@ -177,7 +177,7 @@ TABLE = {o.name: o for o in [
     Option("phys_spring", "real", None, "spring constant k of the cantilever (N/m), with the other -phys_ "
            "options: K = k epsilon / (2 pi R gamma), as -afm_spring", 0.0, 1e9, lo_open=True),
     # studies: a sweep over cases (petsc_adhesion.app.study)
-    Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 50.0),
+    Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 1000.0),
     Option("study_sigma", "sweep", (), "study: the roughness sigma of its cases", 0.0, 5.0),
     Option("study_option", "string", None, "study: a further real or integer option swept over -study_values "
            "(without the dash, e.g. phys_radius, adh_hermite_points, grid_n)"),
