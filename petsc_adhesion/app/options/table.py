@@ -184,10 +184,10 @@ TABLE = {o.name: o for o in [
     Option("study_values", "sweep", (), "study: the values of -study_option", -1e12, 1e12),
     Option("study_compute", "choice", "curve", "study: what each case computes: the whole curve; the events up to "
            "equilibrium; only the pull-off and the equilibrium after it; only the turning points; the critical "
-           "roughness sigma_c(mu) of each -study_mu and the critical mu_c(sigma) of each -study_sigma",
-           choices=("curve", "events", "pull_off", "folds", "critical")),
+           "roughness sigma_c(mu) of each -study_mu and the critical mu_c(sigma) of each -study_sigma (with a "
+           "spring, its jumps too)", choices=("curve", "events", "pull_off", "folds", "critical")),
     Option("study_profiles", "choices", (), "study: the event kinds whose H(r), P(r) each case keeps",
-           choices=("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda")),
+           choices=("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda", "jump_in", "jump_off")),
     Option("study_ranks", "int", 1, "study: MPI ranks per case; the cases are spread over the groups of this "
            "many ranks, the longest first", 1, 10**6),
     Option("study_plot", "choice", "curves", "study: what -plot draws: load-approach curves; one panel per case "
