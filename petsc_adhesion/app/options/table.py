@@ -195,6 +195,22 @@ TABLE = {o.name: o for o in [
            "pull-off against sigma; the boundary of hysteresis (sigma_c, mu_c: the only one, and the default, with "
            "-study_compute critical)",
            choices=("curves", "folds", "profiles", "pull_off", "reduction", "critical")),
+    # fitting a measurement (petsc_adhesion.fitting; docs/fitting.md)
+    Option("fit_pull_off", "real", None, "fit: the work of adhesion whose model pull-off is this measured force "
+           "(N, its magnitude), with -phys_radius, -phys_young1, -phys_poisson1 (-phys_young2, -phys_poisson2: "
+           "default a rigid flat), -phys_epsilon and -phys_rms if rough; reports gamma, its bar, mu and what JKR, "
+           "DMT and Maugis-Dugdale give", 0.0, 1.0, lo_open=True),
+    Option("fit_pull_off_err", "real", 0.0, "fit: the standard uncertainty of -fit_pull_off (N), carried into "
+           "gamma's bar", 0.0, 1.0),
+    Option("fit_curve", "string", None, "fit: a measured force-distance curve (text or CSV: piezo displacement "
+           "and force in SI, approach then retract; or an AFM file afmformats reads): the work of adhesion and the "
+           "reduced modulus E*, with the contact point and baseline, by bounded least squares; needs "
+           "-phys_radius, -phys_epsilon and the spring constant (-phys_spring, or the file's)"),
+    Option("fit_curve_index", "int", 0, "fit: the curve of a -fit_curve file of several (a force map)", 0, 10**9),
+    Option("fit_modulus", "flag", True, "fit: fit E* (false: hold it at the -phys_young/-phys_poisson value; given "
+           "with true, that value is where the fit starts)"),
+    Option("fit_roughness", "flag", False, "fit: fit the rms roughness too (-phys_rms: its start, default 0.3 "
+           "epsilon)"),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
