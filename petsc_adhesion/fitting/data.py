@@ -28,6 +28,7 @@ finite, a curve that does not turn back) is one line (:class:`CurveFileError`).
 """
 from __future__ import annotations
 
+import logging
 import os
 import re
 import warnings
@@ -194,13 +195,18 @@ def _read_afm(path: str, index: int) -> MeasuredCurve:
     # ValueError and the like from its readers
     own = tuple(getattr(afmformats.errors, n) for n in ("AFMFileFormatError", "MissingMetaDataError")
                 if hasattr(getattr(afmformats, "errors", None), n))
+    log = logging.getLogger("afmformats")      # it logs each recipe that fails, with a traceback: one line is ours
+    level = log.level
     try:
+        log.setLevel(logging.CRITICAL + 1)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             curves = afmformats.load_data(str(path), modality="force-distance")
     except (Exception, *own) as e:
         why = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         raise CurveFileError(f"{_name(path)}: not a force-distance curve afmformats reads ({why[:120]})") from None
+    finally:
+        log.setLevel(level)
     if not curves:
         raise CurveFileError(f"{_name(path)}: afmformats finds no force-distance curve in it")
     if not 0 <= index < len(curves):

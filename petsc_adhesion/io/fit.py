@@ -21,6 +21,9 @@ DESCRIBE_FIT = {
             "wall_time_s: s", "the fit of a measurement (kind pull_off: -fit_pull_off; curve: -fit_curve): the "
             "work of adhesion gamma and its bar gamma_err (one standard deviation), mu (eq. 9), and for a curve "
             "the reduced modulus E_star with its bar (docs/fitting.md)"),
+    "fit/covariance": ("of the parameters named in fit's attribute parameters (ln E_star, ln gamma: 1; sigma: "
+                       "epsilon; z0: epsilon; F0: noise_N)", "the covariance of the fitted parameters at the optimum: "
+                       "s^2 (J^T J)^-1 carried to (ln E*, ln w)"),
     "fit/closed_forms": ("gamma: J/m^2", "what DMT (P / 2 pi R), JKR (P / 1.5 pi R) and the Maugis-Dugdale "
                          "transition (lambda_MD = 1.157 mu, self-consistent) give for gamma from the same pull-off"),
     "fit/iterations": ("gamma: J/m^2; F_grid: 2 pi R gamma", "the secant's steps: gamma, mu and the model's "
