@@ -94,3 +94,24 @@ def test_what_a_fit_cannot_use_is_one_line(tmp_path, key):
     msg = one_line(p)
     assert msg.startswith(says), msg
     assert listing(out) == []
+
+
+def test_the_measured_asylum_curve(tmp_path):
+    """The MFP3D curve of tests/data (docs/fitting.md): read with its spring constant, fitted with E* held at
+    the assumed moduli; the fit reports its misfit (the contact is half as stiff as the lever, which those
+    moduli cannot make) rather than hide it, and its measured pull-off is the file's own."""
+    pytest.importorskip("afmformats")
+    out = tmp_path / "s.json"
+    p = run_cli("-fit_curve", IBW, "-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9", "-phys_young1", "250e9",
+                "-phys_poisson1", "0.25", "-phys_young2", "170e9", "-phys_poisson2", "0.28", "-fit_modulus", "false",
+                "-summary", out, "-plot", tmp_path / "f.png", "-csv", tmp_path / "f.csv")
+    assert p.returncode == 0, p.stderr
+    fit = json.load(open(out))["fit"]
+    assert fit["given"]["spring_N_m"] == pytest.approx(1.1841) and fit["given"]["spring_from"] == "the file"
+    assert fit["fixed"]["E_star"] == pytest.approx(1 / ((1 - 0.25**2) / 250e9 + (1 - 0.28**2) / 170e9))
+    assert fit["measured"]["pull_off_N"] == pytest.approx(12.84e-9, rel=2e-3)
+    assert 0 < fit["gamma_err"] < fit["gamma"] < 1.0
+    assert fit["reduced_chi2"] > 100                    # the misfit is said
+    assert (tmp_path / "f.png").stat().st_size > 10_000
+    rows = (tmp_path / "f.csv").read_text().splitlines()
+    assert rows[0] == "z_m,F_N,leg,F_fit_N,used" and len(rows) == 2017
