@@ -218,7 +218,7 @@ TABLE = {o.name: o for o in [
     Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
     Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, Z and stable_spring "
            "behind a spring, contact radius, stable (0/1), and in nm and nN with -phys_ inputs; a study: its table "
-           "of events (default with -out X.h5: X.csv beside it); not with -adh_lambda"),
+           "of events; not with -adh_lambda"),
     Option("csv_events", "string", None, "CSV of the curve's events, a row each: kind, best values, error bars, "
            "landing, single-grid values (in nm and nN too with -phys_ inputs); not with -adh_lambda nor in a study"),
     Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "
