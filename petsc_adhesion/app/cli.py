@@ -114,7 +114,7 @@ def _program(argv: list[str]) -> int:
     from petsc4py import PETSc
 
     from ..errors import collective
-    from . import run, study
+    from . import fit, run, study
     from .options.help import print_help
     from .options.reading import AppOptions
 
@@ -122,6 +122,9 @@ def _program(argv: list[str]) -> int:
     helping = opts.db.hasName("help")
     if helping and PETSc.COMM_WORLD.getRank() == 0:
         print_help()
+    if collective(PETSc.COMM_WORLD, fit.is_fit, opts):
+        return fit.main(opts, argv, helping)
+    fit.refuse_fit_options(opts)
     if collective(PETSc.COMM_WORLD, run.is_study, opts):
         return study.main(opts, argv, helping)
     return run.main(opts, argv, helping)

@@ -185,6 +185,9 @@ def main(argv: list[str]) -> int:
     with open(DOC, "w") as f:
         f.write(text)
     print(table(rows))
+    from . import energy_coverage          # the page's last section, the energy's bars, from their own data
+    if os.path.exists(energy_coverage.DATA):
+        energy_coverage.main(["-table"])
     return 0
 
 

@@ -3,6 +3,7 @@
     ./run figures                  # all of them, into docs/figures/
     ./run figures fig18            # one paper figure: the study options/fig18.opts
     ./run figures convergence      # one of our own studies
+    ./run figures afm_example      # one of docs/afm.md's (petsc_adhesion.benchmarks.afm)
 
 The paper's figures are the studies ``options/figNN.opts`` (:mod:`petsc_adhesion.app.study`),
 run here one after another as ``./run study`` runs them (``NP=2`` spreads each over two
@@ -338,7 +339,15 @@ def validation():
     v.write()
 
 
+def _afm(name: str) -> None:
+    """docs/figures/afm_NAME.png and .md of docs/afm.md (:mod:`petsc_adhesion.benchmarks.afm`)."""
+    from . import afm
+
+    afm.FIGURES[name]()
+
+
 OWN = {f.__name__: f for f in (convergence, hermite, coarse, quadrature, models, critical_models, validation)}
+OWN |= {f"afm_{n}": (lambda n=n: _afm(n)) for n in ("example", "stiffness", "radius")}
 FIGURES = {**{n: (lambda n=n: study(n)) for n in STUDIES}, **OWN}
 
 if __name__ == "__main__":

@@ -75,8 +75,10 @@ def relocate(tracer, seg, found, level: int, target=None):
         behind = a.ds if back is not a and a.ds else 0.0        # an event found there may be another
 
         def far(u, v):
+            # an event of another label on the way (a jump-off before the jump-in sought) is not the one
             travelled[0] += v.ds
-            return bool(finder.found) and travelled[0] > behind or travelled[0] > 4 * length + behind
+            hit = any(f.label == found.label for f in finder.found) if target is None else bool(finder.found)
+            return hit and travelled[0] > behind or travelled[0] > 4 * length + behind
 
         travelled = [0.0]
 

@@ -352,11 +352,15 @@ def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = 
                  bodies: Bodies | None = None) -> CurveRequest:
     """What a curve reports (-cont_lambda_start, -cont_at_lambda, -cont_event_tol, -cont_error_estimate,
     -target_error, -profiles, the spring of -afm_spring or -phys_spring with the ``bodies``); ``kinds`` and
-    ``profiles`` as a study's case asks."""
+    ``profiles`` as a study's case asks (behind a spring its jumps are reported with any kinds: they are
+    the turning points and the pull-off the cantilever sees)."""
+    spring = read_spring(opts, bodies)
+    if spring is not None and kinds is not None:
+        kinds = tuple(kinds) + ("jump_in", "jump_off")
     return CurveRequest(lambda_start=opts.real("cont_lambda_start"), at_lambda=opts.reals("cont_at_lambda"),
                         event_tol=opts.real("cont_event_tol"), error_bars=opts.flag("cont_error_estimate"),
                         target_error=opts.real("target_error"), profiles=profiles or opts.flag("profiles"),
-                        kinds=kinds, spring=read_spring(opts, bodies))
+                        kinds=kinds, spring=spring)
 
 
 def read_settings(opts: AppOptions, model: Model | None = None):

@@ -184,10 +184,10 @@ TABLE = {o.name: o for o in [
     Option("study_values", "sweep", (), "study: the values of -study_option", -1e12, 1e12),
     Option("study_compute", "choice", "curve", "study: what each case computes: the whole curve; the events up to "
            "equilibrium; only the pull-off and the equilibrium after it; only the turning points; the critical "
-           "roughness sigma_c(mu) of each -study_mu and the critical mu_c(sigma) of each -study_sigma",
-           choices=("curve", "events", "pull_off", "folds", "critical")),
+           "roughness sigma_c(mu) of each -study_mu and the critical mu_c(sigma) of each -study_sigma (with a "
+           "spring, its jumps too)", choices=("curve", "events", "pull_off", "folds", "critical")),
     Option("study_profiles", "choices", (), "study: the event kinds whose H(r), P(r) each case keeps",
-           choices=("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda")),
+           choices=("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda", "jump_in", "jump_off")),
     Option("study_ranks", "int", 1, "study: MPI ranks per case; the cases are spread over the groups of this "
            "many ranks, the longest first", 1, 10**6),
     Option("study_plot", "choice", "curves", "study: what -plot draws: load-approach curves; one panel per case "
@@ -195,6 +195,22 @@ TABLE = {o.name: o for o in [
            "pull-off against sigma; the boundary of hysteresis (sigma_c, mu_c: the only one, and the default, with "
            "-study_compute critical)",
            choices=("curves", "folds", "profiles", "pull_off", "reduction", "critical")),
+    # fitting a measurement (petsc_adhesion.fitting; docs/fitting.md)
+    Option("fit_pull_off", "real", None, "fit: the work of adhesion whose model pull-off is this measured force "
+           "(N, its magnitude), with -phys_radius, -phys_young1, -phys_poisson1 (-phys_young2, -phys_poisson2: "
+           "default a rigid flat), -phys_epsilon and -phys_rms if rough; reports gamma, its bar, mu and what JKR, "
+           "DMT and Maugis-Dugdale give", 0.0, 1.0, lo_open=True),
+    Option("fit_pull_off_err", "real", 0.0, "fit: the standard uncertainty of -fit_pull_off (N), carried into "
+           "gamma's bar", 0.0, 1.0),
+    Option("fit_curve", "string", None, "fit: a measured force-distance curve (text or CSV: piezo displacement "
+           "and force in SI, approach then retract; or an AFM file afmformats reads): the work of adhesion and the "
+           "reduced modulus E*, with the contact point and baseline, by bounded least squares; needs "
+           "-phys_radius, -phys_epsilon and the spring constant (-phys_spring, or the file's)"),
+    Option("fit_curve_index", "int", 0, "fit: the curve of a -fit_curve file of several (a force map)", 0, 10**9),
+    Option("fit_modulus", "flag", True, "fit: fit E* (false: hold it at the -phys_young/-phys_poisson value; given "
+           "with true, that value is where the fit starts)"),
+    Option("fit_roughness", "flag", False, "fit: fit the rms roughness too (-phys_rms: its start, default 0.3 "
+           "epsilon)"),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
@@ -202,7 +218,7 @@ TABLE = {o.name: o for o in [
     Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
     Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, Z and stable_spring "
            "behind a spring, contact radius, stable (0/1), and in nm and nN with -phys_ inputs; a study: its table "
-           "of events (default with -out X.h5: X.csv beside it); not with -adh_lambda"),
+           "of events; not with -adh_lambda"),
     Option("csv_events", "string", None, "CSV of the curve's events, a row each: kind, best values, error bars, "
            "landing, single-grid values (in nm and nN too with -phys_ inputs); not with -adh_lambda nor in a study"),
     Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "

@@ -7,7 +7,11 @@
 events marked, unstable branches dashed, and the profiles at the events when the
 file holds them), a fixed-approach solve (H and P), a study (its own kind of
 figure) or a critical study (the boundary of hysteresis); with physical inputs,
-a curve gets axes in nm and nN beside the dimensionless ones.  It reads HDF5
+a curve gets axes in nm and nN beside the dimensionless ones.  A curve traced behind
+a spring (``-afm_spring``, ``-phys_spring``: the file's curve has ``Z``) gets two more
+panels: the load against the spring's base Z (the force-distance curve of an AFM,
+stable parts solid, the jumps drawn at constant Z from each jump-in and jump-off to
+its landing) and the contact radius against the load along the curve.  It reads HDF5
 only: neither MPI nor PETSc is started.
 """
 from __future__ import annotations
@@ -17,23 +21,127 @@ import numpy as np
 
 from .read import figure, from_tree, legend, read
 
-__all__ = ["load_approach", "profiles", "curve_figure", "solve_figure", "MARK"]
+__all__ = ["load_approach", "profiles", "force_distance", "contact_load", "curve_figure", "solve_figure", "MARK",
+           "stiffness"]
 
 
 MARK = {"snap_on": ("v", "snap-on"), "snap_off": ("^", "snap-off"), "F_min": ("o", "load extremum"),
-        "equilibrium": ("s", "equilibrium"), "lambda": ("x", "at lambda")}
+        "equilibrium": ("s", "equilibrium"), "lambda": ("x", "at lambda"), "jump_in": ("<", "jump-in"),
+        "jump_off": (">", "jump-off")}
+#: The turning points of a spring's base Z.
+JUMPS = ("jump_in", "jump_off")
+
+
+def _kind(ev: dict) -> str:
+    return ev["kind"].decode() if isinstance(ev["kind"], bytes) else str(ev["kind"])
+
+
+def _solid_dashed(ax, x, y, stable, label=None, joints=(), **style):
+    """y(x), solid where ``stable``, dashed elsewhere in the same colour, the two joined; the solid line.
+
+    ``joints``: (x, y) of the located turning points (where the stability changes between two computed
+    points): each is put between the two points it lies between, on both lines; where none does, the
+    dashed line runs on to the stable point next to it.
+    """
+    x, y, stable = np.asarray(x, float), np.asarray(y, float), np.asarray(stable, bool)
+    span = np.array([np.ptp(x[np.isfinite(x)]) if np.isfinite(x).any() else 1.0,
+                     np.ptp(y[np.isfinite(y)]) if np.isfinite(y).any() else 1.0])
+    span[~(span > 0)] = 1.0
+    joints = [np.array(j, float) / span for j in joints]
+    xs, ys, solid, dashed = [], [], [], []
+    for i in range(x.size):
+        xs.append(x[i])
+        ys.append(y[i])
+        solid.append(stable[i])
+        dashed.append(not stable[i])
+        if i + 1 < x.size and stable[i] != stable[i + 1]:
+            a, b = np.array([x[i], y[i]]) / span, np.array([x[i + 1], y[i + 1]]) / span
+            near = [j for j in joints if np.linalg.norm(j - (a + b) / 2) <= max(np.linalg.norm(b - a), 1e-12)]
+            if near:
+                j = min(near, key=lambda j: np.linalg.norm(j - (a + b) / 2)) * span
+                xs.append(j[0])
+                ys.append(j[1])
+                solid.append(True)
+                dashed.append(True)
+            else:
+                dashed[-1] = True          # the dashed line runs on to this stable point
+                if not stable[i]:
+                    xs.append(x[i + 1])
+                    ys.append(y[i + 1])
+                    solid.append(False)
+                    dashed.append(True)
+    xs, ys, solid, dashed = np.array(xs), np.array(ys), np.array(solid), np.array(dashed)
+    line, = ax.plot(np.where(solid, xs, np.nan), np.where(solid, ys, np.nan), label=label, **style)
+    if dashed.any():
+        ax.plot(np.where(dashed, xs, np.nan), np.where(dashed, ys, np.nan), "--", color=line.get_color(),
+                lw=line.get_linewidth())
+    return line
+
+
+def stiffness(curve: dict) -> float | None:
+    """The stiffness K of the spring a curve was traced behind, from its points (Z = lambda + F / K); None
+    without a spring."""
+    if "Z" not in curve:
+        return None
+    F, d = np.asarray(curve["F"], float), np.asarray(curve["Z"], float) - np.asarray(curve["lambda"], float)
+    i = int(np.argmax(np.abs(F)))
+    return float(F[i] / d[i]) if d[i] != 0 else None
+
+
+def force_distance(ax, res: dict, label: str | None = None, scale: tuple = (1.0, 1.0), **style) -> None:
+    """Behind a spring: F against its base Z = lambda + F / K, stable parts (dZ/ds > 0) solid and unstable
+    dashed, each jump-in and jump-off marked and drawn as an arrow at constant Z to its landing.
+    ``scale``: the factors of Z and F (1, 1: the model's units; the physical ones for nm and nN)."""
+    c = res["curve"]
+    sz, sf = scale
+    K = stiffness(c)
+    joints = [(sz * float(e["Z"]), sf * float(e["F"])) for e in res["events"] if _kind(e) in JUMPS]
+    line = _solid_dashed(ax, sz * np.asarray(c["Z"]), sf * np.asarray(c["F"]), np.asarray(c["stable_spring"], bool),
+                         label=label or (f"mu = {res['mu']:g}, K = {K:.4g}" if K else None), joints=joints, **style)
+    for ev in res["events"]:
+        kind = _kind(ev)
+        if kind not in JUMPS:
+            continue
+        Z, F = sz * float(ev["Z"]), sf * float(ev["F"])
+        ax.plot(Z, F, MARK[kind][0], color=line.get_color(), ms=6)
+        land = ev.get("landing")
+        if land:
+            ax.annotate("", xy=(Z, sf * float(land["F"])), xytext=(Z, F),
+                        arrowprops={"arrowstyle": "->", "color": line.get_color(), "lw": 1.0})
+            ax.plot(Z, sf * float(land["F"]), "o", mfc="none", color=line.get_color(), ms=4)
+    ax.axhline(0.0, color="0.7", lw=0.5)
+
+
+def contact_load(ax, res: dict, label: str | None = None, **style) -> None:
+    """The contact radius against the load along the curve: solid where stable (behind a spring, under it),
+    the jumps of a spring (or the snaps of a rigid machine) drawn as arrows to their landings."""
+    c = res["curve"]
+    stable = np.asarray(c["stable_spring"] if "stable_spring" in c else c["stable"], bool)
+    jumps = JUMPS if "Z" in c else ("snap_on", "snap_off")
+    joints = [(float(e["F"]), float(e["contact_radius"])) for e in res["events"]
+              if _kind(e) in jumps and "contact_radius" in e]
+    line = _solid_dashed(ax, np.asarray(c["F"]), np.asarray(c["contact_radius"]), stable, label=label, joints=joints,
+                         **style)
+    for ev in res["events"]:
+        kind, land = _kind(ev), ev.get("landing")
+        if kind not in jumps or not land or "contact_radius" not in ev or "contact_radius" not in land:
+            continue
+        ax.plot(ev["F"], ev["contact_radius"], MARK[kind][0], color=line.get_color(), ms=6)
+        ax.annotate("", xy=(land["F"], land["contact_radius"]), xytext=(ev["F"], ev["contact_radius"]),
+                    arrowprops={"arrowstyle": "->", "color": line.get_color(), "lw": 1.0})
+    ax.set_xlabel("load F / (2 pi R gamma)")
+    ax.set_ylabel("contact radius a / sqrt(epsilon R)")
 
 
 def load_approach(ax, res: dict, label: str | None = None, events: bool = True, **style) -> None:
     """F(lambda), stable parts solid and unstable parts dashed, events marked (Figs. 4, 5, 13, 14)."""
     lam, F, stable = res["curve"]["lambda"], res["curve"]["F"], res["curve"]["stable"].astype(bool)
-    line, = ax.plot(np.where(stable, lam, np.nan), np.where(stable, F, np.nan),
-                    label=label or f"mu = {res['mu']:g}, sigma = {res['sigma']:g}", **style)
-    if not stable.all():
-        ax.plot(np.where(~stable, lam, np.nan), np.where(~stable, F, np.nan), "--", color=line.get_color())
+    joints = [(float(e["lambda"]), float(e["F"])) for e in res["events"] if _kind(e) in ("snap_on", "snap_off")]
+    line = _solid_dashed(ax, lam, F, stable, label=label or f"mu = {res['mu']:g}, sigma = {res['sigma']:g}",
+                         joints=joints, **style)
     if events:
         for ev in res["events"]:
-            kind = ev["kind"].decode() if isinstance(ev["kind"], bytes) else ev["kind"]
+            kind = _kind(ev)
             if kind == "F_max" or kind not in MARK:
                 continue
             ax.plot(ev["lambda"], ev["F"], MARK[kind][0], color=line.get_color(), ms=5)
@@ -53,40 +161,71 @@ def profiles(ax_h, ax_p, r: np.ndarray, H: np.ndarray, P: np.ndarray, label: str
 
 
 def curve_figure(source, out: str, fmt: str = "png") -> None:
-    """The load-approach curve of a result file or tree, with its event profiles when stored."""
+    """The load-approach curve of a result file or tree, with its event profiles when stored; behind a
+    spring, beside it the load against the spring's base Z and the contact radius against the load."""
     res = read(source) if isinstance(source, str) else from_tree(source)
     with_profiles = [e for e in res["events"] if "H" in e]
-    if with_profiles:
+    spring = "Z" in res["curve"] and "stable_spring" in res["curve"]
+    ax_z = ax_a = ax_p = None
+    if spring:
+        rows = 3 if with_profiles else 1
+        fig = figure(figsize=(12.8, 9.6) if with_profiles else (16.0, 4.8))
+        grid = fig.add_gridspec(rows, 2 if with_profiles else 3)
+        ax = fig.add_subplot(grid[0, 0])
+        ax_z = fig.add_subplot(grid[0, 1])
+        ax_a = fig.add_subplot(grid[1, 1] if with_profiles else grid[0, 2])
+        if with_profiles:
+            ax_h, ax_p = fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[2, 0])
+    elif with_profiles:
         fig = figure(figsize=(6.4, 9.6))
         ax, ax_h, ax_p = fig.subplots(3, 1)
-        for ev in with_profiles:
-            kind = ev["kind"].decode() if isinstance(ev["kind"], bytes) else ev["kind"]
-            profiles(ax_h, ax_p, ev.get("r", res["r"]), ev["H"], ev["P"], f"{kind} lambda = {ev['lambda']:.4f}")
-        legend(ax_h, fontsize=7)
     else:
         fig = figure(figsize=(6.4, 4.8))
         ax = fig.subplots()
+    for ev in with_profiles:
+        profiles(ax_h, ax_p, ev.get("r", res["r"]), ev["H"], ev["P"], f"{_kind(ev)} lambda = {ev['lambda']:.4f}")
+    if with_profiles:
+        legend(ax_h, fontsize=7)
     load_approach(ax, res)
     legend(ax, fontsize=8)
+    if spring:
+        force_distance(ax_z, res)
+        ax_z.set_xlabel("base of the spring Z = lambda + F / K")
+        ax_z.set_ylabel("load F / (2 pi R gamma)")
+        ax_z.set_title("behind the spring: jumps at constant Z (arrows)", fontsize=9)
+        legend(ax_z, fontsize=8)
+        if "contact_radius" in res["curve"]:
+            contact_load(ax_a, res)
+        else:
+            ax_a.remove()
+            ax_a = None
     if res.get("physical"):
-        _physical_axes(ax, res["physical"], ax_p if with_profiles else None)
+        _physical_axes(ax, res["physical"], ax_p, ax_z, ax_a)
     fig.tight_layout()
     fig.savefig(out, dpi=120, format=fmt)
 
 
-def _physical_axes(ax, phys: dict, ax_p=None) -> None:
-    """Secondary axes for a curve with physical inputs: approach in nm (top) and load in nN (right); on
-    the pressure profiles ``ax_p``, r in nm (top) and P in MPa (right)."""
-    def twin(axis, where, scale, label):
-        side = axis.secondary_xaxis if where == "top" else axis.secondary_yaxis
-        sec = side(where, functions=(lambda v: v * scale, lambda v: v / scale))
-        (sec.set_xlabel if where == "top" else sec.set_ylabel)(label)
+def _twin(axis, where: str, scale: float, label: str) -> None:
+    side = axis.secondary_xaxis if where == "top" else axis.secondary_yaxis
+    sec = side(where, functions=(lambda v: v * scale, lambda v: v / scale))
+    (sec.set_xlabel if where == "top" else sec.set_ylabel)(label)
 
-    twin(ax, "top", float(phys["approach_nm"]), "approach (nm)")
-    twin(ax, "right", float(phys["force_nN"]), "load (nN)")
+
+def _physical_axes(ax, phys: dict, ax_p=None, ax_z=None, ax_a=None) -> None:
+    """Secondary axes for a curve with physical inputs: approach in nm (top) and load in nN (right); on
+    the pressure profiles ``ax_p``, r in nm (top) and P in MPa (right); behind a spring, Z in nm and the
+    load in nN on ``ax_z``, the load in nN and the contact radius in nm on ``ax_a``."""
+    _twin(ax, "top", float(phys["approach_nm"]), "approach (nm)")
+    _twin(ax, "right", float(phys["force_nN"]), "load (nN)")
     if ax_p is not None:
-        twin(ax_p, "top", float(phys["radius_nm"]), "r (nm)")
-        twin(ax_p, "right", float(phys["pressure_MPa"]), "pressure (MPa)")
+        _twin(ax_p, "top", float(phys["radius_nm"]), "r (nm)")
+        _twin(ax_p, "right", float(phys["pressure_MPa"]), "pressure (MPa)")
+    if ax_z is not None:
+        _twin(ax_z, "top", float(phys["approach_nm"]), "Z (nm)")
+        _twin(ax_z, "right", float(phys["force_nN"]), "load (nN)")
+    if ax_a is not None:
+        _twin(ax_a, "top", float(phys["force_nN"]), "load (nN)")
+        _twin(ax_a, "right", float(phys["radius_nm"]), "contact radius (nm)")
 
 
 def solve_figure(path: str, out: str, fmt: str = "png") -> None:

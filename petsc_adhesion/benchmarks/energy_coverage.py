@@ -1,0 +1,465 @@
+"""Does the energy's bar hold?  The section "The energy of a cycle" of docs/coverage.md.
+
+    python -m petsc_adhesion.benchmarks.energy_coverage          # all cases (two at a time), then the table
+    python -m petsc_adhesion.benchmarks.energy_coverage -table   # the table from docs/data/energy_coverage.json
+    python -m petsc_adhesion.benchmarks.energy_coverage -case 1 0 0.05   # one case (mu sigma K|rigid), printed
+
+For each case (mu, sigma, machine: the rigid machine or a spring of stiffness
+K) the program's energy of one approach-retract cycle and its bar are those of
+``trace_curve`` with its defaults (error bars on): the curve's own grids
+(refinement level 0) and :func:`~petsc_adhesion.tracing.energy.energy_bar`.
+The truth is the whole curve traced again on the default grids at refinement
+levels 0, 1, 2 (2^k times the nodes), started, traced back and jumped exactly
+as ``trace_curve`` does, its energy at each level computed with a quadrature
+tolerance 1000 times tighter (so that the truth holds no quadrature error
+worth the name), and extrapolated (:func:`~petsc_adhesion.tracing.error_bars.extrapolate`).
+Where that extrapolation's own bar is not well below the program's bar
+(:data:`RESOLVE`), level 3 is traced too when affordable and levels 1, 2, 3
+are used; else the case is reported as "truth not resolved".
+
+Each case runs in a process of its own (PETSc started there), two at a time.
+The program's bar is split into its three terms (the jumps' c-errors, the
+stretches' F-errors and the quadrature's estimate) by wrapping
+:func:`~petsc_adhesion.tracing.energy.energy_bar` in the case's process; the
+true error is split into the quadrature's (the program's value against the
+same grid's value with the tight tolerance) and the grid's (the rest), and the
+grid's jump part is measured from each jump's c at the levels.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from . import paths
+
+__all__ = ["CASES", "RESOLVE", "LEVELS", "case", "derived", "table", "section", "main", "DATA", "DOC", "HEADING",
+           "TRUTH_TOL", "TRUTH_HALVINGS", "LEVEL3_BUDGET"]
+
+#: (mu, sigma, K or None: the rigid machine): mu = 1 .. 5, then mu = 0.5 (rigid: no hysteresis; K = 2: a small loop).
+CASES = [(mu, s, K) for mu in (5.0, 3.0, 2.0, 1.0) for s in (0.0, 0.2) for K in (None, 0.05, 0.5, 2.0)] + \
+    [(0.5, 0.0, None), (0.5, 0.2, None), (0.5, 0.0, 2.0)]
+#: The truth is resolved when its own bar is at most this share of the program's bar.
+RESOLVE = 0.1
+#: The truth's levels, and the level added where they do not resolve it.
+LEVELS = (0, 1, 2)
+#: Level 3 is traced only where its expected time (8 times level 2's) is below this (seconds).
+LEVEL3_BUDGET = 600.0
+#: The truth's quadrature (energy.QUADRATURE_TOL 1e-5 and MAX_HALVINGS 6 by default).
+TRUTH_TOL, TRUTH_HALVINGS = 1e-8, 8
+DATA = os.path.join(paths.DATA, "energy_coverage.json")
+DOC = os.path.join(paths.DOCS, "coverage.md")
+HEADING = "## The energy of a cycle"
+
+
+def _jump_record(rec: dict, key: str) -> dict:
+    """A jump of the program's cycle: its c (best, grid, bar) and the heights of the jump in F."""
+    land = rec.get("landing") or {}
+    return {"kind": rec["kind"], "c": rec[key], "c_grid": rec.get(f"{key}_grid", rec[key]), "c_err": rec.get(f"{key}_err"),
+            "F": rec["F"], "landing_F": land.get("F"), "error_note": rec.get("error_note")}
+
+
+def _program(model, K) -> dict:
+    """The program's energy and bar (trace_curve, defaults), the bar's terms and the times."""
+    from ..tracing import energy
+    from ..tracing.trace import CurveRequest, trace_curve
+
+    seen, cycle_s = {}, {}
+    real_bar, real_cycle = energy.energy_bar, energy.cycle
+
+    def bar(result, fold, record_of):
+        total = real_bar(result, fold, record_of)
+        key = "Z" if fold.weight else "lambda"
+        jumps = [_jump_record(record_of(f), key) for f in result.get("jumps", [])]
+        term = sum(abs(j["landing_F"] - j["F"]) * (abs(j["c_grid"] - j["c"]) + j["c_err"])
+                   for j in jumps if j["landing_F"] is not None and j["c_err"] is not None)
+        quad = result.get("quadrature_err", 0.0) if result.get("pieces") else 0.0
+        seen["spring" if fold.weight else "rigid"] = {
+            "jumps": jumps, "terms": None if total is None else
+            {"jumps": term, "stretches": total - term - quad, "quadrature": quad}}
+        return total
+
+    def cycle(segments, fold):
+        t = time.perf_counter()
+        out = real_cycle(segments, fold)
+        cycle_s["spring" if fold.weight else "rigid"] = time.perf_counter() - t
+        return out
+
+    energy.energy_bar, energy.cycle = bar, cycle
+    try:
+        t = time.perf_counter()
+        c = trace_curve(model, request=CurveRequest(spring=K))
+        wall = time.perf_counter() - t
+    finally:
+        energy.energy_bar, energy.cycle = real_bar, real_cycle
+    machine = "rigid" if K is None else "spring"
+    s = c.summary if K is None else c.summary["spring"]
+    return {"value": s["energy"], "bar": s["energy_err"], "loops": s["loops"], "note": s.get("energy_note"),
+            "bar_terms": seen[machine]["terms"], "jumps": seen[machine]["jumps"],
+            "time": {"curve_s": wall, "cycle_s": cycle_s[machine]}}
+
+
+def _level(model, K, level: int) -> dict:
+    """The whole curve on refinement ``level`` of the default grids, as trace_curve traces it, and its energy
+    (the tight quadrature; at level 0 the program's too)."""
+    from ..core.events import EVENT_TOL, Fold, jumps
+    from ..discretization import preconditioning
+    from ..discretization.problem import far_approach
+    from ..tracing import energy, results
+    from ..tracing.trace import _reach_landings, curve_settings, spring_start
+    from ..tracing.tracer import Tracer
+
+    t = time.perf_counter()
+    tracer = Tracer(model, curve_settings(), results.curve_events((), K), EVENT_TOL, None, preconditioning.Dense(),
+                    level=level, rmax=model.rmax)
+    try:
+        lam0 = far_approach(model)
+        if K:
+            lam0 = min(lam0, spring_start(K))
+        tracer.run(lam0)
+        fold = results.spring_fold(tracer.events) if K else next(e for e in tracer.events if isinstance(e, Fold))
+        if K:
+            _reach_landings(tracer, fold)
+        segments = tracer.segments
+        jumps([seg.finder for seg in segments])
+        traced = time.perf_counter() - t
+        out = {"folds": sum(f.event is fold for seg in segments for f in seg.finder.found),
+               "nodes": int(max(seg.problem.layout.N for seg in segments)),
+               "steps": sum(len(seg.cont.points) - 1 for seg in segments), "trace_s": traced}
+        if level == 0:
+            cyc = energy.cycle(segments, fold)
+            out["energy_default"] = cyc["energy"]
+        tol, halvings = energy.QUADRATURE_TOL, energy.MAX_HALVINGS
+        energy.QUADRATURE_TOL, energy.MAX_HALVINGS = TRUTH_TOL, TRUTH_HALVINGS
+        try:
+            t = time.perf_counter()
+            cyc = energy.cycle(segments, fold)
+            out["cycle_s"] = time.perf_counter() - t
+        finally:
+            energy.QUADRATURE_TOL, energy.MAX_HALVINGS = tol, halvings
+        out |= {"energy": cyc["energy"], "loops": cyc.get("loops", 0), "quadrature_err": cyc.get("quadrature_err"),
+                "note": cyc.get("note"),
+                "jumps": [{"kind": f.label, "c": fold.value(f.point), "F": f.point.values["F"],
+                           "landing_F": None if f.landing is None else f.landing.values["F"]}
+                          for f in cyc.get("jumps", [])]}
+    finally:
+        tracer.destroy()
+    return out
+
+
+def _truth(levels: dict, use: tuple) -> tuple:
+    """(value, bar) of the tight energies at the levels ``use``: exactly 0 when every level has no loop."""
+    from ..tracing.error_bars import extrapolate
+
+    vals = {k: levels[k]["energy"] for k in use}
+    if all(v == 0.0 for v in vals.values()):
+        return 0.0, 0.0
+    return extrapolate(vals)
+
+
+def _agree(levels: dict, use) -> str | None:
+    """Why the levels ``use`` cannot be extrapolated together (their cycles differ), or None."""
+    shapes = {k: (levels[k]["loops"], [j["kind"] for j in levels[k]["jumps"]]) for k in use}
+    if any(levels[k]["energy"] is None for k in use):
+        return "no cycle on level " + ", ".join(str(k) for k in use if levels[k]["energy"] is None)
+    if len({json.dumps(s) for s in shapes.values()}) > 1:
+        return "the levels jump differently: " + "; ".join(f"level {k}: {n} loops, jumps {', '.join(j) or 'none'}"
+                                                         for k, (n, j) in shapes.items())
+    return None
+
+
+def case(mu: float, sigma: float, K: float | None) -> dict:
+    """One case in this process: the program's value and bar, the levels, the truth."""
+    import petsc4py
+    petsc4py.init([sys.argv[0]])
+    from ..model.parameters import Model
+    from ..tracing.edge_grids import RMAX
+
+    t0 = time.perf_counter()
+    row = {"mu": mu, "sigma": sigma, "K": K}
+    row |= _program(Model(mu=mu, sigma=sigma), K)
+    model = Model(mu=mu, sigma=sigma, rmax=RMAX)
+    levels = {k: _level(model, K, k) for k in LEVELS}
+    use = LEVELS
+    why = _agree(levels, use)
+    truth, tbar = (None, None) if why else _truth(levels, use)
+    bar = row["bar"]
+    if bar is not None and (why or tbar > RESOLVE * bar):
+        if 8 * levels[LEVELS[-1]]["trace_s"] < LEVEL3_BUDGET:
+            levels[LEVELS[-1] + 1] = _level(model, K, LEVELS[-1] + 1)
+            use = LEVELS[1:] + (LEVELS[-1] + 1,)
+            why = _agree(levels, use)
+            truth, tbar = (None, None) if why else _truth(levels, use)
+        else:
+            why = why or "level 3 too costly"
+    if not why and tbar > RESOLVE * (abs(row["value"] - truth) if bar is None else bar):
+        why = f"the truth's bar {tbar:.1e} is above {RESOLVE:g} times the program's" + (" error" if bar is None else "")
+    row |= {"levels": {str(k): v for k, v in levels.items()}, "truth_levels": list(use), "truth": truth,
+            "truth_bar": tbar, "resolved": not why, "unresolved": why,
+            "level0_diff": row["value"] - levels[0]["energy_default"]}
+    row["time"]["case_s"] = time.perf_counter() - t0
+    return row | derived(row)
+
+
+def derived(row: dict) -> dict:
+    """The error of the program's value, the ratio bar / error (None for no bar or no error) and whether the bar
+    covers (None where the truth is not resolved or the program gives no bar)."""
+    if row.get("truth") is None:
+        return {"error": None, "ratio": None, "covered": None}
+    err = abs(row["value"] - row["truth"])
+    bar = row["bar"]
+    return {"error": err, "ratio": bar / err if bar is not None and err > 0 else None,
+            "covered": bool(err <= bar) if bar is not None and row["resolved"] else None}
+
+
+def _run(c) -> dict:
+    mu, sigma, K = c
+    t = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.energy_coverage", "-case", f"{mu:g}",
+                           f"{sigma:g}", "rigid" if K is None else f"{K:g}"],
+                          capture_output=True, text=True, cwd=paths.ROOT)
+    if proc.returncode:
+        return {"mu": mu, "sigma": sigma, "K": K, "failed": proc.stderr.strip().splitlines()[-1:],
+                "time": {"process_s": time.perf_counter() - t}}
+    row = json.loads(proc.stdout.strip().splitlines()[-1])
+    row["time"]["process_s"] = time.perf_counter() - t
+    print(f"mu = {mu:g}, sigma = {sigma:g}, {_machine(row)}: {row['time']['process_s']:.0f} s", file=sys.stderr,
+          flush=True)
+    return row
+
+
+def _where(row: dict) -> str:
+    return f"mu = {row['mu']:g}, sigma = {row['sigma']:g}, {_machine(row)}"
+
+
+def _machine(row: dict) -> str:
+    return "rigid" if row["K"] is None else f"K = {row['K']:g}"
+
+
+def _g(x, digits: int = 2) -> str:
+    return "-" if x is None else f"{x:.{digits}g}" if x == 0 else f"{x:.{digits}e}".replace("e-0", "e-").replace("e+0", "e")
+
+
+def table(rows: list, made: dict | None = None) -> str:
+    """The per-case table, the summary line and the cost, from the study's rows."""
+    lines = ["| mu | sigma | machine | loops | energy (program) | bar | truth | truth's bar | levels | \\|error\\| | "
+             "bar / \\|error\\| | covered | bar: jumps, stretches, quadrature | curve (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    counted, ratios, missed, unresolved, failed, barless = [], [], [], [], [], []
+    for r in rows:
+        if "failed" in r:
+            failed.append(f"mu = {r['mu']:g}, sigma = {r['sigma']:g}, {_machine(r)}")
+            continue
+        terms = r["bar_terms"] or {}
+        split = ", ".join(_g(terms.get(k), 1) for k in ("jumps", "stretches", "quadrature")) if r["bar"] else "-"
+        cov = "truth not resolved" if not r["resolved"] else "no bar" if r["bar"] is None else \
+            "yes" if r["covered"] else "**no**"
+        lines.append(f"| {r['mu']:g} | {r['sigma']:g} | {_machine(r)} | {r['loops']} | {r['value']:.8f} | {_g(r['bar'])} | "
+                     + ("- | - | " if r["truth"] is None else f"{r['truth']:.8f} | {_g(r['truth_bar'], 1)} | ")
+                     + f"{', '.join(map(str, r['truth_levels']))} | {_g(r['error'])} | {_g(r['ratio'])} | {cov} | "
+                     f"{split} | {r['time']['curve_s']:.1f} |")
+        if not r["resolved"]:
+            unresolved.append(f"{_where(r)} ({r['unresolved']}; "
+                              f"value {r['value']:.8f}, bar {_g(r['bar'])}"
+                              + ("" if r["truth"] is None else f", truth {r['truth']:.8f} +- {_g(r['truth_bar'], 1)}")
+                              + ")")
+            continue
+        if r["bar"] is None:
+            barless.append(f"{_where(r)} (value {r['value']:.8f}, truth {r['truth']:.8f}, error {_g(r['error'])}: "
+                           + "; ".join(f"{j['kind']}: {j['error_note']}" for j in r["jumps"] if j["error_note"]) + ")")
+            continue
+        if r["loops"]:
+            counted.append(r)
+            if r["ratio"] is not None:
+                ratios.append((r["ratio"], r))
+        if not r["covered"]:
+            missed.append(f"{_where(r)} (bar {_g(r['bar'])}, "
+                          f"error {_g(r['error'])})")
+    zeros = [r for r in rows if "failed" not in r and r["resolved"] and not r["loops"]]
+    cov = sum(r["covered"] for r in counted)
+    lines.append("")
+    if counted:
+        lo, hi = min(ratios, key=lambda x: x[0]), max(ratios, key=lambda x: x[0])
+        lines.append(f"**With hysteresis: covered in {cov} of {len(counted)} cases** (a bar given, the truth resolved); "
+                     f"bar / |error| median {np.median([x for x, _ in ratios]):.2g}, the smallest {lo[0]:.2g} "
+                     f"({_where(lo[1])}), the widest {hi[0]:.3g} ({_where(hi[1])}).")
+    if zeros:
+        lines.append(f"Without hysteresis: {len(zeros)} cases, "
+                     + ("every one 0 +- 0 on every level." if all(r["value"] == 0 and r["bar"] == 0 and r["truth"] == 0
+                                                                 for r in zeros) else "NOT all 0 +- 0."))
+    lines.append("\nNot covered: " + ("; ".join(missed) if missed else "none") + ".")
+    lines.append("\nNo bar (an energy with hysteresis reported without one): "
+                 + ("; ".join(barless) if barless else "none") + ".")
+    lines.append("\nTruth not resolved: " + ("; ".join(unresolved) if unresolved else "none") + ".")
+    if failed:
+        lines.append("\nFailed: " + "; ".join(failed) + ".")
+    ok = [r for r in rows if "failed" not in r]
+    curve = np.array([r["time"]["curve_s"] for r in ok])
+    cyc = np.array([r["time"]["cycle_s"] for r in ok])
+    wall = (made or {}).get("study_s")
+    lines.append(f"\nCost: the whole curve with its error bars (`trace_curve`, what the energy needs) took "
+                 f"{np.median(curve):.2g} s median, {curve.min():.2g} to {curve.max():.3g} s; `energy.cycle` "
+                 f"itself {np.median(cyc) * 1e3:.0f} ms median, at most {cyc.max():.2g} s "
+                 f"({np.median(cyc / curve):.1%} of the curve's time median)."
+                 + ("" if wall is None else f"  The study took {wall / 60:.0f} minutes on 2 cores."))
+    return "\n".join(lines)
+
+
+def _diagnosis(rows: list) -> list:
+    """Over the cases with hysteresis, a bar and a resolved truth: the true error split into the quadrature's
+    (the program's value against the same curve's with the tight tolerance) and the grid's (the rest), the
+    jumps' share of the grid's (each jump's c at level 0 against its extrapolation from the truth's levels,
+    times the jump's height), and each jump's c-error against the program's (grid value's distance from
+    the best value plus its bar)."""
+    from ..tracing.error_bars import extrapolate
+
+    out = []
+    for r in rows:
+        if "failed" in r or not r["resolved"] or not r["loops"] or r["bar"] is None:
+            continue
+        lv, use = r["levels"], r["truth_levels"]
+        d = {"row": r, "quad_err": abs(r["value"] - lv["0"]["energy"]), "grid_err": abs(lv["0"]["energy"] - r["truth"]),
+             "jump_err": 0.0, "c_ratios": []}
+        for i, (j, p) in enumerate(zip(lv["0"]["jumps"], r["jumps"])):
+            c = extrapolate({k: lv[str(k)]["jumps"][i]["c"] for k in use})[0]
+            if j["landing_F"] is not None:
+                d["jump_err"] += abs(j["landing_F"] - j["F"]) * abs(j["c"] - c)
+            if p["c_err"] is not None and j["c"] != c:
+                d["c_ratios"].append((abs(p["c_grid"] - p["c"]) + p["c_err"]) / abs(j["c"] - c))
+        out.append(d)
+    return out
+
+
+def _span(xs: list) -> str:
+    return f"{min(xs):.2g} to {max(xs):.3g} (median {np.median(xs):.2g})" if xs else "-"
+
+
+_OWN = {"jumps": "jumps'", "stretches": "stretches'", "quadrature": "quadrature's"}
+
+
+def section(rows: list, made: dict | None = None) -> str:
+    """The section of docs/coverage.md, from the study's rows."""
+    diag = _diagnosis(rows)
+    terms = ("jumps", "stretches", "quadrature")
+    qr = [d["row"]["bar_terms"]["quadrature"] / d["quad_err"] for d in diag if d["quad_err"] > 0]
+    jr = [d["row"]["bar_terms"]["jumps"] / d["jump_err"] for d in diag if d["jump_err"] > 0]
+    cr = [x for d in diag for x in d["c_ratios"]]
+    alone = {t: sum(d["row"]["error"] <= d["row"]["bar_terms"][t] for d in diag) for t in terms}
+    dominant = [max(terms, key=lambda t: d["row"]["bar_terms"][t]) for d in diag]
+    safe = [d["row"]["bar"] / (d["row"]["error"] + d["row"]["truth_bar"]) for d in diag]
+    blurred = [d["row"] for d in diag if d["row"]["error"] < d["row"]["truth_bar"]]
+    ok = [r for r in rows if "failed" not in r]
+    diffs = [abs(r["level0_diff"]) / abs(r["value"]) for r in ok if r["value"]]
+    used = sorted({tuple(r["truth_levels"]) for r in ok})
+    jumps_differ = [r for r in ok if any(len(v["jumps"]) != len(r["levels"]["0"]["jumps"]) or v["folds"] !=
+                                         r["levels"]["0"]["folds"] for v in r["levels"].values())]
+    src = made or {}
+    return SECTION.format(
+        table=table(rows, made), n=len(ok), hyst=sum(1 for r in ok if r["loops"]), m=len(diag),
+        zero=", ".join(_where(r) for r in ok if not r["loops"]) or "none",
+        quad=_span(qr), jump=_span(jr), c=_span(cr), safe=_span(safe),
+        alone=", ".join(f"the {_OWN[t]} term alone in {alone[t]}" for t in terms),
+        excess=_span([d["jump_err"] / d["row"]["error"] for d in diag if d["row"]["error"] > 0]),
+        dominant=", ".join(f"{t} in {dominant.count(t)}" for t in terms if dominant.count(t)) or "-",
+        blurred=len(blurred),
+        gq=(f"{np.median([d['quad_err'] / (d['quad_err'] + d['grid_err']) for d in diag]):.0%}" if diag else "-"),
+        same=f"{max(diffs, default=0.0):.0e}", resolve=RESOLVE, tol=TRUTH_TOL, budget=LEVEL3_BUDGET,
+        used="; ".join(", ".join(map(str, u)) for u in used),
+        differ=("none" if not jumps_differ else "; ".join(_where(r) for r in jumps_differ)),
+        commit=(src.get("commit") or "?")[:7])
+
+
+SECTION = HEADING + """
+
+<!-- made by: python -m petsc_adhesion.benchmarks.energy_coverage (data: docs/data/energy_coverage.json; -table redraws from it) -->
+Made by `python -m petsc_adhesion.benchmarks.energy_coverage` (`-table` redraws it from
+docs/data/energy_coverage.json).  The energy one approach-retract cycle dissipates
+(`summary["energy"]`, and behind a spring `summary["spring"]["energy"]`; `tracing/energy.py`)
+is computed on the curve's own grids (level 0), and its bar is built from the events' errors:
+each jump moved in its control c by its fold's error (the grid value's distance from the best
+value plus its bar) times the jump's height in F, each stretch of a loop's border moved in F by
+its ends' errors times its width in c, plus the quadrature's estimate.
+
+What was measured: {n} cases ({hyst} with hysteresis), mu = 1, 2, 3, 5 by sigma = 0, 0.2 (the
+Hermite rule), each with the rigid machine and springs K = 0.05, 0.5, 2, and mu = 0.5 (rigid:
+no hysteresis; K = 2: a small loop).  The program's value and bar are `trace_curve`'s with its
+defaults (commit {commit}).  The truth is the whole curve traced again on the default grids at
+refinement levels 0, 1, 2 (2^k times the nodes), started, traced back and jumped exactly as
+`trace_curve` does, its energy integrated with a quadrature tolerance of {tol:g} (the
+program's: 1e-5), and extrapolated by `error_bars.extrapolate`.  Where that extrapolation's own
+bar is above {resolve:g} times the program's bar, level 3 is traced too (when expected below
+{budget:.0f} s) and levels 1, 2, 3 are used, else the case is "truth not resolved".  Levels
+used: {used}.  Cases whose levels found a different number of folds or jumps: {differ}.
+Level 0 of the truth's trace is the program's own curve: its energy with the program's
+tolerance is the program's value to {same} (relative) in every case.  A bar covers when
+|value - truth| <= bar.
+
+{table}
+
+Which term carries the bar ({m} cases with hysteresis, a bar and a resolved truth).  The
+error is almost all the grid's: the quadrature's true error (the program's value against the
+same curve integrated with the tight tolerance) is a median {gq} of it, and its estimate is
+{quad} times that error.  Each jump's c-error as the program states it (grid value's distance
+from the best value, plus the bar) is {c} times the true one (level 0 against the levels'
+extrapolation): the best values of the folds are accurate, so the jumps' term is, in effect, the
+sum of |jump height x c-error| over the jumps ({jump} times it).  That sum alone is {excess}
+times the energy's whole error: the jumps' and the borders' errors, both the coarse grid's, evidently
+largely cancel in the loop's area, which the bar, a sum of absolute values, does not credit.  Of the {m} cases the error is covered by {alone}; the
+largest term: {dominant} cases.  In {blurred} cases the
+error is below the truth's own bar, so their bar / |error| is uncertain; bar / (|error| +
+truth's bar), a lower bound of the ratio wherever the truth's bar holds, is {safe}.
+"""
+
+
+def _source() -> dict:
+    """The library the study measured: the checkout's commit and the package's files changed since."""
+    def git(*args):
+        p = subprocess.run(["git", *args], capture_output=True, text=True, cwd=paths.ROOT)
+        return p.stdout.strip() if p.returncode == 0 else None
+
+    changed = git("status", "--porcelain", "--", "petsc_adhesion")
+    return {"commit": git("rev-parse", "HEAD"), "changed": None if changed is None else changed.splitlines()}
+
+
+def _write_section(text: str) -> None:
+    """``text`` as the section HEADING of docs/coverage.md: in place of the one there, else at the end."""
+    with open(DOC) as f:
+        doc = f.read()
+    if HEADING + "\n" in doc:
+        head, rest = doc.split(HEADING + "\n", 1)
+        tail = rest.split("\n## ", 1)
+        doc = head + text + ("\n## " + tail[1] if len(tail) > 1 else "")
+    else:
+        doc = doc.rstrip("\n") + "\n\n" + text
+    with open(DOC, "w") as f:
+        f.write(doc)
+
+
+def main(argv: list[str]) -> int:
+    """The study (or one case with -case mu sigma K|rigid, or the table alone with -table)."""
+    if argv[:1] == ["-case"]:
+        K = None if argv[3] == "rigid" else float(argv[3])
+        print(json.dumps(case(float(argv[1]), float(argv[2]), K)))
+        return 0
+    if argv[:1] != ["-table"]:
+        t = time.perf_counter()
+        with ThreadPoolExecutor(2) as pool:
+            rows = list(pool.map(_run, CASES))
+        made = {"study_s": time.perf_counter() - t, **_source()}
+        os.makedirs(os.path.dirname(DATA), exist_ok=True)
+        with open(DATA, "w") as f:
+            json.dump({"made": made, "rows": rows}, f, indent=1)
+    with open(DATA) as f:
+        data = json.load(f)
+    _write_section(section(data["rows"], data["made"]))
+    print(table(data["rows"], data["made"]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
