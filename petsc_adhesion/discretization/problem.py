@@ -34,7 +34,7 @@ def norm_radius(model) -> float:
 
 
 #: Above this Tabor parameter a sphere is soft: its curve is measured in units of mu (:func:`step_scale`).
-MU_SOFT = 20.0
+MU_SOFT = 10.0
 
 
 def step_scale(model) -> float:
@@ -45,8 +45,7 @@ def step_scale(model) -> float:
     order one): measured in units of mu its steps take the same number at any mu
     (the frame of the edge weighs the contact radius's relative change alike,
     :class:`~petsc_adhesion.discretization.edge_frame.EdgeFrameProblem`).  Up to
-    MU_SOFT, the range the program covered before, its curves are traced as they
-    were, step for step.
+    MU_SOFT curves are traced as they were, step for step.
     """
     return float(model.mu) if model.mu > MU_SOFT else 1.0
 

@@ -11,11 +11,12 @@ import math
 
 from ..discretization.grid import EdgeGrid
 from ..discretization.resolution import NODES_PER_ZONE, cohesive_zone
+from ..discretization.problem import MU_SOFT
 from ..model.pressure import pressure_law
 
 __all__ = ["BAND", "BAND_ZONES", "CONTACT_SPACING", "REACH", "RMAX", "A_SWITCH", "A_SWITCH_ZONES", "GROW", "band",
            "a_switch", "grid_for", "scaled_grid_for", "scaled_band", "sharp",
-           "frame_of_edge", "MU_TRUNCATED"]
+           "frame_of_edge", "MU_TRUNCATED", "soft"]
 
 
 #: Half-width of the fine band about the edge in the physical frame ...
@@ -63,17 +64,25 @@ def _fine(model) -> float:
     """The spacing about the edge: the zone over NODES_PER_ZONE, COARSE_MARGIN times finer for a sharp edge
     (so that its two coarser levels still resolve the zone and give the error bars), at most CONTACT_SPACING."""
     zone = _zone(model)
-    return min(zone / NODES_PER_ZONE / (COARSE_MARGIN if sharp(model) else 1), CONTACT_SPACING)
+    return min(zone / NODES_PER_ZONE / (COARSE_MARGIN if soft(model) else 1), CONTACT_SPACING)
+
+
+def soft(model) -> bool:
+    """A soft sphere (mu above MU_SOFT): its grids are sized by the cohesive zone and the contact radius,
+    its curve measured in units of mu; up to MU_SOFT the grids are as they were, node for node."""
+    return model.mu > MU_SOFT
 
 
 def band(model) -> float:
-    """The half-width of the fine band about the edge in the physical frame: BAND, or BAND_ZONES zones."""
-    return min(BAND, BAND_ZONES * _zone(model))
+    """The half-width of the fine band about the edge in the physical frame: BAND, or for a soft sphere
+    BAND_ZONES zones where fewer."""
+    return min(BAND, BAND_ZONES * _zone(model)) if soft(model) else BAND
 
 
 def a_switch(model) -> float:
-    """The contact radius at which the frame of the edge takes over: A_SWITCH, or A_SWITCH_ZONES zones."""
-    return min(A_SWITCH, A_SWITCH_ZONES * _zone(model))
+    """The contact radius at which the frame of the edge takes over: A_SWITCH, or for a soft sphere
+    A_SWITCH_ZONES zones where fewer."""
+    return min(A_SWITCH, A_SWITCH_ZONES * _zone(model)) if soft(model) else A_SWITCH
 
 
 def grid_for(model, edge: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid:
@@ -91,14 +100,17 @@ def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: f
     past rmax at a / GROW^2, or to GROW a where that is further (a small r_m must not
     put the end of a grid in rho = r / a before the edge pinned at rho = 1; the far
     field beyond keeps the model the half-infinite one, and
-    :func:`~petsc_adhesion.tracing.results.assess` says when the contact nears the end).  Inside the contact the spacing may grow to CORE_SHARE a;
+    :func:`~petsc_adhesion.tracing.results.assess` says when the contact nears the end).  For a soft
+    sphere (:func:`soft`) inside the contact the spacing may grow to CORE_SHARE a;
     outside, it is capped by CONTACT_SPACING as far as the forces reach: where the rigid
     sphere's gap has opened by REACH^2 / 2 beyond the edge's, sqrt(a^2 + REACH^2) - a
     (REACH at a = 0, 3 / (2 a) for a large contact; the elastic opening only shortens it).
     """
+    big = soft(model)
     return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=max(rmax * GROW**2, GROW * a),
                     band=2 * _zone(model) if band is None else band, contact=CONTACT_SPACING,
-                    reach=math.sqrt(a * a + REACH**2) - a, core=CORE_SHARE * a, level=level)
+                    reach=math.sqrt(a * a + REACH**2) - a if big else REACH, core=CORE_SHARE * a if big else 0.0,
+                    level=level)
 
 
 def scaled_band(model, a: float, peak: float) -> float:
