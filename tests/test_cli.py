@@ -511,3 +511,18 @@ def test_unwritable_output_is_one_line(tmp_path, option):
         err = proc.stderr.strip().splitlines()
         assert proc.returncode == 2 and len(err) == 1 and err[0].startswith(f"petsc-adhesion: error: {option}:")
     assert [p.name for p in tmp_path.iterdir()] == ["d"] and not any((tmp_path / "d").iterdir())
+
+
+def test_the_installed_command_names_a_main_that_exists():
+    """pyproject.toml's petsc-adhesion command (what ./run demo and ./run study start) names a module and a
+    function that exist: it named petsc_adhesion.cli after the subpackages had moved it to app/cli.py, and
+    every ./run demo failed with ModuleNotFoundError while the suite, which starts python -m petsc_adhesion,
+    passed."""
+    import importlib
+    import tomllib
+
+    with open(os.path.join(os.path.dirname(petsc_adhesion.__file__), os.pardir, "pyproject.toml"), "rb") as f:
+        target = tomllib.load(f)["project"]["scripts"]["petsc-adhesion"]
+    module, _, name = target.partition(":")
+    assert callable(getattr(importlib.import_module(module), name))
+    assert importlib.import_module(module) is importlib.import_module("petsc_adhesion.app.cli")
