@@ -198,7 +198,7 @@ class EventFinder:
         sb = b.ds if b.ds and b.corrector == ("natural" if cont.natural_ok(a) and not arclength else "arclength") \
             else cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p)
         correct = cont.arclength if arclength else cont.correct
-        natural = cont.natural_ok(a) and not arclength and cont.set.corrector != "arclength"
+        natural = cont.natural_ok(a) and not arclength
         cache = {}
 
         def point(s, tangent=tangent):
