@@ -33,21 +33,21 @@ def norm_radius(model) -> float:
     return max(10.0, 3.0 * jkr_zero_load(model.mu)[0]) if model.mu > 0 else 10.0
 
 
-#: Above this Tabor parameter a sphere is soft: its curve is measured in units of mu (:func:`step_scale`).
-MU_SOFT = 10.0
+#: From this Tabor parameter on a sphere is soft: its curve is measured in units of mu (:func:`step_scale`).
+MU_SOFT = 20.0
 
 
 def step_scale(model) -> float:
-    """The length unit of a soft sphere's curve: mu above MU_SOFT, else 1.
+    """The length unit of a soft sphere's curve: mu from MU_SOFT on, else 1.
 
     Towards the JKR end the curve is self-similar in lambda / mu and F (the
     deformation grows like mu, the contact radius like mu^(1/2), the load stays of
     order one): measured in units of mu its steps take the same number at any mu
     (the frame of the edge weighs the contact radius's relative change alike,
-    :class:`~petsc_adhesion.discretization.edge_frame.EdgeFrameProblem`).  Up to
+    :class:`~petsc_adhesion.discretization.edge_frame.EdgeFrameProblem`).  Below
     MU_SOFT curves are traced as they were, step for step.
     """
-    return float(model.mu) if model.mu > MU_SOFT else 1.0
+    return float(model.mu) if model.mu >= MU_SOFT else 1.0
 
 
 def far_approach(model) -> float:
