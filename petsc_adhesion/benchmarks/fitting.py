@@ -189,29 +189,8 @@ def pull_off_section(rows: list, made: dict) -> str:
 
 
 # -- docs/fitting.md ------------------------------------------------------------------
-def _write_section(text: str) -> None:
-    """``text`` (from its '## ' heading) in place of the section of that heading in docs/fitting.md, else at
-    its end."""
-    heading = text.split("\n", 1)[0]
-    with open(DOC) as f:
-        doc = f.read()
-    if heading + "\n" in doc:
-        head, rest = doc.split(heading + "\n", 1)
-        tail = rest.split("\n## ", 1)
-        doc = head + text + ("\n## " + tail[1] if len(tail) > 1 else "")
-    else:
-        doc = doc.rstrip("\n") + "\n\n" + text
-    with open(DOC, "w") as f:
-        f.write(doc)
 
 
-def _source() -> dict:
-    def git(*args):
-        p = subprocess.run(["git", *args], capture_output=True, text=True, cwd=paths.ROOT)
-        return p.stdout.strip() if p.returncode == 0 else None
-
-    changed = git("status", "--porcelain", "--", "petsc_adhesion")
-    return {"commit": git("rev-parse", "HEAD"), "changed": None if changed is None else changed.splitlines()}
 
 
 def main(argv: list[str]) -> int:
@@ -226,11 +205,11 @@ def main(argv: list[str]) -> int:
             t = time.perf_counter()
             rows = pull_off_rows()
             with open(_data("pull_off"), "w") as f:
-                json.dump({"made": {"seconds": time.perf_counter() - t, **_source()}, "rows": rows}, f, indent=1)
+                json.dump({"made": {"seconds": time.perf_counter() - t, **paths.source()}, "rows": rows}, f, indent=1)
         with open(_data("pull_off")) as f:
             d = json.load(f)
         text = pull_off_section(d["rows"], d["made"])
-        _write_section(text)
+        paths.write_section(DOC, text)
         print(text)
     if "coverage" in parts:
         if not redraw:
@@ -241,11 +220,11 @@ def main(argv: list[str]) -> int:
                 rows = list(pool.map(_case_process, cases))
             rows.sort(key=lambda r: (r["mu"], r["seed"]))
             with open(_data("coverage"), "w") as f:
-                json.dump({"made": {"study_s": time.perf_counter() - t, **_source()}, "rows": rows}, f, indent=1)
+                json.dump({"made": {"study_s": time.perf_counter() - t, **paths.source()}, "rows": rows}, f, indent=1)
         with open(_data("coverage")) as f:
             d = json.load(f)
         text = coverage_section(d["rows"], d["made"])
-        _write_section(text)
+        paths.write_section(DOC, text)
         print(text)
     return 0
 
