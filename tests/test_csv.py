@@ -1,4 +1,4 @@
-"""The CSV exports: -csv (the curve), -csv_events (its events) and a study's table of events beside -out.
+"""The CSV exports: -csv (the curve), -csv_events (its events) and a study's table of events (-csv).
 
 Each file is read back with the standard library's csv module and judged against what the same run wrote
 elsewhere: the HDF5 file (bit for bit), the JSON summary, the scales of the physical group, Z = lambda + F/K
@@ -119,8 +119,10 @@ RUNS = {
     # physical inputs, no error bars: columns in nm and nN, empty bars
     "physical": (*PHYSICAL, "-cont_error_estimate", "false", "-out", "c.h5", "-summary", "c.json", "-csv",
                  "c.csv", "-csv_events", "e.csv"),
-    # a study: its table beside -out
-    "study": (*STUDY, "-out", "s.h5", "-summary", "s.json"),
+    # a study: its table where -csv says
+    "study": (*STUDY, "-out", "s.h5", "-summary", "s.json", "-csv", "s.csv"),
+    # a study without -csv writes no table
+    "study_no_csv": (*STUDY, "-out", "s.h5", "-cont_error_estimate", "false"),
     # a study of a swept option, its table where -csv says
     "study_option": ("-study_mu", "1", "-study_option", "cont_F_max", "-study_values", "0,0.5", *FAST,
                      "-cont_error_estimate", "false", "-out", "x.h5", "-csv", "table.csv"),
@@ -306,8 +308,10 @@ def _check_table(path, h5) -> tuple[list, dict]:
     return header, cols
 
 
-def test_study_table_beside_out(runs):
-    """-out s.h5 writes s.csv: one row per event of each case, its columns the HDF5 table's."""
+def test_study_table(runs):
+    """-csv s.csv: one row per event of each case, its columns the HDF5 table's; without -csv, no table
+    (nothing is written that the run was not asked to write)."""
+    assert listing(runs["study_no_csv"]) == ["s.h5"]
     assert listing(runs["study"]) == ["s.csv", "s.h5", "s.json"]
     header, cols = _check_table(runs["study"] / "s.csv", runs["study"] / "s.h5")
     assert header == ["case", "adh_mu [1]", "kind", f"lambda {EPS}", f"lambda_err {EPS}", f"F {LOAD}",
@@ -318,7 +322,7 @@ def test_study_table_beside_out(runs):
 
 
 def test_study_table_where_csv_says(runs):
-    """-csv names the table's file (none beside -out); a swept option's column is named by the option."""
+    """-csv names the table's file; a swept option's column is named by the option."""
     assert listing(runs["study_option"]) == ["table.csv", "x.h5"]
     header, cols = _check_table(runs["study_option"] / "table.csv", runs["study_option"] / "x.h5")
     assert header[:4] == ["case", "adh_mu [1]", "cont_F_max", "kind"]
@@ -351,12 +355,6 @@ REFUSED = {
     "study_events": ((*STUDY, "-out", "s.h5", "-csv_events", "e.csv"), {}, "-csv_events: "),
     "critical_csv": (("-study_mu", "1", "-study_compute", "critical", "-out", "k.h5", "-csv", "k.csv"), {},
                      "-csv: -study_compute critical has no table of events"),
-    "study_out_named_csv": ((*STUDY, "-out", "s.csv"), {}, "-csv: 's.csv' is also the file of -out; it is the "
-                                                          "study's table beside -out: give -csv another file"),
-    "study_table_over_an_input": ((*STUDY, "-adh_roughness", "measured", "-adh_roughness_file", "s.csv",
-                                   "-out", "s.h5"), {},
-                                  "-csv: 's.csv' is an input of this run (-adh_roughness_file); it is the "
-                                  "study's table beside -out: give -csv another file"),
     "study_csv_is_summary": ((*STUDY, "-summary", "s.json", "-csv", "s.json"), {},
                              "-csv: 's.json' is also the file of -summary"),
 }

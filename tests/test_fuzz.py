@@ -855,6 +855,31 @@ def check_h5(path: str) -> tuple[list, dict]:
     return bad, info
 
 
+def check_csv(path: str, opt: str) -> list:
+    """A CSV export: its header's first column (lambda for -csv, kind for -csv_events), every row as long as
+    the header, every number finite."""
+    import csv
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+    except (OSError, UnicodeDecodeError, csv.Error) as e:
+        return [f"{path}: not a CSV file ({e})"]
+    first = "kind" if opt == "csv_events" else "lambda"
+    if not rows or not rows[0] or not rows[0][0].startswith(first):
+        return [f"{path}: -{opt} has no header starting with {first} ({rows[:1]!r})"]
+    bad = [f"{path}: row {i} has {len(r)} cells, the header {len(rows[0])}" for i, r in enumerate(rows[1:], 1)
+           if len(r) != len(rows[0])]
+    for i, r in enumerate(rows[1:], 1):
+        for cell in r:
+            try:
+                v = float(cell)
+            except ValueError:
+                continue
+            if not math.isfinite(v):
+                bad.append(f"{path}: row {i} holds {cell}")
+    return bad
+
+
 def check_plot(path: str) -> list:
     ext = os.path.splitext(path)[1].lower()
     with open(path, "rb") as f:
@@ -933,6 +958,8 @@ def judge(case: Case, res: dict, before: dict, after: dict, out: bytes, err: byt
             problems, infos[opt] = check_h5(path)
         elif opt == "summary":
             problems, infos[opt] = check_json(path)
+        elif opt in ("csv", "csv_events"):
+            problems = check_csv(path, opt)
         else:
             problems = check_plot(path)
         bad += problems
@@ -1019,9 +1046,10 @@ class Worker:
 
 @pytest.fixture(scope="module")
 def assets(tmp_path_factory):
-    """The earlier result set (a curve: -out, -summary, -plot) and a guess (-out of a solve)."""
+    """The earlier result set (a curve: -out, -summary, -plot, -csv, -csv_events) and a guess (-out of a solve)."""
     d = tmp_path_factory.mktemp("assets")
-    runs = {"earlier": [*EARLIER_ARGS, "-out", d / "e.h5", "-summary", d / "e.json", "-plot", d / "e.png"],
+    runs = {"earlier": [*EARLIER_ARGS, "-out", d / "e.h5", "-summary", d / "e.json", "-plot", d / "e.png",
+                        "-csv", d / "e.csv", "-csv_events", d / "ee.csv"],
             "guess": [*GUESS_ARGS, "-out", d / "g.h5"]}
     procs = {k: subprocess.Popen([sys.executable, "-m", "petsc_adhesion", *map(str, a)], cwd=ROOT,
                                  env=conftest._env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -1029,7 +1057,8 @@ def assets(tmp_path_factory):
     for k, p in procs.items():
         _, e = p.communicate(timeout=120)
         assert p.returncode in (0, 3), (k, e)
-    return {"out": str(d / "e.h5"), "summary": str(d / "e.json"), "plot": str(d / "e.png"), "guess": str(d / "g.h5")}
+    return {"out": str(d / "e.h5"), "summary": str(d / "e.json"), "plot": str(d / "e.png"), "guess": str(d / "g.h5"),
+            "csv": str(d / "e.csv"), "csv_events": str(d / "ee.csv")}
 
 
 def _selected(cases: list) -> list:

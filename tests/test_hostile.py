@@ -3,7 +3,7 @@ member of its class of hostile input, not one example each.
 
 1. File options are judged by what the file is before it is opened: every file option the program reads
    (-options_file, one nested in an options file, one named in PETSC_OPTIONS, a .petscrc in the working
-   directory, -adh_roughness_file, -adh_guess, -cont_restart, ``plot FILE``) given every special kind (a
+   directory, -adh_roughness_file, -adh_guess, -cont_restart, -fit_curve, ``plot FILE``) given every special kind (a
    FIFO, /dev/zero, /dev/null, a directory, a symbolic link that loops, one to nothing, a missing file):
    exit 2, one line naming the option, the file and what it is, promptly (a FIFO never blocks), nothing
    written; on two ranks too for the files read after MPI starts.
@@ -151,7 +151,7 @@ FILE_OPTIONS = {"options_file": "-options_file: ", "nested_options_file": "-opti
                 "PETSC_OPTIONS": "PETSC_OPTIONS: -options_file: ",
                 "petscrc": ".petscrc (read by PETSc at start-up): ",
                 "adh_roughness_file": "-adh_roughness_file: ", "adh_guess": "-adh_guess: ",
-                "cont_restart": "-cont_restart: ", "plot": "plot: "}
+                "cont_restart": "-cont_restart: ", "fit_curve": "-fit_curve: ", "plot": "plot: "}
 #: on two ranks: the files read once MPI runs (a check on rank 0 must end every rank)
 TWO_RANKS = [("adh_roughness_file", "fifo"), ("adh_guess", "fifo"), ("cont_restart", "fifo"),
              ("cont_restart", "dev_zero")]
@@ -199,6 +199,9 @@ def _file_case(option: str, kind: str, work: str, out: str) -> tuple:
         return (*SOLVE, "-adh_guess", path, *outputs), None, path
     if option == "cont_restart":
         return (*CURVE, "-cont_restart", path, *outputs), None, path
+    if option == "fit_curve":
+        return ("-fit_curve", path, "-phys_radius", "20e-9", "-phys_epsilon", "3e-10", "-phys_spring", "1",
+                *outputs), None, path
     assert option == "plot"
     return ("plot", path, "-o", os.path.join(out, "r.png")), None, path
 

@@ -23,8 +23,9 @@ ALLOWED = {
     "discretization": {"core", "model"},
     "tracing": {"core", "model", "discretization"},
     "io": {"model", "tracing"},
-    "app": {"core", "model", "discretization", "tracing", "io"},
-    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app"},
+    "fitting": {"core", "model", "discretization", "tracing"},
+    "app": {"core", "model", "discretization", "tracing", "io", "fitting"},
+    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app", "fitting"},
 }
 
 

@@ -134,9 +134,9 @@ def test_bad_case_does_not_spoil_the_study(tmp_path):
 
 
 @pytest.mark.parametrize("args, line", [
-    (("-study_mu", "1:0:3"), "-study_mu: expected comma-separated reals or ranges lo:hi:n[:log] in [0, 50], got '1:0:3'"),
+    (("-study_mu", "1:0:3"), "-study_mu: expected comma-separated reals or ranges lo:hi:n[:log] in [0, 1000], got '1:0:3'"),
     (("-study_mu", "0:1:3:log"), "-study_mu: expected comma-separated reals or ranges"),
-    (("-study_mu", "1,60"), "-study_mu: expected comma-separated reals or ranges"),
+    (("-study_mu", "1,1001"), "-study_mu: expected comma-separated reals or ranges"),
     (("-adh_mu", "1", "-study_mu", "1,2"), "-adh_mu: not with -study_mu, which sets it for each case"),
     (("-study_option", "adh_mu", "-study_values", "1"), "-study_option: 'adh_mu': use -study_mu or -study_sigma"),
     (("-study_option", "adh_rmax"), "-study_values: required with -study_option"),

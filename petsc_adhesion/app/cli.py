@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import time
 from contextlib import nullcontext
 
 from ..errors import Interrupted, first_line, printable, say, tell
@@ -31,13 +32,37 @@ def _on_signal(signum, frame):
     raise Interrupted(signum)
 
 
+#: How long the other ranks wait for rank 0 to have written the line before they exit ...
+SETTLE_S = 10.0
+#: ... and before MPI is initialised, where they cannot know when it has.
+SETTLE_BEFORE_MPI_S = 2.0
+#: A launcher's rank of this process (Open MPI, PMIx, MPICH's PMI, Slurm).
+_RANK_VARIABLES = ("OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK", "SLURM_PROCID")
+
+
 def _say(msg: str) -> None:
-    """One line on rank 0's stderr (every process's, before MPI is there to ask)."""
+    """One line on rank 0's stderr (before MPI is there to ask, rank 0 by the launcher's variables).
+
+    On several ranks the others wait until rank 0 has written it (a barrier, at most SETTLE_S): a rank
+    that exits first with a non-zero status makes mpiexec abort the job, and rank 0 was killed before
+    its line was out (found by the fuzz: exit 2 with no line, Open MPI's notices only)."""
     if "mpi4py.MPI" in sys.modules:
         from mpi4py import MPI
 
-        if MPI.COMM_WORLD.Get_rank() != 0:
-            return
+        comm = MPI.COMM_WORLD
+        if comm.Get_rank() == 0:
+            say(f"error: {printable(msg)}")
+        if comm.Get_size() > 1 and MPI.Is_initialized() and not MPI.Is_finalized():
+            request, t0 = comm.Ibarrier(), time.monotonic()
+            while not request.Test() and time.monotonic() - t0 < SETTLE_S:
+                time.sleep(0.002)
+        return
+    # before MPI: the launcher's rank; the others stay silent, and wait a moment so that rank 0's line is
+    # out before their exit status makes mpiexec abort the job
+    rank = next((os.environ[v] for v in _RANK_VARIABLES if v in os.environ), "0")
+    if rank.strip() != "0":
+        time.sleep(SETTLE_BEFORE_MPI_S)
+        return
     say(f"error: {printable(msg)}")
 
 
@@ -114,7 +139,7 @@ def _program(argv: list[str]) -> int:
     from petsc4py import PETSc
 
     from ..errors import collective
-    from . import run, study
+    from . import fit, run, study
     from .options.help import print_help
     from .options.reading import AppOptions
 
@@ -122,6 +147,9 @@ def _program(argv: list[str]) -> int:
     helping = opts.db.hasName("help")
     if helping and PETSc.COMM_WORLD.getRank() == 0:
         print_help()
+    if collective(PETSc.COMM_WORLD, fit.is_fit, opts):
+        return fit.main(opts, argv, helping)
+    fit.refuse_fit_options(opts)
     if collective(PETSc.COMM_WORLD, run.is_study, opts):
         return study.main(opts, argv, helping)
     return run.main(opts, argv, helping)

@@ -106,7 +106,7 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
               "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
-    return Request(model, grid_choice, read_solver(opts), read_settings(opts), read_request(opts, kinds, profiles, model.bodies),
+    return Request(model, grid_choice, read_solver(opts), read_settings(opts, model), read_request(opts, kinds, profiles, model.bodies),
                    lam, opts.string("adh_guess"), targets, inputs)
 
 

@@ -21,7 +21,7 @@ files hold them (exit status 3 when any case is missing).  One HDF5 file (a
 group per case and a table of every case's events with their error bars), one
 JSON summary (``cases``: each case's ``mu``, ``sigma`` and the keys of a single
 curve's summary), the figure of ``-study_plot`` and the table of events as CSV
-(``-csv``, by default ``X.csv`` beside ``-out X.h5``) are written together.
+(``-csv``, when given) are written together.
 
 Rank 0 saves the finished cases into a checkpoint as they reach it (at most
 every ``-cont_checkpoint_interval`` seconds; by default beside ``-out``):
@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -304,8 +303,8 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
 
 
 def _files(opts: AppOptions, argv: list[str], table: bool = True):
-    """The study's files (-out, -summary, -plot and, for a ``table`` of events, its CSV: -csv, by default
-    -out's name with the extension .csv), checked writable and apart from its inputs, and its checkpoint
+    """The study's files (-out, -summary, -plot and, for a ``table`` of events, its CSV -csv: nothing the
+    user did not name), checked writable and apart from its inputs, and its checkpoint
     (:func:`~petsc_adhesion.app.checkpoint.open_checkpoint`; collective)."""
     if opts.db.hasName("csv_events"):
         raise InputError("-csv_events: writes the events of one curve, not of a study (its table of events goes to "
@@ -315,21 +314,12 @@ def _files(opts: AppOptions, argv: list[str], table: bool = True):
     if given and not table:
         raise InputError("-csv: -study_compute critical has no table of events (its cusps are in -out and "
                          "-summary); remove it")
-    beside = table and not given and "out" in targets      # the table beside the HDF5 file, unasked
-    if given or beside:
-        targets["csv"] = given or os.path.splitext(targets["out"])[0] + ".csv"
+    if given:
+        targets["csv"] = given
     inputs = {"options_file": options_files(argv), "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     world = PETSc.COMM_WORLD
 
-    def check():
-        try:
-            check_targets(targets, inputs)
-        except InputError as e:
-            if beside and str(e).startswith("-csv:"):    # the user gave no -csv: say where the name came from
-                raise InputError(f"{e}; it is the study's table beside -out: give -csv another file") from None
-            raise
-
-    collective(world, lambda: check() if world.getRank() == 0 else None)
+    collective(world, lambda: check_targets(targets, inputs) if world.getRank() == 0 else None)
     return targets, open_checkpoint(opts, targets, inputs, world, study=True)
 
 

@@ -1,7 +1,7 @@
 """Benchmarks on one rank: the influence matrix, one Newton solve, the mu = 1 curve.
 
     OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.benchmarks [-bench_repeats K] \\
-        [-bench_only influence|solve|curve|stiff|leaveout|workprecision] [-bench_json bench.json] [-bench_profile] [-log_view]
+        [-bench_only influence|solve|curve|stiff|fit|leaveout|workprecision] [-bench_json bench.json] [-bench_profile] [-log_view]
 
 Each quantity is the median wall time of repeated runs (7, 3 at N = 4000 and 5
 for the curve, or K each), shown with its min, max and number of repeats,
@@ -24,6 +24,9 @@ a measurement, not a test.
 * stiff: the default curves at mu = 7 (target 10 s) and mu = 20 (target 60 s),
   error bars included, checked for their fold pairs, pull-off and equilibrium
   and for no warning (3 repeats each).
+* fit: one fit of a force curve (:func:`~petsc_adhesion.fitting.curve_fit.fit_curve`, target 60 s)
+  made by the forward solver at mu = 1 with 1% noise (300 points a leg, its
+  making untimed), checked for w and E* inside their 95% intervals (3 repeats).
 
 ``-bench_profile`` profiles one more curve (cProfile, which slows the Python
 side) and prints the ten functions of largest own time; ``-log_view`` gives PETSc's account of all runs.
@@ -59,13 +62,13 @@ from ..tracing.trace import discretize
 from ..version import __version__
 from ._library import traced
 
-__all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main", "PARTS", "STIFF", "row", "mu1_problem", "check_curve", "bench_stiff", "report"]
+__all__ = ["bench_influence", "bench_solve", "bench_curve", "profile_curve", "main", "PARTS", "STIFF", "row", "mu1_problem", "check_curve", "bench_stiff", "bench_fit", "report"]
 
 #: -bench_only choices, in the order they run; the last two only when asked for: "leaveout" (about
 #: 15 minutes, writes docs/figures/leaveout.md: petsc_adhesion/benchmarks/leaveout.py) with -bench_only leaveout,
 #: "workprecision" (about 20 minutes, writes docs/performance.md: petsc_adhesion/benchmarks/workprecision)
 #: with -bench_only workprecision or -bench_workprecision
-PARTS = ("influence", "solve", "curve", "stiff", "leaveout", "workprecision")
+PARTS = ("influence", "solve", "curve", "stiff", "fit", "leaveout", "workprecision")
 #: Stiff curves: mu -> (target in s, turning points of the resolved curve; docs/stability.md).
 STIFF = {7.0: (10.0, 4), 20.0: (60.0, 6)}
 
@@ -179,6 +182,28 @@ def bench_stiff(repeats: int | None = None) -> dict:
     return out
 
 
+def bench_fit(repeats: int | None = None) -> dict:
+    """One fit of a synthetic force curve at mu = 1 (target 60 s on one core; docs/fitting.md)."""
+    import math
+
+    from ..fitting.curve_fit import fit_curve
+    from ..fitting.synthetic import synthetic_curve
+
+    R, eps, k, w, mu = 20e-9, 0.3e-9, 1.0, 0.05, 1.0
+    E = w * math.sqrt(R / (mu**3 * eps**3))
+    data = synthetic_curve(R, eps, k, w, E, noise=0.01 * 2 * math.pi * R * w, points=300, z0=5e-9, seed=1)
+    times = []
+    for _ in range(repeats or 3):
+        t0 = time.perf_counter()
+        f = fit_curve(data, R, eps, k)
+        times.append(time.perf_counter() - t0)
+        if abs(f.gamma - w) > 1.96 * f.gamma_err or abs(f.E_star - E) > 1.96 * f.E_star_err:
+            raise RuntimeError(f"fit of the mu = 1 curve: w = {f.gamma:.5g} +- {f.gamma_err:.2g} (true {w:g}), "
+                               f"E* = {f.E_star:.5g} +- {f.E_star_err:.2g} (true {E:.5g})")
+    return {"fit": row("fit of a force curve, mu = 1", times, 60.0, traces=f.traces, evaluations=f.iterations,
+                       gamma=f.gamma, gamma_err=f.gamma_err, E_star=f.E_star, E_star_err=f.E_star_err)}
+
+
 def _where(key: tuple) -> str:
     path, line, name = key
     if path == "~":
@@ -226,6 +251,10 @@ def report(info: dict, results: dict, profile: dict | None) -> None:
         p = results["curve_paper"]
         print(f"curve: the edge grid takes {c['median_s'] / p['median_s']:.2f} times the paper grid's time "
               f"(medians of this run; {p['steps']} steps on the paper grid)")
+    if "fit" in results:
+        q = results["fit"]
+        print(f"fit: {q['traces']} curves traced, {q['evaluations']} evaluations; w = {q['gamma']:.6g} +- "
+              f"{q['gamma_err']:.2g} J/m^2 (true 0.05), E* = {q['E_star']:.6g} +- {q['E_star_err']:.2g} Pa")
     for key, q in results.items():
         if key.startswith("curve_mu"):
             print(f"{q['quantity']}: {q['steps']} steps, {q['turning_points']} turning points, up to "
@@ -265,6 +294,8 @@ def main() -> int:
         results |= bench_curve(repeats)
     if "stiff" in parts:
         results |= bench_stiff(repeats)
+    if "fit" in parts:
+        results |= bench_fit(repeats)
     if "leaveout" in parts:
         from ..benchmarks import leaveout
         leaveout.run()                       # its table is docs/figures/leaveout.md

@@ -416,28 +416,6 @@ truth's bar), a lower bound of the ratio wherever the truth's bar holds, is {saf
 """
 
 
-def _source() -> dict:
-    """The library the study measured: the checkout's commit and the package's files changed since."""
-    def git(*args):
-        p = subprocess.run(["git", *args], capture_output=True, text=True, cwd=paths.ROOT)
-        return p.stdout.strip() if p.returncode == 0 else None
-
-    changed = git("status", "--porcelain", "--", "petsc_adhesion")
-    return {"commit": git("rev-parse", "HEAD"), "changed": None if changed is None else changed.splitlines()}
-
-
-def _write_section(text: str) -> None:
-    """``text`` as the section HEADING of docs/coverage.md: in place of the one there, else at the end."""
-    with open(DOC) as f:
-        doc = f.read()
-    if HEADING + "\n" in doc:
-        head, rest = doc.split(HEADING + "\n", 1)
-        tail = rest.split("\n## ", 1)
-        doc = head + text + ("\n## " + tail[1] if len(tail) > 1 else "")
-    else:
-        doc = doc.rstrip("\n") + "\n\n" + text
-    with open(DOC, "w") as f:
-        f.write(doc)
 
 
 def main(argv: list[str]) -> int:
@@ -450,13 +428,13 @@ def main(argv: list[str]) -> int:
         t = time.perf_counter()
         with ThreadPoolExecutor(2) as pool:
             rows = list(pool.map(_run, CASES))
-        made = {"study_s": time.perf_counter() - t, **_source()}
+        made = {"study_s": time.perf_counter() - t, **paths.source()}
         os.makedirs(os.path.dirname(DATA), exist_ok=True)
         with open(DATA, "w") as f:
             json.dump({"made": made, "rows": rows}, f, indent=1)
     with open(DATA) as f:
         data = json.load(f)
-    _write_section(section(data["rows"], data["made"]))
+    paths.write_section(DOC, section(data["rows"], data["made"]), HEADING)
     print(table(data["rows"], data["made"]))
     return 0
 

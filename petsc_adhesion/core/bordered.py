@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-from .newton import PC_REUSE_ITS, PCReuse, create_snes, fresh_retry, guard, krylov_retry
+from .newton import PC_REUSE_ITS, PCReuse, Tolerances, create_snes, fresh_retry, guard, krylov_retry
 
 __all__ = ["ARCLENGTH_PREFIX", "Bordered", "Border"]
 
@@ -29,7 +29,7 @@ class Bordered:
     MatNest's blocks line up with X without index sets.
     """
 
-    def __init__(self, problem, pc_reuse_its: int = PC_REUSE_ITS):
+    def __init__(self, problem, pc_reuse_its: int = PC_REUSE_ITS, tol: Tolerances = Tolerances()):
         pb = self.pb = problem
         comm = self.comm = pb.comm
         self._mpi = comm.tompi4py()
@@ -56,7 +56,7 @@ class Bordered:
         try:
             self.snes = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R, self.form_jacobian,
                                     self.K, self.pmat or self.K, pb.setup_pc, self.precheck, full_steps=True,
-                                    bordered=True)
+                                    bordered=True, tol=tol)
         except BaseException:           # a solver option refused: free what is made
             self.destroy()
             raise
@@ -128,18 +128,19 @@ class Bordered:
         return guard(self.pb, x, Y, Y.getArray(readonly=True)[:self.nloc])
 
     # -- use ---------------------------------------------------------------------
-    def correct(self, a, ds: float):
-        """Solve for the point at distance ds from ``a`` along its tangent (eq. 24-25).
+    def correct(self, a, ds: float, guess=None):
+        """Solve for the point at distance ds from ``a`` along its tangent (eq. 24-25), from ``guess``
+        (x, p) when given, else from the predictor.
 
         Returns (x, p, Newton its, KSP its), or None when Newton fails or
         the predictor leaves the domain.
         """
-        x = a.x + ds * a.xdot
+        x, p = (a.x + ds * a.xdot, a.p + ds * a.pdot) if guess is None else guess
         if not self.pb.inside(x):
             return None
         self.x0, self.p0, self.xdot, self.pdot, self.ds = a.x, a.p, a.xdot, a.pdot, ds
         self.set_border(a.xdot, a.pdot)
-        if not fresh_retry(self.snes, self.join(x, a.p + ds * a.pdot), self.reuse, self.start):
+        if not fresh_retry(self.snes, self.join(x, p), self.reuse, self.start):
             return None
         x, p = self.split(self.X)
         return x.copy(), p, self.snes.getIterationNumber(), self.snes.getLinearSolveIterations()

@@ -33,7 +33,7 @@ from petsc4py import PETSc
 
 from ..errors import tell
 from .bordered import Bordered
-from .newton import PC_REUSE_ITS, Newton, krylov_retry
+from .newton import Tolerances, PC_REUSE_ITS, Newton, krylov_retry
 from .protocol import POINT_FIELDS, Point, check_point
 
 __all__ = ["Settings", "Continuation", "NATURAL_PREFIX", "CORRECTORS"]
@@ -42,6 +42,8 @@ __all__ = ["Settings", "Continuation", "NATURAL_PREFIX", "CORRECTORS"]
 NATURAL_PREFIX = "nat_"
 #: What -cont_type accepts: the paper's switch, or one corrector throughout.
 CORRECTORS = ("auto", "natural", "arclength")
+#: Newton's first iterate: the tangent's (eq. 20, 23), or with the curvature of the step before added.
+PREDICTORS = ("linear", "quadratic")
 
 
 @dataclass
@@ -73,6 +75,8 @@ class Settings:
     max_folds: int = 12             # stop after more than this many turning points
     pc_reuse_its: int = PC_REUSE_ITS
     monitor: bool = False           # one line a step
+    predictor: str = "linear"       # one of PREDICTORS
+    unit: float = 1.0               # the size of x and p: SNES's absolute tolerance is Tolerances' times its square
 
     @classmethod
     def from_state(cls, d: dict) -> Settings:
@@ -92,7 +96,8 @@ class Settings:
                 ok = v is None or isinstance(v, str)
             if not ok:
                 raise ValueError(f"the setting {f.name} = {v!r}")
-        if not 0 < d["ds_min"] <= d["ds"] <= d["ds_max"] or d["corrector"] not in CORRECTORS:
+        if not 0 < d["ds_min"] <= d["ds"] <= d["ds_max"] or d["corrector"] not in CORRECTORS or \
+                d["predictor"] not in PREDICTORS:
             raise ValueError("step lengths or a corrector the continuation cannot take")
         return cls(**d)
 
@@ -108,9 +113,14 @@ class Continuation:
 
     def __init__(self, problem, settings: Settings | None = None, index0: int = 0):
         self.pb, self.set, self.index0 = problem, settings or Settings(), index0
-        self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its)
+        # the residual's rounding floor grows faster than the size of x and p (a soft sphere's deformation
+        # and approach grow like mu, the coupling c like mu^1.5): measured 1e-5 to 6e-5 at mu = 1000 in the
+        # frame of the edge (-nat_snes_monitor), where an absolute tolerance of 1e-10 is out of reach from a
+        # first iterate already near the curve and Newton stalls for its 50 iterations: unit^2 times it
+        tol = Tolerances(snes_atol=Tolerances.snes_atol * self.set.unit**2)
+        self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its, tol=tol)
         try:
-            self.bordered = Bordered(problem, self.set.pc_reuse_its)
+            self.bordered = Bordered(problem, self.set.pc_reuse_its, tol)
         except BaseException:           # a solver option refused: free the Newton solver made
             self.newton.destroy()
             raise
@@ -186,10 +196,11 @@ class Continuation:
         s = self.set
         return s.corrector == "natural" or (s.corrector == "auto" and abs(a.pdot) >= s.switch)
 
-    def natural(self, a: Point, ds: float, tangent: bool = True):
-        """Natural corrector (eq. 20-22) at p = a.p + ds a.pdot; tangent of eq. (16)-(19)."""
+    def natural(self, a: Point, ds: float, tangent: bool = True, guess=None):
+        """Natural corrector (eq. 20-22) at p = a.p + ds a.pdot; tangent of eq. (16)-(19).  ``guess``: a
+        first iterate (x, p) other than the predictor, moved along a's tangent to that p."""
         p = a.p + ds * a.pdot
-        x = a.x + ds * a.xdot                               # eq. (20)
+        x = a.x + ds * a.xdot if guess is None else guess[0] + (p - guess[1]) / a.pdot * a.xdot  # eq. (20)
         if not self.pb.inside(x):
             return None
         self._x.setArray(x)
@@ -200,16 +211,17 @@ class Continuation:
         tan = self.natural_tangent(x, p, a) if tangent else (a.xdot, a.pdot, 0)
         return None if tan is None else (x, p, tan, its, kits, "natural")
 
-    def arclength(self, a: Point, ds: float, tangent: bool = True):
-        """Pseudo-arclength corrector (eq. 24-25) at distance ds; tangent of the bordered system."""
-        sol = self.bordered.correct(a, ds)
+    def arclength(self, a: Point, ds: float, tangent: bool = True, guess=None):
+        """Pseudo-arclength corrector (eq. 24-25) at distance ds (from ``guess`` (x, p) if given, else the
+        predictor); tangent of the bordered system."""
+        sol = self.bordered.correct(a, ds, guess)
         if sol is None:
             return None
         x, p, its, kits = sol
         tan = self.bordered.tangent(x, p, a.xdot, a.pdot) if tangent else (a.xdot, a.pdot, 0)
         return None if tan is None else (x, p, tan, its, kits, "arclength")
 
-    def correct(self, a: Point, ds: float, tangent: bool = True):
+    def correct(self, a: Point, ds: float, tangent: bool = True, guess=None):
         """The point at step ds from a: the corrector the mode asks for, the other as fallback.
 
         The natural one serves only away from folds (|pdot| >= ``natural_fallback``),
@@ -219,11 +231,43 @@ class Continuation:
         """
         s = self.set
         first, second = (self.natural, self.arclength) if self.natural_ok(a) else (self.arclength, self.natural)
-        sol = first(a, ds, tangent)
+        sol = first(a, ds, tangent, guess)
         if sol is None and (second is self.arclength or abs(a.pdot) >= s.natural_fallback) \
                 and s.corrector != "natural":
-            sol = second(a, ds, tangent)
+            sol = second(a, ds, tangent, guess)
         return sol
+
+    def extrapolate(self, a: Point, ds: float):
+        """Newton's first iterate for the step ds from the last point ``a`` with the quadratic predictor:
+        (x, p) + ds (xdot, pdot) + ds^2 / 2 kappa, the curvature kappa the change of the tangent over the
+        step that reached a.  None for the linear predictor, or with no such step on this grid.
+
+        Why: in the frame of a soft sphere's edge the curve is nearly straight, yet the linear predictor
+        misses the contact radius by several cohesive zones (mu = 300: 5e-4 in a, the zone 1.4e-4),
+        and Newton needs 5 to 6 iterations from the predictor, which holds the step to 1/40 of mu.
+        """
+        pts = self.points
+        if self.set.predictor != "quadratic" or len(pts) < 2 or pts[-1] is not a or not a.ds > 0 \
+                or a.corrector not in ("natural", "arclength"):
+            return None
+        b = pts[-2]
+        h = 0.5 * ds * ds / a.ds
+        return a.x + ds * a.xdot + h * (a.xdot - b.xdot), a.p + ds * a.pdot + h * (a.pdot - b.pdot)
+
+    def between(self, a: Point, b: Point, sb: float, s: float, natural: bool):
+        """Newton's first iterate at step s from a on the step a -> b of length sb (measured as the corrector
+        measures it: in p / a.pdot for the natural one, along a's tangent for the arclength one): the cubic
+        Hermite interpolant of the two points and their tangents.  None with the linear predictor, or
+        where b's tangent turns too far from a's for the measure to follow it."""
+        if self.set.predictor != "quadratic" or not sb:
+            return None
+        rate = b.pdot / a.pdot if natural else self.inner(a.xdot, b.xdot) + a.pdot * b.pdot   # d sigma / ds at b
+        if not rate > 0.5:
+            return None
+        t = s / sb
+        h00, h10, h01, h11 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t, -2 * t**3 + 3 * t**2, t**3 - t**2
+        x = h00 * a.x + h10 * sb * a.xdot + h01 * b.x + h11 * sb / rate * b.xdot
+        return x, h00 * a.p + h10 * sb * a.pdot + h01 * b.p + h11 * sb / rate * b.pdot
 
     def _observable_bound(self, a: Point) -> float:
         return self.set.observable_step * max(1.0, abs(a.values[self.set.observable]))
@@ -231,7 +275,7 @@ class Continuation:
     def step(self, a: Point, ds: float) -> Point | None:
         """One predictor-corrector step of length ds from a, or None (retry smaller)."""
         s = self.set
-        sol = self.correct(a, ds)
+        sol = self.correct(a, ds, guess=self.extrapolate(a, ds))
         if sol is None:
             return None
         x, p, (xdot, pdot, tangent_its), its, kits, kind = sol

@@ -198,15 +198,17 @@ class EventFinder:
         sb = b.ds if b.ds and b.corrector == ("natural" if cont.natural_ok(a) and not arclength else "arclength") \
             else cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p)
         correct = cont.arclength if arclength else cont.correct
+        natural = cont.natural_ok(a) and not arclength
         cache = {}
 
         def point(s, tangent=tangent):
             if s not in cache or (tangent and cache[s].corrector != "event"):
-                sol = correct(a, s, tangent) if s else (a.x, a.p, (a.xdot, a.pdot, 0), 0, 0, "")
+                guess = cont.between(a, b, sb, s, natural) if s else None
+                sol = correct(a, s, tangent, guess) if s else (a.x, a.p, (a.xdot, a.pdot, 0), 0, 0, "")
                 if sol is None:                       # a factorization kept from afar: once more, fresh
                     cont.newton.reuse.expire()
                     cont.bordered.reuse.expire()
-                    sol = correct(a, s, tangent)
+                    sol = correct(a, s, tangent, guess)
                 if sol is None:
                     raise RuntimeError(f"event location failed near {cont.pb.parameter} = {a.p:.6g}")
                 x, p, (xdot, pdot, _), *_ = sol

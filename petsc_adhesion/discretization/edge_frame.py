@@ -29,7 +29,7 @@ from ..model.pressure import pressure_law
 from ..model.reference.rigid import load_beyond, load_beyond_rates
 from .grid import l2_weights, load_weights
 from .preconditioning import Layout
-from .problem import TO_WALL, local_diagonal, norm_radius
+from .problem import TO_WALL, local_diagonal, norm_radius, step_scale
 
 __all__ = ["EdgeFrameProblem", "edge_level", "SMOOTH_LEVEL", "SMOOTH_PEAK", "peak_attraction"]
 
@@ -103,8 +103,9 @@ class EdgeFrameProblem:
         self.pin[k], self.pin[k + 1] = 1.0 - t, t
         self._pin_local = self.pin[self.lo:self.hi]
         w = l2_weights(scale * rho, norm_radius(model))[self.lo:self.hi]
-        # a relative change of the contact radius weighs like a unit change of H
-        self.weights = np.append(w, 1.0 / scale**2) if self.last else w
+        # a relative change of the contact radius weighs like a change of H by the step unit (max(1, mu):
+        # H and lambda grow like mu towards the JKR end, the relative changes of a stay of order one)
+        self.weights = np.append(w, (step_scale(model) / scale) ** 2) if self.last else w
         self._pressure, self._Ap = A.createVecs()
         self.dp, self.column, self.a = np.zeros(self.nloc), np.zeros(self.nloc), scale
         n1 = int(self.last)

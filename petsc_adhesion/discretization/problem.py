@@ -21,7 +21,7 @@ from ..model.reference.rigid import load_beyond, load_beyond_rates
 from .grid import l2_weights, load_weights
 from .preconditioning import Dense, Layout
 
-__all__ = ["Problem", "far_approach", "norm_radius", "TO_WALL", "local_diagonal"]
+__all__ = ["Problem", "far_approach", "step_scale", "MU_SOFT", "norm_radius", "TO_WALL", "local_diagonal"]
 
 #: Newton may cover at most this fraction of the way to the wall in one step.
 TO_WALL = 0.9
@@ -31,6 +31,23 @@ def norm_radius(model) -> float:
     """Where the continuation's norm of H ends: the paper's domain, or three JKR contact radii at zero
     load when larger (mu > 1.9), beyond which H only shifts with lambda."""
     return max(10.0, 3.0 * jkr_zero_load(model.mu)[0]) if model.mu > 0 else 10.0
+
+
+#: From this Tabor parameter on a sphere is soft: its curve is measured in units of mu (:func:`step_scale`).
+MU_SOFT = 20.0
+
+
+def step_scale(model) -> float:
+    """The length unit of a soft sphere's curve: mu from MU_SOFT on, else 1.
+
+    Towards the JKR end the curve is self-similar in lambda / mu and F (the
+    deformation grows like mu, the contact radius like mu^(1/2), the load stays of
+    order one): measured in units of mu its steps take the same number at any mu
+    (the frame of the edge weighs the contact radius's relative change alike,
+    :class:`~petsc_adhesion.discretization.edge_frame.EdgeFrameProblem`).  Below
+    MU_SOFT curves are traced as they were, step for step.
+    """
+    return float(model.mu) if model.mu >= MU_SOFT else 1.0
 
 
 def far_approach(model) -> float:

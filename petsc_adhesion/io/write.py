@@ -20,10 +20,11 @@ from .layout import (
     solve_tree,
     study_table,
 )
+from .fit import DESCRIBE_FIT, write_fit_csv
 from .resultset import ResultSet, plot_format
 from .text import write_curve_csv, write_events_csv, write_table_csv
 
-__all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study", "write_critical"]
+__all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study", "write_critical", "write_fit"]
 
 
 
@@ -37,7 +38,9 @@ def _describe(name: str, obj) -> None:
         key = key.split("/")[0]
     elif key.startswith(("table/", "critical_roughness/", "critical_mu/")):
         key = key.split("/")[0] + "/*"
-    units, text = DESCRIBE[key]
+    elif key.startswith("fit/"):                               # a fit's groups: described by their branch
+        key = "/".join(key.split("/")[:2])
+    units, text = DESCRIBE[key] if key in DESCRIBE else DESCRIBE_FIT[key]
     obj.attrs["units"], obj.attrs["description"] = units, text
 
 
@@ -109,6 +112,21 @@ def write_curve(curve, options: dict, files: ResultSet, commit: bool = True) -> 
         write_events_csv(files.temp("csv_events"), curve)
     if commit:
         files.commit()
+
+
+def write_fit(tree: dict, summary: dict, files) -> None:
+    """The files of a fit into the temporaries of ``files`` (a ResultSet; the caller commits)."""
+    if "out" in files.targets:
+        write_h5(files.temp("out"), tree)
+    if "summary" in files.targets:
+        write_json(files.temp("summary"), summary)
+    if "plot" in files.targets:
+        from .plot.fit import fit_figure
+
+        fit_figure(tree, files.temp("plot"), plot_format(files.targets["plot"]))
+    if "csv" in files.targets:
+        write_fit_csv(files.temp("csv"), tree["fit"]["data"])
+
 
 
 def write_solve(solution, options: dict, files: ResultSet, commit: bool = True) -> None:

@@ -7,15 +7,23 @@ enough while a grows by GROW^2 (:mod:`~petsc_adhesion.tracing.tracer` changes gr
 """
 from __future__ import annotations
 
+import math
+
 from ..discretization.grid import EdgeGrid
 from ..discretization.resolution import NODES_PER_ZONE, cohesive_zone
+from ..discretization.problem import MU_SOFT
 from ..model.pressure import pressure_law
 
-__all__ = ["BAND", "CONTACT_SPACING", "REACH", "RMAX", "A_SWITCH", "GROW", "grid_for", "scaled_grid_for", "scaled_band", "sharp"]
+__all__ = ["BAND", "BAND_ZONES", "CONTACT_SPACING", "REACH", "RMAX", "A_SWITCH", "A_SWITCH_ZONES", "GROW", "band",
+           "a_switch", "grid_for", "scaled_grid_for", "scaled_band", "sharp",
+           "frame_of_edge", "MU_TRUNCATED", "soft"]
 
 
-#: Half-width of the fine band about the edge in the physical frame.
+#: Half-width of the fine band about the edge in the physical frame ...
 BAND = 0.25
+#: ... and at most this many cohesive zones (mu > 20: the zone narrows as mu^-1.5, and a band of fixed
+#: width would take mu^1.5 nodes; the frame of the edge takes over within it, A_SWITCH_ZONES).
+BAND_ZONES = 10
 
 
 #: Largest spacing within reach of the surface forces (the paper grid's is 0.02).
@@ -30,12 +38,21 @@ REACH = 3.0
 RMAX = 150.0
 
 
-#: Contact radius at which a sharp edge is pinned and the frame of the edge takes over.
+#: Contact radius at which a sharp edge is pinned and the frame of the edge takes over ...
 A_SWITCH = 0.3
+#: ... or this many cohesive zones when fewer (mu > 6.5): in the physical frame the edge moves a
+#: fraction of the zone a step, so the steps there grow like the travel over the zone; six zones is
+#: wide enough for the frame's pin (mu = 20 to 100: the same events as at A_SWITCH, in a third of the steps).
+A_SWITCH_ZONES = 6
 
 
 #: Factor by which the contact radius may change on one grid of the frame of the edge.
 GROW = 1.5
+#: In the frame of the edge the spacing inside the contact may reach this share of the contact radius
+#: (the interior varies on the scale of a, the edge's cohesive zone on its own, graded between them) ...
+CORE_SHARE = 0.02
+#: How much finer than NODES_PER_ZONE the grids of a sharp edge are: their levels -1 and -2 resolve it too.
+COARSE_MARGIN = 4
 
 
 def _zone(model) -> float:
@@ -44,13 +61,36 @@ def _zone(model) -> float:
 
 
 def _fine(model) -> float:
-    return min(_zone(model) / NODES_PER_ZONE, CONTACT_SPACING)
+    """The spacing about the edge: the zone over NODES_PER_ZONE, COARSE_MARGIN times finer for a sharp edge
+    (so that its two coarser levels still resolve the zone and give the error bars), at most CONTACT_SPACING."""
+    zone = _zone(model)
+    return min(zone / NODES_PER_ZONE / (COARSE_MARGIN if soft(model) else 1), CONTACT_SPACING)
+
+
+def soft(model) -> bool:
+    """A soft sphere (mu from MU_SOFT on): its grids are sized by the cohesive zone and the contact radius,
+    its curve measured in units of mu; below MU_SOFT the grids are as they were, node for node (their
+    bars, from finer levels, are tighter: on a soft grid mu = 16's zero-load contact radius has a bar of
+    2.0e-4, a quarter of its 7.6e-3 distance from JKR)."""
+    return model.mu >= MU_SOFT
+
+
+def band(model) -> float:
+    """The half-width of the fine band about the edge in the physical frame: BAND, or for a soft sphere
+    BAND_ZONES zones where fewer."""
+    return min(BAND, BAND_ZONES * _zone(model)) if soft(model) else BAND
+
+
+def a_switch(model) -> float:
+    """The contact radius at which the frame of the edge takes over: A_SWITCH, or for a soft sphere
+    A_SWITCH_ZONES zones where fewer."""
+    return min(A_SWITCH, A_SWITCH_ZONES * _zone(model)) if soft(model) else A_SWITCH
 
 
 def grid_for(model, edge: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid:
     """The physical-frame grid centred on the contact edge ``edge`` for ``model`` at refinement ``level``."""
-    return EdgeGrid(edge=edge, fine=_fine(model), rmax=rmax, band=BAND, contact=CONTACT_SPACING, reach=REACH,
-                    level=level)
+    return EdgeGrid(edge=edge, fine=_fine(model), rmax=rmax, band=band(model), contact=CONTACT_SPACING,
+                    reach=REACH, level=level)
 
 
 def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: float | None = None) -> EdgeGrid:
@@ -59,10 +99,19 @@ def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: f
     Fine enough for the zone while a grows by GROW^2 (a change waits at most that
     long), over ``band`` about the pinned edge (default two zones: a smooth surface's
     peak attraction lies within one; :func:`scaled_band`), out to rmax GROW^2 at a, so
-    past rmax at a / GROW^2.
+    past rmax at a / GROW^2, or to GROW a where that is further (a small r_m must not
+    put the end of a grid in rho = r / a before the edge pinned at rho = 1; the far
+    field beyond keeps the model the half-infinite one, and
+    :func:`~petsc_adhesion.tracing.results.assess` says when the contact nears the end).  For a soft
+    sphere (:func:`soft`) inside the contact the spacing may grow to CORE_SHARE a;
+    outside, it is capped by CONTACT_SPACING as far as the forces reach: where the rigid
+    sphere's gap has opened by REACH^2 / 2 beyond the edge's, sqrt(a^2 + REACH^2) - a
+    (REACH at a = 0, 3 / (2 a) for a large contact; the elastic opening only shortens it).
     """
-    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=rmax * GROW**2,
-                    band=2 * _zone(model) if band is None else band, contact=CONTACT_SPACING, reach=REACH,
+    big = soft(model)
+    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=max(rmax * GROW**2, GROW * a),
+                    band=2 * _zone(model) if band is None else band, contact=CONTACT_SPACING,
+                    reach=math.sqrt(a * a + REACH**2) - a if big else REACH, core=CORE_SHARE * a if big else 0.0,
                     level=level)
 
 
@@ -79,3 +128,20 @@ def scaled_band(model, a: float, peak: float) -> float:
 def sharp(model) -> bool:
     """Whether the contact edge is sharp enough to be traced in its own frame."""
     return _zone(model) / NODES_PER_ZONE < CONTACT_SPACING
+
+
+#: The truncated model (-adh_farfield false) on grids that follow the edge, traced in the physical frame
+#: throughout (:func:`frame_of_edge`), up to this mu: its steps there grow like mu^1.5 (mu = 7: 1690 steps).
+MU_TRUNCATED = 10.0
+
+
+def frame_of_edge(model) -> bool:
+    """Whether the frame of the edge may take over a sharp edge: for the half-infinite model only.
+
+    Its grid is in rho = r / a and reaches r = a rho_m, at least r_m and up to
+    GROW^4 r_m as a changes: beyond r_m the rigid sphere's attraction is added
+    (-adh_farfield), so where the grid ends is a numerical choice whose error is in
+    the bar.  The truncated model (no far field) ends at r_m itself, which a grid in
+    rho cannot keep: it is traced in the physical frame throughout.
+    """
+    return sharp(model) and model.farfield

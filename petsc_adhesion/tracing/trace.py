@@ -34,15 +34,16 @@ from ..core.events import EVENT_TOL, jumps
 from ..core.newton import PC_REUSE_ITS, Newton
 from ..discretization import grid, preconditioning, resolution
 from ..discretization.influence import create_influence
-from ..discretization.problem import Problem, far_approach
+from ..discretization.problem import Problem, far_approach, step_scale
 from ..model.reference.jkr import jkr_approach, jkr_load
 from . import error_bars, results
 from .curve import Curve, Solution, model_record, program_record
-from .edge_grids import RMAX, grid_for
+from .edge_grids import MU_TRUNCATED, RMAX, grid_for
 from .tracer import Tracer
 
 __all__ = ["GridChoice", "SolverChoice", "CurveRequest", "curve_settings", "trace_curve", "solve_at", "rigid_edge",
-           "discretize", "configure_solvers", "expected_end", "F_MAX", "GRID_KINDS", "spring_start"]
+           "discretize", "configure_solvers", "expected_end", "F_MAX", "GRID_KINDS", "spring_start",
+           "step_scale"]
 
 #: The load at which a curve stops by default: past equilibrium, into compression.
 F_MAX = 2.0
@@ -139,9 +140,14 @@ class CurveRequest:
             raise ValueError(f"spring stiffness {self.spring!r}: expected a finite K > 0")
 
 
-def curve_settings(**changes) -> Settings:
-    """The continuation settings of a load-approach curve: the load F watched, stopping at F_MAX."""
-    return Settings(**{"observable": "F", "observable_max": F_MAX, **changes})
+def curve_settings(scale: float = 1.0, **changes) -> Settings:
+    """The continuation settings of a load-approach curve: the load F watched, stopping at F_MAX; the
+    first and the largest step (ds, ds_max) in units of ``scale`` (:func:`step_scale`), and SNES's absolute
+    tolerance and the events' location (``unit``).  The smallest
+    (ds_min) stays absolute: where the contact forms at large mu the curve turns on the scale of the
+    cohesive zone, not of mu (mu = 1000: steps of 2e-4 there)."""
+    s = Settings(**{"observable": "F", "observable_max": F_MAX, **changes})
+    return replace(s, ds=s.ds * scale, ds_max=s.ds_max * scale, unit=scale)
 
 
 def rigid_edge(lam: float) -> float:
@@ -181,7 +187,7 @@ def configure_solvers(model, grid_choice: GridChoice = GridChoice(), solver: Sol
     problem = discretize(model, r, solver.strategy(), comm or PETSc.COMM_WORLD)
     try:
         if lam is None:
-            Continuation(problem, settings or curve_settings()).destroy()
+            Continuation(problem, settings or curve_settings(step_scale(model))).destroy()
         else:
             Newton(problem, "", pc_reuse_its=solver.pc_reuse_its).destroy()
     finally:
@@ -230,7 +236,10 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
 
     comm = comm or PETSc.COMM_WORLD
     model = _domain(model, grid_choice)
-    settings = settings or curve_settings()
+    if grid_choice.kind == "edge" and not model.farfield and model.mu > MU_TRUNCATED:
+        raise ValueError(f"farfield False (the model truncated at r_m) is traced in the physical frame, up to "
+                         f"mu = {MU_TRUNCATED:g}: got mu = {model.mu:g}")
+    settings = settings or curve_settings(step_scale(model))
     lam0 = far_approach(model) if request.lambda_start is None else request.lambda_start
     if request.spring and request.lambda_start is None:
         lam0 = min(lam0, spring_start(request.spring))

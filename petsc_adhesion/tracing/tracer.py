@@ -8,11 +8,11 @@ one grid, of two kinds:
 
 * ``edge``: the physical frame, an :class:`~petsc_adhesion.discretization.grid.EdgeGrid`
   centred on the edge (fine, zone / NODES_PER_ZONE and at most
-  CONTACT_SPACING, within BAND of it; graded beyond; geometric out to RMAX,
+  CONTACT_SPACING, within a band of it (BAND, or BAND_ZONES zones); graded beyond; geometric out to RMAX,
   where the attraction left out carries |F| < 1e-8).  A new segment when the
   edge has travelled more than ``travel`` from the grid's centre.
 * ``scaled``: once a sharp edge (zone / NODES_PER_ZONE < CONTACT_SPACING)
-  has formed a contact of radius A_SWITCH,
+  has formed a contact of radius A_SWITCH (or A_SWITCH_ZONES zones when fewer),
   the frame of the edge (:mod:`petsc_adhesion.discretization.edge_frame`): the grid in rho = r/a
   follows the contact radius a by itself, and a new segment is needed only
   when a has changed by the factor GROW.
@@ -34,14 +34,14 @@ from mpi4py import MPI
 
 from .. import brent
 from ..core.continuation import Continuation, Settings
-from ..core.events import EventFinder
+from ..core.events import EVENT_TOL, EventFinder
 from ..discretization import grid
 from ..discretization.edge_frame import EdgeFrameProblem, edge_level
 from ..discretization.influence import create_influence
 from ..discretization.problem import Problem
 from .edge_grids import (
-    A_SWITCH,
-    BAND,
+    a_switch,
+    band,
     GROW,
     REACH,
     RMAX,
@@ -49,7 +49,7 @@ from .edge_grids import (
     grid_for,
     scaled_band,
     scaled_grid_for,
-    sharp,
+    frame_of_edge,
 )
 
 __all__ = ["edge_of", "contact_radius", "crossing", "Segment", "Tracer", "carry", "FAR_STEPS"]
@@ -140,6 +140,17 @@ def _carry(old, new, x: np.ndarray, scale: float, xdot: np.ndarray | None = None
     return np.interp(r_new, r_old, field) + (0.0 if scaled else 0.5 * r_new * r_new)
 
 
+def _radius_rate(problem, pt, a: float) -> float:
+    """d(contact radius)/ds along the tangent of a point of the physical frame (collective): a central
+    difference over a step that moves H by about 1e-6 of the contact radius."""
+    xdot = pt.xdot
+    size = problem.comm.tompi4py().allreduce(float(np.max(np.abs(xdot), initial=0.0)), op=MPI.MAX)
+    if size == 0.0:
+        return 0.0
+    h = 1e-6 * max(a, 1e-3) / size
+    return (contact_radius(problem, pt.x + h * xdot) - contact_radius(problem, pt.x - h * xdot)) / (2 * h)
+
+
 def carry(old: Segment, new: Segment, pt, scale: float | None = None):
     """The point ``pt`` of ``old``'s curve put on ``new``'s: interpolated, then a zero-length arclength
     correction there (regular at folds), its tangent oriented like pt's; None when that fails.
@@ -152,11 +163,13 @@ def carry(old: Segment, new: Segment, pt, scale: float | None = None):
     if scaled and scale is None:
         scale = src.radius(pt.x) if isinstance(src, EdgeFrameProblem) else contact_radius(src, pt.x)
     shaped, slope = _carry(src, dst, pt.x, scale), _carry(src, dst, pt.x, scale, pt.xdot)
-    if scaled and dst.last:
-        adot = src.radius(pt.xdot) if isinstance(src, EdgeFrameProblem) else 0.0
-        shaped, slope = np.append(shaped, scale), np.append(slope, adot)
-    elif scaled:
-        src.radius(pt.xdot) if isinstance(src, EdgeFrameProblem) else None   # collective
+    if scaled:
+        # the contact radius's rate: the tangent's own in the frame of the edge, else a difference
+        # quotient along it (with adot left 0 the new frame, which weighs a's relative change by
+        # (mu / a)^2, could orient its tangent against the curve's)
+        adot = src.radius(pt.xdot) if isinstance(src, EdgeFrameProblem) else _radius_rate(src, pt, scale)
+        if dst.last:
+            shaped, slope = np.append(shaped, scale), np.append(slope, adot)
     x = dst.create_vec()
     x.setArray(shaped)
     out = new.cont.project(x, pt.p, slope, pt.pdot)
@@ -170,8 +183,9 @@ class _Regrid:
     def __init__(self, tracer, seg: Segment):
         self.tracer, self.seg, self.next = tracer, seg, None
         zone = _zone(seg.problem.model)
-        self.travel = min(BAND / 2 + zone, REACH / 3)
-        self.forced = min(BAND + 2 * zone, 2 * REACH / 3)
+        half = band(seg.problem.model)
+        self.travel = min(half / 2 + zone, REACH / 3)
+        self.forced = min(half + 2 * zone, 2 * REACH / 3)
 
     def target(self, b) -> tuple | None:
         """(kind, where, forced) of the next segment, or None to stay."""
@@ -183,7 +197,7 @@ class _Regrid:
             return None if 1 / GROW <= ratio <= GROW else ("scaled", a, not 1 / GROW**2 <= ratio <= GROW**2, edge)
         # a contact, and the peak attraction off the centre (a rough centre may still attract most)
         a = contact_radius(seg.problem, b.x)
-        if tr.sharp and min(edge, a) >= A_SWITCH:
+        if tr.sharp and min(edge, a) >= a_switch(seg.problem.model):
             return "scaled", a, False, edge
         moved = abs(edge - seg.grid.edge)
         return None if moved <= self.travel else ("edge", edge, moved > self.forced, edge)
@@ -247,6 +261,10 @@ class Tracer:
             rho = design.nodes() / at
             problem = EdgeFrameProblem(self.model, rho, create_influence(rho, self.comm), at, self.pmat)
         s = settings or self.set
+        if kind == "scaled" and s.unit > 1:
+            # a soft sphere's curve in the frame of its edge is smooth on the scale of mu, its Newton
+            # iterations set by the cohesive zone's: the quadratic predictor takes steps 2-3x as long
+            s = replace(s, predictor="quadratic")
         if before is not None:
             steps = sum(len(g.cont.points) - 1 for g in self.segments)
             folds = sum(g.cont.folds for g in self.segments)
@@ -257,7 +275,9 @@ class Tracer:
         except BaseException:
             problem.destroy()
             raise
-        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, *([self.tol] if self.tol else [])))
+        # events located to tol in units of the curve's size (lambda grows like mu towards the JKR end)
+        tol = (self.tol or EVENT_TOL) * s.unit
+        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, tol))
 
     def run(self, lam0: float, started=None, pause=None) -> list[Segment]:
         """The curve from lam0, starting from the rigid state (eq. 27); ``started()`` after the first point.
@@ -266,7 +286,7 @@ class Tracer:
         goes on from its last segment's state instead.  ``pause(tracer)``: before every step
         attempt (:meth:`~petsc_adhesion.core.continuation.Continuation.run`).
         """
-        self.sharp = self.nodes is None and sharp(self.model)
+        self.sharp = self.nodes is None and frame_of_edge(self.model)
         start = None
         if not self.segments:
             seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)

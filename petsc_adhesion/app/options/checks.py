@@ -15,6 +15,7 @@ from ...errors import InputError
 from ...model.parameters import Model
 from ...model.reference.jkr import jkr_zero_load
 from ...model.reference.rigid import load_beyond
+from ...tracing.edge_grids import MU_TRUNCATED
 from .reading import _NUMBER, AppOptions, _strict_float, _strict_int
 from .table import ROUGHNESS_OPTIONS, SOLVER_PREFIXES, TABLE, Option
 
@@ -91,6 +92,12 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
         raise InputError(f"-adh_rmax: {model.rmax:g} leaves out part of the contact at mu = {model.mu:g}: "
                          f"expected at least {smallest_domain(model.mu):.3g} (the JKR contact radius, or the "
                          f"reach of {DOMAIN_SHARE:.0%} of the attraction)")
+
+
+    if not fixed and not model.farfield and kind == "edge" and model.mu > MU_TRUNCATED:
+        raise InputError(f"-adh_farfield: false (the model truncated at r_m) is traced in the physical frame, up to "
+                         f"mu = {MU_TRUNCATED:g}, got mu = {model.mu:g}: leave it true (the half-infinite model, r_m's "
+                         f"error in the bar) or take -grid_type uniform")
 
 
 def check_memory(grid_choice, pmat: str, curve: bool, ranks: int) -> None:

@@ -15,7 +15,7 @@ from ...model.parameters import Model
 from ...model.parameters import tabor
 from ...model.physical import Bodies
 from ...model.roughness import Measured
-from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings
+from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, step_scale
 from .table import TABLE, Option
 
 __all__ = ["AppOptions", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
@@ -363,10 +363,11 @@ def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = 
                         kinds=kinds, spring=spring)
 
 
-def read_settings(opts: AppOptions):
-    """The continuation's step control and stops; the load F is the observable watched."""
+def read_settings(opts: AppOptions, model: Model | None = None):
+    """The continuation's step control and stops; the load F is the observable watched; the step lengths
+    in units of ``model``'s :func:`~petsc_adhesion.tracing.trace.step_scale` (1 without a model)."""
     lam_max = opts.real("cont_lambda_max")
-    return curve_settings(corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
+    return curve_settings(1.0 if model is None else step_scale(model), corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                           ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
                           max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
                           observable_step=opts.real("cont_dF_max"), observable_max=opts.real("cont_F_max"),

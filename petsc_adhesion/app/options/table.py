@@ -78,7 +78,7 @@ _S = Settings
 
 TABLE = {o.name: o for o in [
     # model (paper eq. 9-14)
-    Option("adh_mu", "real", Model.mu, "Tabor parameter mu (eq. 9)", 0.0, 50.0),
+    Option("adh_mu", "real", Model.mu, "Tabor parameter mu (eq. 9)", 0.0, 1000.0),
     Option("adh_sigma", "real", Model.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
     Option("adh_roughness", "choice", Model.roughness, "height distribution averaged over (eq. 7, 10): the "
            "paper's Gaussian by its Gauss-Hermite rule (eq. 14), whose rule is the model; Gaussian truncated at "
@@ -177,7 +177,7 @@ TABLE = {o.name: o for o in [
     Option("phys_spring", "real", None, "spring constant k of the cantilever (N/m), with the other -phys_ "
            "options: K = k epsilon / (2 pi R gamma), as -afm_spring", 0.0, 1e9, lo_open=True),
     # studies: a sweep over cases (petsc_adhesion.app.study)
-    Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 50.0),
+    Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 1000.0),
     Option("study_sigma", "sweep", (), "study: the roughness sigma of its cases", 0.0, 5.0),
     Option("study_option", "string", None, "study: a further real or integer option swept over -study_values "
            "(without the dash, e.g. phys_radius, adh_hermite_points, grid_n)"),
@@ -195,6 +195,22 @@ TABLE = {o.name: o for o in [
            "pull-off against sigma; the boundary of hysteresis (sigma_c, mu_c: the only one, and the default, with "
            "-study_compute critical)",
            choices=("curves", "folds", "profiles", "pull_off", "reduction", "critical")),
+    # fitting a measurement (petsc_adhesion.fitting; docs/fitting.md)
+    Option("fit_pull_off", "real", None, "fit: the work of adhesion whose model pull-off is this measured force "
+           "(N, its magnitude), with -phys_radius, -phys_young1, -phys_poisson1 (-phys_young2, -phys_poisson2: "
+           "default a rigid flat), -phys_epsilon and -phys_rms if rough; reports gamma, its bar, mu and what JKR, "
+           "DMT and Maugis-Dugdale give", 0.0, 1.0, lo_open=True),
+    Option("fit_pull_off_err", "real", 0.0, "fit: the standard uncertainty of -fit_pull_off (N), carried into "
+           "gamma's bar", 0.0, 1.0),
+    Option("fit_curve", "string", None, "fit: a measured force-distance curve (text or CSV: piezo displacement "
+           "and force in SI, approach then retract; or an AFM file afmformats reads): the work of adhesion and the "
+           "reduced modulus E*, with the contact point and baseline, by bounded least squares; needs "
+           "-phys_radius, -phys_epsilon and the spring constant (-phys_spring, or the file's)"),
+    Option("fit_curve_index", "int", 0, "fit: the curve of a -fit_curve file of several (a force map)", 0, 10**9),
+    Option("fit_modulus", "flag", True, "fit: fit E* (false: hold it at the -phys_young/-phys_poisson value; given "
+           "with true, that value is where the fit starts)"),
+    Option("fit_roughness", "flag", False, "fit: fit the rms roughness too (-phys_rms: its start, default 0.3 "
+           "epsilon)"),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
@@ -202,7 +218,7 @@ TABLE = {o.name: o for o in [
     Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
     Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, Z and stable_spring "
            "behind a spring, contact radius, stable (0/1), and in nm and nN with -phys_ inputs; a study: its table "
-           "of events (default with -out X.h5: X.csv beside it); not with -adh_lambda"),
+           "of events; not with -adh_lambda"),
     Option("csv_events", "string", None, "CSV of the curve's events, a row each: kind, best values, error bars, "
            "landing, single-grid values (in nm and nN too with -phys_ inputs); not with -adh_lambda nor in a study"),
     Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "

@@ -523,6 +523,7 @@ def render(data: dict) -> str:
         L += _profile_lines(data["profile"], data["speed"]["speed_curve_bars"])
     if "startup" in data:
         L += _startup_lines(data)
+    L += ['Soft spheres (mu = 5 to 1000): steps, nodes and time of a default curve with its error bars against mu, one core, in [soft.md](soft.md#the-cost-against-mu), made by `python -m petsc_adhesion.benchmarks.soft`.', ""]
     sc = data["scaling"]
     n_cross = crossover(sc)
     L += ["## Scaling", "",

@@ -1,0 +1,275 @@
+"""A run that fits a measurement: ``-fit_pull_off P`` (the work of adhesion of a pull-off force) or
+``-fit_curve FILE`` (the work of adhesion and the modulus of a force-distance curve).
+
+    petsc-adhesion -fit_pull_off 12.5e-9 -phys_radius 20e-9 -phys_young1 150e9 -phys_poisson1 0.27 \\
+        -phys_epsilon 0.3e-9 -summary fit.json
+    petsc-adhesion -fit_curve curve.ibw -phys_radius 20e-9 -phys_epsilon 0.3e-9 -plot fit.png
+
+As a curve's run: the options are read into typed objects and checked before any
+work (one line naming the option for what is wrong or missing, exit status 2,
+nothing written), the library fits (:mod:`petsc_adhesion.fitting`), and rank 0
+writes the files all together and the report.  A fit runs on one rank.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from petsc4py import PETSc
+
+from ..errors import InputError, collective, printable
+from ..fitting.curve_fit import CurveFitError, fit_curve, predict_curve
+from ..fitting.data import CurveFileError, read_curve
+from ..fitting.pull_off import PullOffFitError, fit_pull_off
+from ..io.fit import fit_summary, fit_tree, report_fit
+from ..io.inputs import check_input
+from ..io.resultset import PLOT_FORMATS, check_targets, written
+from ..io.write import write_fit
+from ..model.parameters import Model
+from ..model.physical import Bodies
+from ..tracing.curve import model_record, program_record
+from ..tracing.trace import GridChoice
+from .options.checks import check_petsc_values, check_unused
+from .options.reading import AppOptions, read_grid, read_solver
+from .options.table import ROUGHNESS_OPTIONS, TABLE
+from .optionsfile import options_files
+
+__all__ = ["FitRequest", "is_fit", "refuse_fit_options", "read", "execute", "main", "FIT_OPTIONS"]
+
+#: The application options a fit honours besides its own (-fit_*): the bodies, the roughness average, the
+#: domain, the grid and the preconditioner of the curves it traces, its outputs.
+FIT_OPTIONS = {"phys_radius", "phys_radius2", "phys_young1", "phys_poisson1", "phys_young2", "phys_poisson2",
+               "phys_epsilon", "phys_rms", "phys_spring", "adh_roughness", "adh_rmax", "adh_farfield", "adh_pmat",
+               "adh_pmat_band", "adh_pc_reuse_its", "grid_type", "grid_n", "grid_paper_uniform", "grid_paper_extra",
+               "grid_paper_split", "grid_paper_refine_from", "out", "summary", "plot", "csv",
+               *ROUGHNESS_OPTIONS}
+_OUTPUTS = ("out", "summary", "plot", "csv")
+#: Points per leg of the fitted model's curve in the files.
+MODEL_POINTS = 400
+
+
+def is_fit(opts: AppOptions) -> bool:
+    """Whether the options ask for a fit of a measurement."""
+    return opts.db.hasName("fit_pull_off") or opts.db.hasName("fit_curve")
+
+
+def refuse_fit_options(opts: AppOptions) -> None:
+    """An InputError for a -fit_ option given without -fit_pull_off or -fit_curve."""
+    stray = [n for n in TABLE if n.startswith("fit_") and opts.db.hasName(n)]
+    if stray:
+        needs = "-fit_pull_off" if stray[0] == "fit_pull_off_err" else "-fit_curve"
+        raise InputError(f"-{stray[0]}: only with {needs}; remove it")
+
+
+@dataclass
+class FitRequest:
+    """A fit's inputs, read and checked."""
+
+    kind: str                   # "pull_off" | "curve"
+    model: Model                # the roughness average and the domain (mu and bodies are the fit's)
+    grid: GridChoice
+    solver: object
+    bodies: Bodies | None       # pull_off: radii, moduli, epsilon, rms
+    P: float | None
+    P_err: float
+    data: object                # curve: the MeasuredCurve
+    radius: float | None
+    epsilon: float | None
+    modulus: float | None       # curve: E* of the -phys_ moduli (the start, or held with -fit_modulus false)
+    spring: float | None
+    spring_source: str
+    rms: float | None
+    fit_modulus: bool
+    fit_roughness: bool
+    targets: dict
+
+
+def _given(opts: AppOptions, name: str) -> bool:
+    return opts.db.hasName(name)
+
+
+def _refuse_others(opts: AppOptions, what: str) -> None:
+    for name in TABLE:
+        if _given(opts, name) and not name.startswith("fit_") and name not in FIT_OPTIONS:
+            why = "the work of adhesion is what the fit finds" if name in ("phys_gamma", "phys_hamaker",
+                                                                          "phys_hamaker_cutoff") else \
+                "mu is what the fit finds (eq. 9)" if name == "adh_mu" else \
+                "sigma is -phys_rms / -phys_epsilon" if name == "adh_sigma" else "a fit traces its own curves"
+            raise InputError(f"-{name}: not with {what}: {why}; remove it")
+
+
+def _moduli(opts: AppOptions, need: bool, what: str) -> float | None:
+    """E* of eq. (2) from -phys_young1, -phys_poisson1 (and -phys_young2, -phys_poisson2), or None."""
+    have = {n: opts.real(n) for n in ("phys_young1", "phys_poisson1", "phys_young2", "phys_poisson2") if _given(opts, n)}
+    for a, b in (("phys_young1", "phys_poisson1"), ("phys_young2", "phys_poisson2")):
+        if (a in have) != (b in have):
+            missing = b if a in have else a
+            raise InputError(f"-{missing}: needed with -{a if a in have else b} (eq. 2)")
+    if "phys_young2" in have and "phys_young1" not in have:
+        raise InputError("-phys_young1: needed with -phys_young2 (the sphere's modulus, eq. 2)")
+    if "phys_young1" not in have:
+        if need:
+            raise InputError(f"-phys_young1: required with {what}, with -phys_poisson1 (the sphere's modulus; the "
+                             f"flat's -phys_young2, -phys_poisson2, or a rigid flat)")
+        return None
+    b = Bodies(radius=1.0, young1=have["phys_young1"], poisson1=have["phys_poisson1"], epsilon=1.0,
+               young2=have.get("phys_young2"), poisson2=have.get("phys_poisson2"))
+    E = b.E
+    if not (math.isfinite(E) and E > 0):
+        raise InputError("-phys_young1: with the other moduli gives no finite positive E* (eq. 2)")
+    return E
+
+
+def _template(opts: AppOptions, rms: float | None, eps: float) -> Model:
+    rough = opts.choice("adh_roughness")
+    if rough == "measured":
+        raise InputError("-adh_roughness: measured is not fitted (its heights set sigma); give -phys_rms with "
+                         "hermite, truncated_gaussian or weibull")
+    sigma = 0.0 if rms is None else rms / eps
+    if rough == "none" and sigma > 0:
+        raise InputError("-phys_rms: not with -adh_roughness none (a smooth surface)")
+    if sigma > TABLE["adh_sigma"].hi:
+        raise InputError(f"-phys_rms: gives sigma = rms / epsilon = {sigma:.3g}, above {TABLE['adh_sigma'].hi:g}")
+    rmax = opts.real("adh_rmax")
+    if rmax is None:
+        rmax = GridChoice(opts.choice("grid_type")).default_rmax
+    return Model(mu=1.0, sigma=sigma, rmax=rmax, roughness=rough, hermite_points=opts.int("adh_hermite_points"),
+                 roughness_cutoff=opts.real("adh_roughness_cutoff"),
+                 roughness_skewness=opts.real("adh_roughness_skewness"),
+                 quadrature_points=opts.int("adh_quadrature_points"), farfield=opts.flag("adh_farfield"))
+
+
+def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
+    """Read and check a fit's options before any work (see the module)."""
+    opts.read_all()
+    check_unused(lambda n: n.startswith(("adh_", "grid_", "cont_", "fit_")) or n in TABLE)
+    check_petsc_values(opts.db)
+    pull, path = opts.real("fit_pull_off"), opts.string("fit_curve")
+    if pull is not None and path is not None:
+        raise InputError("-fit_pull_off: not with -fit_curve; a run fits one measurement")
+    kind = "pull_off" if pull is not None else "curve"
+    what = "-fit_pull_off" if pull is not None else "-fit_curve"
+    for name, needs in (("fit_pull_off_err", "pull_off"), ("fit_curve_index", "curve"), ("fit_modulus", "curve"),
+                        ("fit_roughness", "curve")):
+        if _given(opts, name) and kind != needs:
+            raise InputError(f"-{name}: only with -fit_{needs}")
+    if comm.getSize() > 1:
+        raise InputError(f"{what}: a fit runs on one rank (its curves are small); run it without mpiexec")
+    _refuse_others(opts, what)
+    for name in ("phys_radius", "phys_epsilon"):
+        if not _given(opts, name):
+            need = "the tip's radius R" if name == "phys_radius" else "the Lennard-Jones law's epsilon"
+            raise InputError(f"-{name}: required with {what} ({need}, m)")
+    radius, eps = opts.real("phys_radius"), opts.real("phys_epsilon")
+    if _given(opts, "phys_radius2"):
+        r2 = opts.real("phys_radius2")
+        radius = radius * r2 / (radius + r2)
+    rms = opts.real("phys_rms")
+    if opts.choice("adh_roughness") == "none" and rms:
+        raise InputError("-phys_rms: not with -adh_roughness none (a smooth surface)")
+    model = _template(opts, rms, eps)
+    for name, kinds in ROUGHNESS_OPTIONS.items():
+        if _given(opts, name) and (model.roughness not in kinds or (model.sigma == 0 and not
+                                                                    opts.flag("fit_roughness"))):
+            raise InputError(f"-{name}: applies to -adh_roughness {' or '.join(kinds)} with a roughness "
+                             f"(-phys_rms or -fit_roughness); remove it")
+    grid, solver = read_grid(opts, model), read_solver(opts)
+    targets = {k: opts.string(k) for k in _OUTPUTS if opts.string(k)}
+    if kind == "pull_off":
+        for name in ("plot", "csv", "phys_spring"):
+            if name in targets or _given(opts, name):
+                raise InputError(f"-{name}: applies to -fit_curve (a pull-off has no curve); remove it")
+    if "plot" in targets and not targets["plot"].lower().endswith(tuple(PLOT_FORMATS)):
+        raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
+    inputs = {"options_file": options_files(argv), "fit_curve": [path or ""]}
+    fit_modulus, fit_rough = opts.flag("fit_modulus"), opts.flag("fit_roughness")
+    if kind == "pull_off":
+        E = _moduli(opts, True, what)
+        bodies = Bodies(radius=opts.real("phys_radius"), young1=opts.real("phys_young1"),
+                        poisson1=opts.real("phys_poisson1"), epsilon=eps, radius2=opts.real("phys_radius2"),
+                        young2=opts.real("phys_young2"), poisson2=opts.real("phys_poisson2"), rms=rms)
+        req = FitRequest("pull_off", model, grid, solver, bodies, pull, opts.real("fit_pull_off_err"), None, radius,
+                         eps, E, None, "", rms, True, False, targets)
+    else:
+        E = _moduli(opts, not fit_modulus, "-fit_modulus false")
+        if fit_rough and model.roughness == "none":
+            raise InputError("-fit_roughness: not with -adh_roughness none (a smooth surface)")
+        check_input("fit_curve", path)
+        try:
+            data = read_curve(path, opts.int("fit_curve_index"))
+        except CurveFileError as e:
+            raise InputError(f"-fit_curve: {printable(str(e))}") from None
+        k = opts.real("phys_spring")
+        source = "-phys_spring"
+        if k is None:
+            if data.spring is None:
+                raise InputError(f"-phys_spring: required with -fit_curve: the file '{printable(path)}' states no "
+                                 f"spring constant (N/m)")
+            k, source = data.spring, "the file"
+        elif data.spring is not None and k != data.spring:
+            data = data.rescaled(k)       # the file's force is its spring constant times the measured deflection
+            source = f"-phys_spring (the file's force rescaled from its {data.metadata.get('spring constant')} N/m)"
+        req = FitRequest("curve", model, grid, solver, None, None, 0.0, data, radius, eps, E, k, source, rms,
+                         fit_modulus, fit_rough, targets)
+    if comm.getRank() == 0:
+        check_targets(targets, inputs)
+    return req
+
+
+def _fit(req: FitRequest, comm):
+    """The library's fit of ``req``; InputError (one line naming the option) for what it cannot fit."""
+    try:
+        if req.kind == "pull_off":
+            return fit_pull_off(req.P, req.bodies, req.P_err, model=req.model, grid=req.grid, solver=req.solver,
+                                comm=comm)
+        return fit_curve(req.data, req.radius, req.epsilon, req.spring, modulus=req.modulus, rms=req.rms,
+                         fit_modulus=req.fit_modulus, fit_roughness=req.fit_roughness, model=req.model,
+                         grid=req.grid, solver=req.solver, comm=comm)
+    except PullOffFitError as e:
+        raise InputError(f"-fit_pull_off: {printable(str(e))}") from None
+    except CurveFitError as e:
+        raise InputError(f"-fit_curve: {printable(str(e))}") from None
+
+
+def _curve_arrays(req: FitRequest, fit) -> tuple[dict, dict]:
+    import numpy as np
+
+    data = {"z": fit.z, "F": fit.F, "leg": fit.leg, "F_fit": fit.F_fit, "used": fit.used.astype(int)}
+    z = np.linspace(float(fit.z.min()), float(fit.z.max()), MODEL_POINTS)
+    model = {"z": z, "F_approach": predict_curve(fit, z, "approach"), "F_retract": predict_curve(fit, z, "retract")}
+    return data, model
+
+
+def execute(opts: AppOptions, argv: list[str], report: bool = True):
+    """The fit of the options database: (exit status, the library's fit)."""
+    comm = PETSc.COMM_WORLD
+    req = collective(comm, read, opts, comm, argv)
+    fit = _fit(req, comm)
+    summary = dict(fit.summary)
+    if req.kind == "curve":
+        summary["given"] = {**summary["given"], "file": req.data.path, "format": req.data.source,
+                            "spring_from": req.spring_source}
+    head = program_record(comm)
+    head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted
+    given = opts.given()
+    data = model = None
+    if req.kind == "curve":
+        data, model = _curve_arrays(req, fit)
+    with written(req.targets) as files:
+        write_fit(fit_tree(head, given, summary, data, model), fit_summary(head, given, summary), files)
+        if report:
+            report_fit(summary)
+        files.commit()
+    PETSc.garbage_cleanup()
+    return 0, fit
+
+
+def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
+    """A fit of the options database; its exit status (``helping``: checked only)."""
+    from .run import refuse_study_options
+
+    refuse_study_options(opts)
+    if helping:
+        collective(PETSc.COMM_WORLD, read, opts, PETSc.COMM_WORLD, argv)
+        return 0
+    return execute(opts, argv)[0]

@@ -1,0 +1,257 @@
+"""Measured force-distance curves read from files: plain text or CSV, and the AFM formats afmformats reads.
+
+A curve is the piezo (base) displacement z and the force F of one approach and
+the retract that follows, in the order measured.  What is read:
+
+plain text or CSV (any name; ``.csv``, ``.txt``, ``.tsv``, ``.dat`` ...)
+    Two or more columns: the piezo displacement, then the force; further columns
+    are ignored.  Columns are separated by commas, semicolons, tabs or blanks;
+    lines starting with ``#`` and empty lines are skipped.  One header line may
+    come first, naming the columns; a unit in parentheses or brackets after a
+    name is honoured (displacement: m, mm, um, nm, pm; force: N, mN, uN, nN, pN),
+    and a name without one is taken in SI, as are the columns of a file without a
+    header.  The force is tensile (attractive) negative, as a cantilever's
+    deflection towards the surface gives it.
+an AFM file afmformats reads
+    JPK (``.jpk-force``, ``.jpk-force-map``, ``.jpk-qi-data``, ``.jpk-qi-series``),
+    Asylum Research / Igor (``.ibw``), AFM Workshop (``.csv``), NT-MDT (``.txt``),
+    afmformats' own ``.h5`` and ``.tab``, and their ``.zip``: the column ``height
+    (piezo)`` (else ``height (measured)``) and ``force``, with the spring constant
+    (N/m) and the sensitivity (m/V) of the file's metadata when it states them.  A
+    file of several curves (a force map) gives the one of ``index``.
+
+Approach and retract are split where the displacement turns: at its extreme
+farthest from the first sample.  Either sign convention of the displacement is
+taken: the approach is the direction in which it moves first.  Anything that is
+no such curve (no number, one column, too few points, values that are not
+finite, a curve that does not turn back) is one line (:class:`CurveFileError`).
+"""
+from __future__ import annotations
+
+import logging
+import os
+import re
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["CurveFileError", "MeasuredCurve", "read_curve", "AFM_EXTENSIONS", "LENGTH_UNITS", "FORCE_UNITS",
+           "MIN_POINTS", "MAX_TEXT_BYTES"]
+
+#: The extensions afmformats reads (0.18): a file of these is read through it (``.csv`` and ``.txt`` only when
+#: they are not plain columns of numbers).
+AFM_EXTENSIONS = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw", ".h5", ".tab", ".zip",
+                  ".csv", ".txt")
+#: Length and force units a text header may state, in SI.
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "\u00b5m": 1e-6, "\u03bcm": 1e-6, "nm": 1e-9, "pm": 1e-12}
+FORCE_UNITS = {"n": 1.0, "mn": 1e-3, "un": 1e-6, "\u00b5n": 1e-6, "\u03bcn": 1e-6, "nn": 1e-9, "pn": 1e-12}
+#: The fewest points of each of approach and retract.
+MIN_POINTS = 10
+#: The largest text file read (a curve of 10^7 points).
+MAX_TEXT_BYTES = 1 << 30
+
+
+class CurveFileError(ValueError):
+    """A file that holds no measured force curve; the message is one line, starting with the file's name."""
+
+
+@dataclass(frozen=True)
+class MeasuredCurve:
+    """A measured force-distance curve in SI: ``z`` the piezo (base) displacement (m) and ``F`` the force (N,
+    tensile negative), in the order measured; ``turn`` the index of the first retract sample (``z[:turn]``
+    the approach); ``direction`` +1 when z grows towards the surface, -1 when it falls; ``spring`` the
+    cantilever's spring constant the file states (N/m, None when it states none); ``source`` what read it
+    (``text`` or afmformats' format name) and ``metadata`` what the file says of itself (JSON-able)."""
+
+    z: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)
+    turn: int
+    direction: int
+    spring: float | None = None
+    sensitivity: float | None = None
+    source: str = "text"
+    path: str = ""
+    metadata: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def approach(self) -> slice:
+        return slice(0, self.turn)
+
+    @property
+    def retract(self) -> slice:
+        return slice(self.turn, len(self.z))
+
+    def rescaled(self, spring: float) -> MeasuredCurve:
+        """The curve with the force of a cantilever of ``spring`` N/m instead of the file's (the force is the
+        spring constant times the deflection, which the file measured)."""
+        from dataclasses import replace
+
+        factor = 1.0 if self.spring is None else spring / self.spring
+        return replace(self, F=self.F * factor, spring=spring)
+
+
+def _name(path: str) -> str:
+    return f"'{os.path.basename(str(path))}'"
+
+
+def read_curve(path: str, index: int = 0) -> MeasuredCurve:
+    """The measured curve of ``path`` (see the module for what is read); ``index``: the curve of a file of
+    several.  Raises :class:`CurveFileError` with one line."""
+    ext = os.path.splitext(str(path))[1].lower()
+    ext = ".jpk-" + str(path).lower().rsplit(".jpk-", 1)[1] if ".jpk-" in str(path).lower() else ext
+    text_error = None
+    if ext not in AFM_EXTENSIONS or ext in (".csv", ".txt"):
+        try:
+            if index:
+                raise CurveFileError(f"{_name(path)}: a text file holds one curve; index {index} asked for")
+            return _read_text(path)
+        except CurveFileError as e:
+            if ext not in AFM_EXTENSIONS:
+                raise
+            text_error = e
+    try:
+        return _read_afm(path, index)
+    except CurveFileError as e:
+        if text_error is not None:
+            raise CurveFileError(f"{text_error}; nor is it a file afmformats reads ({str(e).split(': ', 1)[-1]})") \
+                from None
+        raise
+
+
+# -- plain text -----------------------------------------------------------------
+_SPLIT = re.compile(r"[,;\t ]+")
+_UNIT = re.compile(r"[(\[]\s*([^)\]]*?)\s*[)\]]\s*$")
+
+
+def _numbers(line: str) -> list[float] | None:
+    try:
+        return [float(x) for x in _SPLIT.split(line.strip()) if x]
+    except ValueError:
+        return None
+
+
+def _unit(name: str, units: dict, what: str, column: int, path: str) -> float:
+    m = _UNIT.search(name)
+    if m is None:
+        return 1.0
+    unit = m.group(1).replace("\u00b5", "u").replace("\u03bc", "u")
+    scale = units.get(unit.lower() if units is FORCE_UNITS else unit)
+    if scale is None:
+        raise CurveFileError(f"{_name(path)}: column {column} '{name.strip()}': '{m.group(1)}' is no {what} unit "
+                             f"(expected one of {', '.join(u for u in units if u.isascii())})")
+    return scale
+
+
+def _read_text(path: str) -> MeasuredCurve:
+    try:
+        with open(path, "rb") as f:
+            raw = f.read(MAX_TEXT_BYTES + 1)
+    except OSError as e:
+        raise CurveFileError(f"{_name(path)}: cannot be read ({e.strerror})") from None
+    if len(raw) > MAX_TEXT_BYTES:
+        raise CurveFileError(f"{_name(path)}: more than {MAX_TEXT_BYTES >> 20} MiB of text")
+    if b"\0" in raw[:4096]:
+        raise CurveFileError(f"{_name(path)}: not text (a binary file)")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")
+    rows, header, scale_z, scale_F = [], None, 1.0, 1.0
+    for number, line in enumerate(text.splitlines(), 1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        values = _numbers(stripped)
+        if values is None:
+            if rows or header is not None:
+                raise CurveFileError(f"{_name(path)}: line {number} is not numbers: '{stripped[:60]}'")
+            header = [h for h in re.split(r"\s*[,;\t]\s*", stripped)] if re.search(r"[,;\t]", stripped) \
+                else stripped.split()
+            if len(header) < 2:
+                raise CurveFileError(f"{_name(path)}: the header '{stripped[:60]}' names one column; expected "
+                                     f"the piezo displacement and the force")
+            scale_z = _unit(header[0], LENGTH_UNITS, "length", 1, path)
+            scale_F = _unit(header[1], FORCE_UNITS, "force", 2, path)
+            continue
+        if len(values) < 2:
+            raise CurveFileError(f"{_name(path)}: line {number} has {len(values)} column; expected two: the piezo "
+                                 f"displacement and the force")
+        rows.append(values[:2])
+    if not rows:
+        raise CurveFileError(f"{_name(path)}: no rows of numbers")
+    data = np.array(rows, dtype=float)
+    return _curve(data[:, 0] * scale_z, data[:, 1] * scale_F, path, "text", None, None, {})
+
+
+# -- afmformats ------------------------------------------------------------------
+def _read_afm(path: str, index: int) -> MeasuredCurve:
+    try:
+        import afmformats
+    except ImportError:
+        raise CurveFileError(f"{_name(path)}: reading this format needs afmformats (pip install afmformats, or "
+                             f"./run setup)") from None
+    # afmformats' own errors derive from BaseException, not Exception; a damaged file raises KeyError,
+    # ValueError and the like from its readers
+    own = tuple(getattr(afmformats.errors, n) for n in ("AFMFileFormatError", "MissingMetaDataError")
+                if hasattr(getattr(afmformats, "errors", None), n))
+    log = logging.getLogger("afmformats")      # it logs each recipe that fails, with a traceback: one line is ours
+    level = log.level
+    try:
+        log.setLevel(logging.CRITICAL + 1)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            curves = afmformats.load_data(str(path), modality="force-distance")
+    except (Exception, *own) as e:
+        why = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise CurveFileError(f"{_name(path)}: not a force-distance curve afmformats reads ({why[:120]})") from None
+    finally:
+        log.setLevel(level)
+    if not curves:
+        raise CurveFileError(f"{_name(path)}: afmformats finds no force-distance curve in it")
+    if not 0 <= index < len(curves):
+        raise CurveFileError(f"{_name(path)}: holds {len(curves)} curve{'s' * (len(curves) != 1)}; index {index} "
+                             f"asked for")
+    d = curves[index]
+    columns = list(d.columns)
+    zcol = next((c for c in ("height (piezo)", "height (measured)") if c in columns), None)
+    if zcol is None or "force" not in columns:
+        missing = "force" if zcol else "height (piezo)"
+        raise CurveFileError(f"{_name(path)}: no column '{missing}' (it has {', '.join(columns) or 'none'}); "
+                             f"a force curve needs the piezo height and the force")
+    meta = {}
+    for k, v in dict(d.metadata).items():
+        if isinstance(v, (str, int, float, bool)) and k != "path":
+            meta[k] = v.item() if isinstance(v, np.generic) else v
+    spring = meta.get("spring constant")
+    sens = meta.get("sensitivity")
+    spring = float(spring) if isinstance(spring, (int, float)) and np.isfinite(spring) and spring > 0 else None
+    sens = float(sens) if isinstance(sens, (int, float)) and np.isfinite(sens) and sens > 0 else None
+    source = str(meta.get("format", "afmformats"))
+    return _curve(np.asarray(d[zcol], dtype=float), np.asarray(d["force"], dtype=float), path, source, spring, sens,
+                  {**meta, "z_column": zcol, "curves_in_file": len(curves), "index": index})
+
+
+# -- the curve -------------------------------------------------------------------
+def _curve(z: np.ndarray, F: np.ndarray, path: str, source: str, spring, sensitivity, meta: dict) -> MeasuredCurve:
+    n = len(z)
+    bad = n - int(np.count_nonzero(np.isfinite(z) & np.isfinite(F)))
+    if bad:
+        raise CurveFileError(f"{_name(path)}: {bad} of {n} points are not finite")
+    if n < 2 * MIN_POINTS:
+        raise CurveFileError(f"{_name(path)}: {n} points; a curve needs at least {2 * MIN_POINTS} (approach and "
+                             f"retract)")
+    far = int(np.argmax(np.abs(z - z[0])))
+    if z[far] == z[0]:
+        raise CurveFileError(f"{_name(path)}: the displacement does not move")
+    direction = 1 if z[far] > z[0] else -1
+    turn = int(np.argmax(direction * z)) + 1        # the first extreme: a dwell there belongs to the approach
+    if turn < MIN_POINTS or n - turn < MIN_POINTS:
+        which = "approach" if turn < MIN_POINTS else "retract"
+        raise CurveFileError(f"{_name(path)}: the {which} has {min(turn, n - turn)} points (the displacement turns "
+                             f"at point {turn} of {n}); a curve needs an approach and a retract of at least "
+                             f"{MIN_POINTS} each, in the order measured")
+    if np.ptp(F) == 0:
+        raise CurveFileError(f"{_name(path)}: the force is constant")
+    return MeasuredCurve(z=np.ascontiguousarray(z), F=np.ascontiguousarray(F), turn=turn, direction=direction,
+                         spring=spring, sensitivity=sensitivity, source=source, path=str(path), metadata=meta)

@@ -1,0 +1,244 @@
+"""The work of adhesion from a measured pull-off force: the model's own pull-off, solved for gamma.
+
+A sphere of radius R pulls off a flat under load control at P = |F_p(mu)| 2 pi R w
+(F_p the model's most tensile load, in 2 pi R w), where the Tabor parameter itself
+depends on the unknown work of adhesion w by eq. (9), mu = (R w^2 / (E^2 eps^3))^(1/3),
+mu proportional to w^(2/3), with the roughness sigma = rms / eps fixed.  Given P, the
+bodies (R, E from eq. 2, eps, rms) and nothing of w, :func:`fit_pull_off` solves
+
+    g(w) = 2 pi R w |F_p(mu(w))| - P = 0
+
+for w: a secant iteration in ln w from the Maugis-Dugdale value, each step a curve
+traced to its pull-off on the grid (no error bars), then one curve with error bars at
+the root, whose best F_p (extrapolated over nested grids) corrects w by one Newton
+step.  Its bar, from the pull-off's bar F_err and the measurement's P_err:
+
+    dP/dw = 2 pi R |F_p| (1 + (2/3) d ln|F_p| / d ln mu)
+    gamma_err = sqrt((2 pi R w F_err)^2 + P_err^2) / (dP/dw)
+
+with d ln|F_p| / d ln mu by central differences (two more curves, mu (1 +- 1.3%)).
+Beside it, what the closed forms would have said: DMT's w = P / (2 pi R), JKR's
+w = P / (1.5 pi R) and Maugis-Dugdale's, solved self-consistently in the same way with
+its pull-off at lambda_MD = 1.157 mu (:mod:`~petsc_adhesion.model.reference.maugis_dugdale`;
+a smooth surface: the roughness does not enter it).
+"""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field, replace
+
+from .. import brent
+from ..model.parameters import Model, tabor
+from ..model.reference.maugis_dugdale import maugis_dugdale_pull_off
+
+__all__ = ["PullOffFit", "PullOffFitError", "fit_pull_off", "model_pull_off", "maugis_dugdale_gamma", "MU_RANGE",
+           "closed_forms"]
+
+#: The Tabor parameters the model is solved for (-adh_mu's range, its least positive value).
+MU_RANGE = (1e-12, 50.0)
+#: Half the step in ln w of the derivative d ln|F_p| / d ln w (so mu moves by 2/3 of it).
+_DLOGW = 0.02
+
+
+class PullOffFitError(ValueError):
+    """A pull-off no work of adhesion gives within the model's range; one line."""
+
+
+@dataclass(frozen=True)
+class PullOffFit:
+    """The work of adhesion of a measured pull-off (SI): ``gamma`` (J/m^2) and its bar ``gamma_err``; ``mu``
+    (eq. 9) and ``sigma`` of the model at gamma; ``F`` the model's pull-off there (2 pi R gamma units) with
+    its bar ``F_err``; ``dlnF_dlnmu`` the slope of |F_p| against mu; ``closed_forms`` what DMT, JKR and
+    Maugis-Dugdale give for gamma (and mu); ``curves`` the curves traced, ``wall_time_s`` the time."""
+
+    P: float
+    P_err: float
+    gamma: float
+    gamma_err: float
+    mu: float
+    sigma: float
+    F: float
+    F_err: float
+    F_grid: float
+    dlnF_dlnmu: float
+    closed_forms: dict
+    curves: int
+    wall_time_s: float
+    bodies: object = field(repr=False, default=None)
+    history: list = field(repr=False, default_factory=list)
+
+    @property
+    def summary(self) -> dict:
+        """The ``fit`` object of a ``-summary`` file (docs/fitting.md)."""
+        return {"kind": "pull_off", "P_N": self.P, "P_err_N": self.P_err, "gamma": self.gamma,
+                "gamma_err": self.gamma_err, "mu": self.mu, "sigma": self.sigma, "F_pull_off": self.F,
+                "F_pull_off_err": self.F_err, "F_pull_off_grid": self.F_grid, "dlnF_dlnmu": self.dlnF_dlnmu,
+                "closed_forms": self.closed_forms, "curves_traced": self.curves, "wall_time_s": self.wall_time_s,
+                "iterations": [{"gamma": g, "mu": m, "F_grid": f} for g, m, f in self.history]}
+
+
+def model_pull_off(model: Model, grid=None, solver=None, error_bars: bool = False, comm=None):
+    """The load-controlled pull-off of ``model`` (its most tensile F_min, an
+    :class:`~petsc_adhesion.tracing.curve.Event`): the curve traced until the load is back at 0."""
+    from ..tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, trace_curve
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        c = trace_curve(model, grid or GridChoice(), solver or SolverChoice(), curve_settings(observable_max=0.0),
+                        CurveRequest(error_bars=error_bars, kinds=("F_min",)), comm=comm)
+    if c.pull_off is None:
+        raise RuntimeError(f"the curve at mu = {model.mu:.6g} has no pull-off ({c.summary['stop_reason']})")
+    return c.pull_off
+
+
+def closed_forms(P: float, bodies) -> dict:
+    """What DMT, JKR and Maugis-Dugdale give for the work of adhesion of the pull-off P (N) of ``bodies``
+    (their R, E, epsilon): {dmt, jkr, maugis_dugdale: {gamma, mu}}."""
+    R = bodies.R
+
+    def mu(w):
+        return tabor(R, w, bodies.E, bodies.epsilon)
+
+    out = {}
+    for name, factor in (("dmt", 2.0), ("jkr", 1.5)):
+        w = P / (factor * math.pi * R)
+        out[name] = {"gamma": w, "mu": mu(w), "formula": f"P / ({factor:g} pi R)"}
+    w = maugis_dugdale_gamma(P, R, bodies.E, bodies.epsilon)
+    out["maugis_dugdale"] = {"gamma": w, "mu": mu(w), "lambda_MD": 1.157 * mu(w),
+                             "formula": "P = 2 pi R w |F_MD(1.157 mu(w))|"}
+    return out
+
+
+def maugis_dugdale_gamma(P: float, R: float, E: float, epsilon: float) -> float:
+    """The w of 2 pi R w |F_MD(mu(w))| = P with Maugis-Dugdale's pull-off (lambda_MD = 1.157 mu): it lies
+    between DMT's P / (2 pi R) and JKR's P / (1.5 pi R)."""
+    def g(lnw):
+        w = math.exp(lnw)
+        return 2 * math.pi * R * w * abs(float(maugis_dugdale_pull_off(tabor(R, w, E, epsilon)))) - P
+
+    lo, hi = math.log(P / (2 * math.pi * R)), math.log(P / (1.5 * math.pi * R))
+    glo, ghi = g(lo), g(hi)
+    if glo >= 0:
+        return math.exp(lo)
+    if ghi <= 0:
+        return math.exp(hi)
+    return math.exp(brent.root(g, lo, hi, xtol=1e-12))
+
+
+def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = None, grid=None, solver=None,
+                 comm=None, rtol: float = 1e-7) -> PullOffFit:
+    """The work of adhesion whose model pull-off is the measured ``P`` (N, its magnitude), with its bar (see
+    the module for the equations).
+
+    Parameters
+    ----------
+    P, P_err
+        The measured pull-off force's magnitude and its standard uncertainty (N; 0: exact).
+    bodies : Bodies
+        Radii, moduli, epsilon and the rms roughness (SI); its work of adhesion is ignored.
+    model : Model
+        The roughness average and domain (its mu, sigma and bodies are replaced); default the smooth model.
+    grid, solver, comm
+        As :func:`~petsc_adhesion.tracing.trace.trace_curve`'s.
+    rtol
+        The relative tolerance of w on the grid.
+
+    Raises :class:`PullOffFitError` (one line) for a P no w gives: P <= 0 or not finite, or a w whose mu
+    would leave [1e-12, 50].
+    """
+    t0 = time.perf_counter()
+    if not (math.isfinite(P) and P > 0):
+        raise PullOffFitError(f"the pull-off force must be a finite positive magnitude (N), got {P!r}")
+    if not (math.isfinite(P_err) and P_err >= 0):
+        raise PullOffFitError(f"the pull-off's uncertainty must be finite and >= 0 (N), got {P_err!r}")
+    template = model or Model()
+    R, E, eps = bodies.R, bodies.E, bodies.epsilon
+    sigma = bodies.sigma if bodies.sigma is not None else template.sigma
+    history = []
+
+    def mu_of(w):
+        return tabor(R, w, E, eps)
+
+    def w_of(mu):
+        return math.sqrt(mu**3 * E**2 * eps**3 / R)
+
+    lo_w, hi_w = w_of(MU_RANGE[0]), w_of(MU_RANGE[1])
+
+    def model_at(w):
+        return replace(template, mu=mu_of(w), sigma=sigma, bodies=replace(bodies, gamma=w, hamaker=None))
+
+    cache = {}
+
+    def pull(lnw: float) -> float:
+        """|F_p| on the grid at w = exp(lnw)."""
+        if lnw not in cache:
+            w = math.exp(lnw)
+            e = model_pull_off(model_at(w), grid, solver, comm=comm)
+            cache[lnw] = abs(e.F)
+            history.append((w, mu_of(w), e.F))
+        return cache[lnw]
+
+    def g(lnw: float) -> float:
+        return math.log(2 * math.pi * R * math.exp(lnw) * pull(lnw) / P)
+
+    w_md = maugis_dugdale_gamma(P, R, E, eps)
+    if w_md > hi_w * 1.5:
+        raise PullOffFitError(f"P = {P:.4g} N needs a work of adhesion near {w_md:.3g} J/m^2 (Maugis-Dugdale), "
+                              f"where mu = {mu_of(w_md):.3g} by eq. (9) is above {MU_RANGE[1]:g}, the model's "
+                              f"range (-adh_mu)")
+    lnw = _solve(g, math.log(min(max(w_md, lo_w), hi_w)), math.log(lo_w), math.log(hi_w), rtol, P, mu_of)
+    w = math.exp(lnw)
+    # the best pull-off at the root (extrapolated over nested grids), its bar, and the slope of |F_p| in mu
+    best = model_pull_off(model_at(w), grid, solver, error_bars=True, comm=comm)
+    Fg = best.F_grid if best.F_grid is not None else best.F
+    up = min(lnw + _DLOGW, math.log(hi_w))
+    down = max(lnw - _DLOGW, math.log(lo_w))
+    slope_w = 1.0 + (math.log(pull(up)) - math.log(pull(down))) / (up - down)     # d ln(w |F_p|) / d ln w
+    dlnF_dlnmu = (slope_w - 1.0) * 1.5
+    if slope_w <= 0:
+        raise PullOffFitError(f"P = {P:.4g} N: the model's pull-off falls faster than 1/w about w = {w:.4g} J/m^2 "
+                              f"(mu = {mu_of(w):.3g}): the pull-off does not determine w there")
+    lnw -= math.log(abs(best.F) / abs(Fg)) / slope_w       # one Newton step onto the best pull-off
+    w = math.exp(lnw)
+    F_err = best.F_err or 0.0
+    rel = math.hypot(F_err / abs(best.F), P_err / P) / slope_w
+    return PullOffFit(P=P, P_err=P_err, gamma=w, gamma_err=w * rel, mu=mu_of(w), sigma=sigma, F=best.F, F_err=F_err,
+                      F_grid=Fg, dlnF_dlnmu=dlnF_dlnmu, closed_forms=closed_forms(P, bodies), curves=len(cache) + 1,
+                      wall_time_s=time.perf_counter() - t0, bodies=replace(bodies, gamma=w, hamaker=None),
+                      history=history)
+
+
+def _solve(g, x0: float, lo: float, hi: float, rtol: float, P: float, mu_of) -> float:
+    """The root of g in ln w: secant steps from x0 (g is nearly ln w + const: its slope is 1 + (2/3) d ln|F_p|
+    / d ln mu), then Brent's method on a bracket when the secant does not settle."""
+    xs, gs = [x0], [g(x0)]
+    x1 = min(max(x0 - gs[0], lo), hi)             # a unit slope's step
+    if x1 == x0:
+        x1 = x0 - math.copysign(1e-3, gs[0])
+    xs.append(x1)
+    gs.append(g(x1))
+    for _ in range(12):
+        if abs(gs[-1]) < rtol or abs(xs[-1] - xs[-2]) < rtol:
+            return xs[-1]
+        if gs[-1] == gs[-2]:
+            break
+        x = xs[-1] - gs[-1] * (xs[-1] - xs[-2]) / (gs[-1] - gs[-2])
+        if not lo <= x <= hi:
+            edge = hi if x > hi else lo
+            if g(edge) * (1 if x > hi else -1) < 0:     # the root is past the edge of the model's range
+                side = "above" if x > hi else "below"
+                raise PullOffFitError(f"P = {P:.4g} N needs mu {side} {mu_of(math.exp(edge)):.3g} "
+                                      f"(w = {math.exp(edge):.3g} J/m^2 gives a pull-off still too "
+                                      f"{'small' if x > hi else 'large'}): outside the model's range of mu "
+                                      f"[{MU_RANGE[0]:g}, {MU_RANGE[1]:g}] (-adh_mu)")
+            x = edge
+        xs.append(x)
+        gs.append(g(x))
+    # no settling: a bracket from the points seen, then Brent
+    pts = sorted(zip(xs, gs))
+    for (a, ga), (b, gb) in zip(pts, pts[1:]):
+        if ga * gb <= 0:
+            return brent.root(g, a, b, xtol=rtol)
+    raise PullOffFitError(f"P = {P:.4g} N: no work of adhesion found in mu [{MU_RANGE[0]:g}, {MU_RANGE[1]:g}]")

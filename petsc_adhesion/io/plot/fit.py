@@ -1,0 +1,59 @@
+"""The figure of a fitted force curve: the measured points and the fitted model over them, and the residuals
+(``-fit_curve`` with ``-plot``, or ``petsc-adhesion plot FIT.h5``)."""
+from __future__ import annotations
+
+import h5py
+import numpy as np
+
+from .read import figure, legend
+
+__all__ = ["fit_figure", "read_fit"]
+
+
+def read_fit(source) -> dict:
+    """The ``fit`` group of a result file, or of a tree, as plain arrays and values."""
+    if not isinstance(source, str):
+        return source["fit"]
+    with h5py.File(source, "r") as f:
+        g = f["fit"]
+        out = {k: v for k, v in g.attrs.items()}
+        for name in ("data", "model"):
+            if name in g:
+                out[name] = {k: v[()] for k, v in g[name].items()}
+        return out
+
+
+def fit_figure(source, out: str, fmt: str = "png") -> None:
+    """Force (nN) against the piezo displacement (nm) of a fitted curve: approach and retract measured, the
+    fitted model as lines, the points left out of the fit hollow; below, the residuals in units of the
+    noise."""
+    fit = read_fit(source)
+    if "data" not in fit:
+        from ...errors import InputError
+
+        raise InputError("plot: a fit of a pull-off force has no curve to draw")
+    d, m = fit["data"], fit.get("model")
+    fig = figure(figsize=(7.5, 6.5))
+    ax, rx = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]})
+    z, F, leg, used = d["z"] * 1e9, d["F"] * 1e9, np.asarray(d["leg"]), np.asarray(d["used"], bool)
+    noise = float(fit["noise_N"]) * 1e9
+    for k, (name, colour) in enumerate((("approach", "tab:blue"), ("retract", "tab:red"))):
+        sel = leg == k
+        ax.plot(z[sel & used], F[sel & used], ".", ms=3, color=colour, alpha=0.5, label=f"{name}, measured")
+        if np.any(sel & ~used):
+            ax.plot(z[sel & ~used], F[sel & ~used], "o", ms=4, mfc="none", color=colour, alpha=0.6,
+                    label=f"{name}, left out (next to a jump)")
+        if m is not None:
+            ax.plot(m["z"] * 1e9, m[f"F_{name}"] * 1e9, "-", lw=1.5, color="k" if k else "0.4",
+                    label=f"{name}, fitted model")
+        rx.plot(z[sel & used], (d["F_fit"][sel & used] * 1e9 - F[sel & used]) / noise, ".", ms=2, color=colour)
+    g, ge, E, Ee = (float(fit[k]) for k in ("gamma", "gamma_err", "E_star", "E_star_err"))
+    ax.set_title(f"gamma = {g:.4g} +- {ge:.2g} J/m^2, E* = {E / 1e9:.4g} +- {Ee / 1e9:.2g} GPa, "
+                 f"mu = {float(fit['mu']):.3g}", fontsize=10)
+    ax.set_ylabel("force (nN)")
+    rx.axhline(0.0, color="0.5", lw=0.8)
+    rx.set_ylabel("(fit - data) / noise")
+    rx.set_xlabel("piezo displacement z (nm)")
+    legend(ax, fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120, format=fmt)
