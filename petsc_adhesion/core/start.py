@@ -10,6 +10,7 @@ SIGINT, SIGTERM and SIGHUP end the run in one line) are kept.
 """
 from __future__ import annotations
 
+import atexit
 import importlib
 import signal
 import sys
@@ -37,4 +38,20 @@ def start_petsc(argv: list[str] | None = None) -> bool:
     for s, handler in kept.items():
         if handler is not None:
             signal.signal(s, handler)
+    if not any(a.lstrip("-") == "options_left" for a in argv):
+        atexit.register(_no_options_left)
     return True
+
+
+def _no_options_left() -> None:
+    """PETSc's finalize says nothing of unused options unless the command line asked it to.
+
+    PETSc 3.21 lists them on standard output at PetscFinalize (3.18 does not): a refused run's
+    options, the Python interpreter's own arguments; on a closed or full standard output that
+    write fails and the process ends with PETSc's error page.  We refuse options ourselves
+    (app/options), so the list says nothing new.  Python's exit handlers run before petsc4py's
+    PetscFinalize (registered with Py_AtExit), so the value is in place when it is read.
+    """
+    PETSc = sys.modules.get("petsc4py.PETSc")
+    if PETSc is not None and PETSc.Sys.isInitialized() and not PETSc.Sys.isFinalized():
+        PETSc.Options().setValue("options_left", "0")
