@@ -530,3 +530,32 @@ def test_trace_near_the_wall():
     assert abs(pt.p + 2) <= TOL and abs(pt.x[0] - 1) <= 1e-9             # measured 0 and 1e-11
     assert tr.counts["outside"] == 0 and tr.lowest > 0
     assert tr.counts["shortened"] >= 1                                   # measured 2 (arclength corrector)
+
+
+def test_python_errors_gives_the_callbacks_own_exception():
+    """capi.python_errors: petsc4py 3.22 and later raise PETSc.Error 101 *from* a callback's exception
+    (as measured with 3.26); inside python_errors the caller gets the callback's exception itself, a
+    PETSc error of PETSc's own stays one, and 3.18's plain re-raise passes through."""
+    from petsc4py import PETSc
+    from petsc_adhesion.core.capi import python_errors
+
+    def wrapped(exc):
+        try:
+            raise exc
+        except BaseException as e:
+            raise PETSc.Error(101) from e
+
+    with pytest.raises(Outside, match="inside"):
+        with python_errors():
+            wrapped(Outside("inside"))
+    with pytest.raises(PETSc.Error) as own:
+        with python_errors():
+            raise PETSc.Error(73)
+    assert own.value.ierr == 73
+    with pytest.raises(PETSc.Error) as chained:
+        with python_errors():
+            wrapped(PETSc.Error(56))
+    assert chained.value.ierr == 101
+    with pytest.raises(KeyError):
+        with python_errors():
+            raise KeyError("3.18 re-raises the callback's exception as it is")

@@ -88,3 +88,45 @@ def test_the_jkr_limit_is_approached():
     d20, d100 = _jkr_distances(20.0), _jkr_distances(100.0)
     for key in d20:
         assert d100[key] < d20[key] / 5 and d100[key] < 5e-4, (key, d20[key], d100[key])
+
+
+def test_measured_zone_of_a_gaussian_attraction():
+    """resolution.measured_zone on P(r) = -exp(-((r - r0) / w)^2): its inner half-width is w sqrt(ln 2)
+    (closed form), reported over INNER_SHARE; no attraction gives nan; an attraction reaching the centre
+    gives the peak's radius over INNER_SHARE."""
+    import math
+    import numpy as np
+    from petsc_adhesion.discretization.resolution import INNER_SHARE, measured_zone
+    r = np.linspace(0.0, 10.0, 200001)
+    for r0, w in ((5.0, 0.3), (2.0, 0.01)):
+        P = 0.2 * np.exp(-((r - r0 - 4 * w) / w) ** 2) - np.exp(-((r - r0) / w) ** 2)
+        k = int(np.argmin(P))
+        left = r[:k][P[:k] > 0.5 * P[k]][-1]
+        assert measured_zone(r, P) * INNER_SHARE == pytest.approx(w * math.sqrt(math.log(2.0)), rel=2e-3)
+        assert measured_zone(r, P) * INNER_SHARE == pytest.approx(r[k] - left, abs=2 * (r[1] - r[0]))
+    assert math.isnan(measured_zone(r, np.exp(-r)))
+    assert measured_zone(r, -np.exp(-r)) == 0.0
+
+
+def test_rough_soft_sphere_bars_cover_finer_grids(tmp_path):
+    """mu = 100, sigma = 1 (the roughness holds the surfaces at its wall; the edge is Hertz-like, its
+    attraction 0.09 to 0.3 wide where the JKR-edge formula says 0.0018): on grids sized by the zone the
+    state shows, the default run's events and bars against the same curve refined to -target_error 3e-6
+    (levels up to 2 and 3): every event within its bar; and the grids stay small (below 1000 nodes,
+    where grids sized by the formula took 3745)."""
+    import json
+    runs = {}
+    for name, extra in (("default", ()), ("fine", ("-target_error", "3e-6"))):
+        js = tmp_path / f"{name}.json"
+        proc = run_cli("-adh_mu", 100, "-adh_sigma", 1, *extra, "-summary", js)
+        assert proc.returncode == 0, proc.stderr
+        runs[name] = json.loads(js.read_text())
+    d, f = runs["default"], runs["fine"]
+    assert d["complete"] and not d["warnings"] and d["n_nodes"] < 1000
+    events = lambda s: [s["pull_off"], *s["folds"], *s["equilibria"]]
+    assert [e["kind"] for e in events(d)] == [e["kind"] for e in events(f)] == \
+        ["F_min", "snap_on", "snap_off", "equilibrium"]
+    for a, b in zip(events(d), events(f)):
+        assert abs(a["lambda"] - b["lambda"]) <= a["lambda_err"], (a, b)
+        if a["kind"] != "equilibrium":
+            assert abs(a["F"] - b["F"]) <= a["F_err"], (a, b)

@@ -1,6 +1,6 @@
 """The stability matrix of docs/stability.md: every Tabor parameter and roughness, default settings.
 
-    ./run stability            # all cells, two at a time, into docs/stability.md (about 10 minutes)
+    ./run stability            # all cells, two at a time, into docs/stability.md (about 15 minutes)
     ./run stability 20 2       # one cell (mu, sigma), printed
 
 Each cell traces the curve from far apart to F >= 2 with the program's
@@ -25,7 +25,7 @@ from . import paths
 
 __all__ = ["MUS", "SIGMAS", "EXTRA", "cell", "main", "OUT", "TIMEOUT", "HEAD", "STABILITY_DOC"]
 
-MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 4.5, 7.0, 10.0, 20.0)
+MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 4.5, 7.0, 10.0, 20.0, 50.0, 100.0, 300.0, 1000.0)
 SIGMAS = (0.0, 0.1, 0.2, 0.4, 1.0, 2.0)
 #: (mu, sigma, extra options, what the row shows)
 EXTRA = ((1.0, 0.0, ("-cont_F_max", "50"), "strong compression"),
@@ -109,6 +109,11 @@ as a new user would.  {done} of {total} cells completed.  Machine: {machine}.
 - wall gap: the smallest H - wall over the curve, in epsilon: how close the curve came to
   the wall of the roughness law (the outermost node of the 16-point Hermite rule,
   6.63 sigma - 1; the curve never steps into it, and below 1e-3 it is warned about).
+- From mu = 20 on a sphere is soft (docs/soft.md): steps in units of mu, the frame of the
+  edge; a rough soft sphere's grids resolve the cohesive zone its state shows (the roughness
+  holds the surfaces at its wall and the edge is Hertz-like, 10 to 100 times wider than a
+  JKR edge's; docs/numerics.md).  The several turning points of the soft rows lie within
+  about 3 epsilon of the snap-on, where the contact forms: the model's (docs/numerics.md).
 
 {head}
 {rows}

@@ -1,8 +1,12 @@
-"""PETSc C functions that petsc4py 3.18 does not bind, called through ctypes.
+"""PETSc C functions that petsc4py 3.18 does not bind, called through ctypes; what newer petsc4py does otherwise.
 
 The symbols come from the PETSc library that petsc4py's extension module
 already links, so they are the same PETSc the rest of the program uses.
 Newer petsc4py binds some of these; one path for all versions is simpler.
+From petsc4py 3.22 on an exception raised in a Python callback (a residual, a
+shell Jacobian) comes out of the PETSc call as PETSc.Error 101 with the
+callback's exception as its cause; :func:`python_errors` gives the caller the
+callback's own exception with every version.
 """
 from __future__ import annotations
 
@@ -13,7 +17,25 @@ from functools import lru_cache
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["options_left", "error_message", "set_linesearch_type", "options_from", "options_of"]
+__all__ = ["options_left", "error_message", "set_linesearch_type", "options_from", "options_of", "python_errors"]
+
+
+@contextmanager
+def python_errors():
+    """Around a PETSc call that calls back into Python: the callback's own exception, not petsc4py's wrapper.
+
+    petsc4py 3.18 to 3.21 re-raise a callback's exception as it is; 3.22 and later raise
+    PETSc.Error (101, "Unhandled Python Exception") from it, and the domain guard's,
+    the signal handlers' and the problems' own exceptions would all read as PETSc errors
+    (measured with petsc4py 3.26: the guard test and a SIGTERM during the error bars).
+    """
+    try:
+        yield
+    except PETSc.Error as e:
+        cause = e.__cause__
+        if cause is None or isinstance(cause, PETSc.Error):
+            raise
+        raise cause.with_traceback(cause.__traceback__) from None
 
 
 @lru_cache(maxsize=None)

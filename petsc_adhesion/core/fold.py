@@ -40,6 +40,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from .bordered import Border
+from .capi import python_errors
 from .newton import TRUE_RESIDUAL, PCReuse, Tolerances
 
 __all__ = ["FoldSystem", "FOLD_PREFIX"]
@@ -162,7 +163,8 @@ class FoldSystem:
                 row = np.concatenate(self._mpi.allgather(self.phi))     # collective: every rank gathers
                 self.base.fill_pmat(self.pmat, [Border(self.psi, row if self.last else None, 0.0)])
             ksp.setOperators(M, self.pmat or M)
-            (ksp.solveTranspose if transpose else ksp.solve)(self.rhs, self.z)
+            with python_errors():
+                (ksp.solveTranspose if transpose else ksp.solve)(self.rhs, self.z)
             if ksp.getConvergedReason() > 0:
                 (M.multTranspose if transpose else M.mult)(self.z, self.work)
                 self.work.aypx(-1.0, self.rhs)
@@ -288,7 +290,8 @@ class _BorderedG:
         fs = self.fs
         xu, xg = fs.split(x.getArray(readonly=True))
         fs._u.setArray(xu)
-        fs.base.jacobian.mult(fs._u, fs._y)
+        with python_errors():
+            fs.base.jacobian.mult(fs._u, fs._y)
         y.setArray(fs.join(fs._y.getArray(readonly=True) + xg * fs.psi, fs._dot(fs.phi, xu)))
 
     def multTranspose(self, mat, x, y):
@@ -311,7 +314,8 @@ class _FoldJacobian:
         fs = self.fs
         xu, xp = fs.split(x.getArray(readonly=True))
         fs._u.setArray(xu)
-        fs.base.jacobian.mult(fs._u, fs._y)
+        with python_errors():
+            fs.base.jacobian.mult(fs._u, fs._y)
         g = fs._dot(fs.row, xu)
         if fs.g_p:
             g += fs.g_p * xp

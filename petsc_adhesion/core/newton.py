@@ -18,6 +18,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..core import capi
+from .capi import python_errors
 
 __all__ = ["Tolerances", "create_snes", "PCReuse", "fresh_retry", "krylov_retry", "guard", "Newton", "PC_REUSE_ITS", "TRUE_RESIDUAL"]
 
@@ -128,7 +129,8 @@ def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse, work: PETSc.Vec)
     """
     X.copy(work)
     for _ in range(2):
-        snes.solve(None, X)
+        with python_errors():
+            snes.solve(None, X)
         if snes.getConvergedReason() > 0:
             return True
         reuse.expire()
@@ -159,9 +161,11 @@ def krylov_retry(ksp: PETSc.KSP, A: PETSc.Mat, P: PETSc.Mat, b: PETSc.Vec, x: PE
     for attempt in range(2):
         linearize(reuse(ksp))
         ksp.setOperators(A, P)
-        ksp.solve(b, x)
+        with python_errors():
+            ksp.solve(b, x)
         if ksp.getConvergedReason() > 0:
-            A.mult(x, work)
+            with python_errors():
+                A.mult(x, work)
             work.aypx(-1.0, b)
             bound = TRUE_RESIDUAL * ksp.getTolerances()[0] if attempt == 0 else FRESH_RESIDUAL
             if work.norm() <= bound * b.norm():
@@ -264,7 +268,8 @@ class Newton:
         self.p = p
         if retry:
             return fresh_retry(self.snes, x, self.reuse, self.work)
-        self.snes.solve(None, x)
+        with python_errors():
+            self.snes.solve(None, x)
         return self.snes.getConvergedReason() > 0
 
     @property

@@ -30,11 +30,22 @@ def start_petsc(argv: list[str] | None = None) -> bool:
     kept = {s: signal.getsignal(s) for s in KEPT_SIGNALS}
     argv = list(argv if argv is not None else [sys.argv[0] if sys.argv and sys.argv[0] else "petsc_adhesion"])
     asked = "-no_signal_handler" in argv
+    # -help is put in the database after the start-up: PETSc's start-up would print its banner and its
+    # debugger options first (ours follow from app/options), and from 3.21 on fail before any handler of
+    # ours can say so in one line when standard output cannot be written (a full device)
+    helping = [i for i, a in enumerate(argv) if a == "-help"]
+    value = None
+    if helping:
+        i = helping[-1]
+        value = argv[i + 1] if i + 1 < len(argv) and not argv[i + 1].startswith("-") else None
+        argv = [a for k, a in enumerate(argv) if k not in helping and not (value is not None and k == i + 1)]
     # PETSc installs its handlers early in its start-up, before it prints -help: none at all
     petsc4py.init(argv if asked else argv + ["-no_signal_handler"])
     PETSc = importlib.import_module("petsc4py.PETSc")     # initialises PETSc
     if not asked:                                          # not the run's option: not in its files
         PETSc.Options().delValue("no_signal_handler")
+    if helping:
+        PETSc.Options().setValue("help", value)
     for s, handler in kept.items():
         if handler is not None:
             signal.signal(s, handler)

@@ -69,7 +69,7 @@ def load_weights(r: np.ndarray) -> np.ndarray:
     >>> r = uniform(3, 2.0)                 # nodes 0, 1, 2
     >>> load_weights(r)                     # P = 1 gives integral_0^2 r dr = 2
     array([0.16666667, 1.        , 0.83333333])
-    >>> abs(load_weights(r) @ r - 8 / 3) < 1e-15   # P = r: integral_0^2 r^2 dr = 8/3, exact
+    >>> bool(abs(load_weights(r) @ r - 8 / 3) < 1e-15)  # P = r: integral_0^2 r^2 dr = 8/3, exact
     True
     """
     a, b = r[:-1], r[1:]

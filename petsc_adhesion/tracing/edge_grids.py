@@ -60,10 +60,11 @@ def _zone(model) -> float:
     return cohesive_zone(model, pressure_law(model))
 
 
-def _fine(model) -> float:
-    """The spacing about the edge: the zone over NODES_PER_ZONE, COARSE_MARGIN times finer for a sharp edge
-    (so that its two coarser levels still resolve the zone and give the error bars), at most CONTACT_SPACING."""
-    zone = _zone(model)
+def _fine(model, zone: float | None = None) -> float:
+    """The spacing about the edge: the zone (default the model's, :func:`_zone`) over NODES_PER_ZONE,
+    COARSE_MARGIN times finer for a sharp edge (so that its two coarser levels still resolve the zone and
+    give the error bars), at most CONTACT_SPACING."""
+    zone = _zone(model) if zone is None else zone
     return min(zone / NODES_PER_ZONE / (COARSE_MARGIN if soft(model) else 1), CONTACT_SPACING)
 
 
@@ -93,7 +94,8 @@ def grid_for(model, edge: float, level: int = 0, rmax: float = RMAX) -> EdgeGrid
                     reach=REACH, level=level)
 
 
-def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: float | None = None) -> EdgeGrid:
+def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: float | None = None,
+                    zone: float | None = None) -> EdgeGrid:
     """The grid of the frame of the edge, in physical units for contact radius ``a`` (divide by a for rho).
 
     Fine enough for the zone while a grows by GROW^2 (a change waits at most that
@@ -107,22 +109,26 @@ def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: f
     outside, it is capped by CONTACT_SPACING as far as the forces reach: where the rigid
     sphere's gap has opened by REACH^2 / 2 beyond the edge's, sqrt(a^2 + REACH^2) - a
     (REACH at a = 0, 3 / (2 a) for a large contact; the elastic opening only shortens it).
+    ``zone``: the cohesive zone to resolve (default the model's; a rough soft sphere's is measured on
+    its state, :func:`~petsc_adhesion.discretization.resolution.zone_of`).
     """
     big = soft(model)
-    return EdgeGrid(edge=a, fine=_fine(model) / GROW**2, rmax=max(rmax * GROW**2, GROW * a),
-                    band=2 * _zone(model) if band is None else band, contact=CONTACT_SPACING,
+    zone = _zone(model) if zone is None else zone
+    return EdgeGrid(edge=a, fine=_fine(model, zone) / GROW**2, rmax=max(rmax * GROW**2, GROW * a),
+                    band=2 * zone if band is None else band, contact=CONTACT_SPACING,
                     reach=math.sqrt(a * a + REACH**2) - a if big else REACH, core=CORE_SHARE * a if big else 0.0,
                     level=level)
 
 
-def scaled_band(model, a: float, peak: float) -> float:
+def scaled_band(model, a: float, peak: float, zone: float | None = None) -> float:
     """The fine band of the frame of the edge at contact radius ``a`` with the peak attraction at ``peak``.
 
     Two zones, or wider so that it holds the peak attraction with a zone to spare: on a
     rough surface the gap rises slowly at the edge, and the pinned level can lie far
-    from the peak in r (0.34 at mu = 20, sigma = 1).
+    from the peak in r (0.34 at mu = 20, sigma = 1).  ``zone``: as in :func:`scaled_grid_for`.
     """
-    return max(2 * _zone(model), abs(a - peak) + _zone(model))
+    zone = _zone(model) if zone is None else zone
+    return max(2 * zone, abs(a - peak) + zone)
 
 
 def sharp(model) -> bool:

@@ -63,7 +63,7 @@ def relocate(tracer, seg, found, level: int, target=None):
                        monitor=False)
     at = owner.grid.edge if owner.grid is not None else None
     new = tracer.segment(owner.kind, at, level=level, settings=settings,
-                         band=owner.grid.band if owner.kind == "scaled" else None)
+                         band=owner.grid.band if owner.kind == "scaled" else None, zone=owner.zone)
     try:
         start = _carry_start(owner, new, back)
         if start is None:
@@ -139,7 +139,8 @@ def coarse_levels(segments) -> tuple:
     keep = len(COARSE)
     for seg in segments:
         if seg.grid is not None:
-            spare = cohesive_zone(seg.problem.model, seg.problem.law) / NODES_PER_ZONE / seg.grid.fine
+            zone = cohesive_zone(seg.problem.model, seg.problem.law) if seg.zone is None else seg.zone
+            spare = zone / NODES_PER_ZONE / seg.grid.fine
             if np.isfinite(spare):                  # mu = 0: no edge to resolve
                 keep = min(keep, max(0, int(np.floor(np.log2(spare) + 1e-9))))
     return COARSE[:keep]

@@ -39,6 +39,7 @@ from ..discretization import grid
 from ..discretization.edge_frame import EdgeFrameProblem, edge_level
 from ..discretization.influence import create_influence
 from ..discretization.problem import Problem
+from ..discretization.resolution import zone_of
 from .edge_grids import (
     a_switch,
     band,
@@ -52,7 +53,7 @@ from .edge_grids import (
     frame_of_edge,
 )
 
-__all__ = ["edge_of", "contact_radius", "crossing", "Segment", "Tracer", "carry", "FAR_STEPS"]
+__all__ = ["edge_of", "state_zone", "contact_radius", "crossing", "Segment", "Tracer", "carry", "FAR_STEPS"]
 
 
 def edge_of(problem, x: np.ndarray) -> float:
@@ -61,6 +62,13 @@ def edge_of(problem, x: np.ndarray) -> float:
     k = int(np.argmin(pressure))
     best = (float(pressure[k]), float(problem.nodes(x)[problem.lo + k]))
     return problem.comm.tompi4py().allreduce(best, op=MPI.MIN)[1]
+
+
+def state_zone(problem, x: np.ndarray) -> float:
+    """The cohesive zone the grid for the state x must resolve
+    (:func:`~petsc_adhesion.discretization.resolution.zone_of`); collective."""
+    pressure, _ = problem.law(problem.separation(x))
+    return zone_of(problem.model, problem.law, problem.nodes(x), problem.gather(pressure))
 
 
 def contact_radius(problem, x: np.ndarray) -> float:
@@ -115,6 +123,7 @@ class Segment:
     cont: Continuation
     finder: EventFinder
     far: bool = False     # the far branch traced back from the start (Tracer.extend_back)
+    zone: float | None = None   # the cohesive zone its grid resolves (None: the model's, _zone)
 
     def destroy(self) -> None:
         """Free the segment's PETSc objects."""
@@ -207,8 +216,11 @@ class _Regrid:
         if where is None:
             return False
         kind, at, forced, peak = where
-        band = scaled_band(self.seg.problem.model, at, peak) if kind == "scaled" else None
-        new = self.tracer.segment(kind, at, self.seg, band=band)
+        band = zone = None
+        if kind == "scaled":
+            zone = state_zone(self.seg.problem, b.x)
+            band = scaled_band(self.seg.problem.model, at, peak, zone)
+        new = self.tracer.segment(kind, at, self.seg, band=band, zone=zone)
         try:
             pt = carry(self.seg, new, b, at if kind == "scaled" else None)
         except BaseException:           # a failed carry: the new segment is no one's
@@ -244,10 +256,12 @@ class Tracer:
         self.sharp = None
 
     def segment(self, kind: str, at: float | None = None, before: Segment | None = None,
-                level: int | None = None, settings: Settings | None = None, band: float | None = None) -> Segment:
+                level: int | None = None, settings: Settings | None = None, band: float | None = None,
+                zone: float | None = None) -> Segment:
         """A segment of ``kind`` (fixed, edge, scaled) centred on ``at`` at refinement ``level`` (default:
         the tracer's), continuing ``before``'s budget, or with ``settings`` of its own; ``band``: the
-        fine band of a scaled segment (:func:`scaled_band`)."""
+        fine band of a scaled segment (:func:`scaled_band`), ``zone`` the cohesive zone its grid resolves
+        (:func:`state_zone`; None: the model's)."""
         level = self.level if level is None else level
         if kind == "fixed":
             nodes = grid.nested(self.nodes, level - self.level)
@@ -257,7 +271,7 @@ class Tracer:
             r = design.nodes()
             problem = Problem(self.model, r, create_influence(r, self.comm), self.pmat)
         else:
-            design = scaled_grid_for(self.model, at, level, self.rmax, band)
+            design = scaled_grid_for(self.model, at, level, self.rmax, band, zone)
             rho = design.nodes() / at
             problem = EdgeFrameProblem(self.model, rho, create_influence(rho, self.comm), at, self.pmat)
         s = settings or self.set
@@ -277,7 +291,8 @@ class Tracer:
             raise
         # events located to tol in units of the curve's size (lambda grows like mu towards the JKR end)
         tol = (self.tol or EVENT_TOL) * s.unit
-        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, tol))
+        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, tol),
+                       zone=zone if kind == "scaled" else None)
 
     def run(self, lam0: float, started=None, pause=None) -> list[Segment]:
         """The curve from lam0, starting from the rigid state (eq. 27); ``started()`` after the first point.
@@ -362,7 +377,8 @@ class Tracer:
         computed).  :meth:`restore` on a tracer made alike goes on as this one would."""
         index = {id(seg.finder): k for k, seg in enumerate(self.segments)}
         return {"segments": [{"kind": seg.kind, "at": seg.grid.edge if seg.grid is not None else None,
-                              "band": seg.grid.band if seg.kind == "scaled" else None, "N": seg.problem.layout.N,
+                              "band": seg.grid.band if seg.kind == "scaled" else None, "zone": seg.zone,
+                              "N": seg.problem.layout.N,
                               "guarded": seg.problem.guarded, "far": seg.far,
                               "continuation": seg.cont.state(solvers),
                               "events": seg.finder.state(lambda f: index[id(f)])} for seg in self.segments]}
@@ -382,7 +398,10 @@ class Tracer:
                 raise ValueError(f"segment {k + 1} on a grid centred nowhere ({st['at']!r})")
             if not (isinstance(st["guarded"], int) and st["guarded"] >= 0 and isinstance(st["N"], int)):
                 raise ValueError(f"segment {k + 1}'s counters are not counts")
-            seg = self.segment(st["kind"], st["at"], settings=settings, band=st["band"])
+            zone = st.get("zone")
+            if zone is not None and not (isinstance(zone, float) and math.isfinite(zone) and zone > 0):
+                raise ValueError(f"segment {k + 1} resolves a cohesive zone of {zone!r}")
+            seg = self.segment(st["kind"], st["at"], settings=settings, band=st["band"], zone=zone)
             self.segments.append(seg)
             if seg.problem.layout.N != st["N"]:
                 raise ValueError(f"a segment {k + 1} of {st['N']} nodes, where this version makes {seg.problem.layout.N}")
