@@ -49,20 +49,24 @@ def start_petsc(argv: list[str] | None = None) -> bool:
     for s, handler in kept.items():
         if handler is not None:
             signal.signal(s, handler)
-    if not any(a.lstrip("-") == "options_left" for a in argv):
-        atexit.register(_no_options_left)
+    atexit.register(_quiet_finalize, not any(a.lstrip("-") == "options_left" for a in argv))
     return True
 
 
-def _no_options_left() -> None:
-    """PETSc's finalize says nothing of unused options unless the command line asked it to.
+def _quiet_finalize(no_options_left: bool) -> None:
+    """PETSc's finalize writes nothing to standard output that the command line did not ask for.
 
-    PETSc 3.21 lists them on standard output at PetscFinalize (3.18 does not): a refused run's
-    options, the Python interpreter's own arguments; on a closed or full standard output that
-    write fails and the process ends with PETSc's error page.  We refuse options ourselves
-    (app/options), so the list says nothing new.  Python's exit handlers run before petsc4py's
-    PetscFinalize (registered with Py_AtExit), so the value is in place when it is read.
+    PETSc 3.21 lists the unused options on standard output at PetscFinalize (3.18 does not):
+    a refused run's options, the Python interpreter's own arguments; and with -help it prints
+    the help of -log_view there.  On a closed or full standard output that write fails and the
+    process ends with PETSc's error page after our one line.  We refuse options ourselves
+    (app/options), so the list says nothing new (unless -options_left was given); the help was
+    printed while the run read its options.  Python's exit handlers run before petsc4py's
+    PetscFinalize, so the database is as set here when it is read.
     """
     PETSc = sys.modules.get("petsc4py.PETSc")
     if PETSc is not None and PETSc.Sys.isInitialized() and not PETSc.Sys.isFinalized():
-        PETSc.Options().setValue("options_left", "0")
+        opts = PETSc.Options()
+        if no_options_left:
+            opts.setValue("options_left", "0")
+        opts.delValue("help")
