@@ -23,9 +23,16 @@ def _clean_env(**extra):
 
 
 def _probe(cmd, env):
+    """The JSON objects the ranks printed: each rank's one write, which a launcher may pass on run together
+    (MPICH's Hydra gave '{...}{...}' on one line, its newlines elsewhere)."""
     p = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stderr
-    return [json.loads(ln) for ln in p.stdout.splitlines() if ln.startswith("{")]
+    decoder, text, outs, i = json.JSONDecoder(), p.stdout, [], p.stdout.find("{")
+    while i >= 0:
+        obj, end = decoder.raw_decode(text, i)
+        outs.append(obj)
+        i = text.find("{", end)
+    return outs
 
 
 def test_user_setting_and_launcher_win():

@@ -181,7 +181,8 @@ def _main(argv: list[str]) -> int:
     try:
         from ..core.start import start_petsc
 
-        start_petsc(argv)                 # the handlers of SIGINT, SIGTERM, SIGHUP, SIGPIPE kept
+        # -version is ours: PETSc's start-up would print its banner (and fail on a closed stdout from 3.21 on)
+        start_petsc(argv[:1] if "-version" in argv else argv)   # the handlers of SIGINT, TERM, HUP, PIPE kept
         from petsc4py import PETSc        # PETSc's own libraries, found through PETSC_DIR
     except ImportError as e:
         _say(f"petsc4py cannot be loaded ({first_line(e)}); with PETSC_DIR = "

@@ -10,6 +10,7 @@ SIGINT, SIGTERM and SIGHUP end the run in one line) are kept.
 """
 from __future__ import annotations
 
+import atexit
 import importlib
 import signal
 import sys
@@ -48,4 +49,24 @@ def start_petsc(argv: list[str] | None = None) -> bool:
     for s, handler in kept.items():
         if handler is not None:
             signal.signal(s, handler)
+    atexit.register(_quiet_finalize, not any(a.lstrip("-") == "options_left" for a in argv))
     return True
+
+
+def _quiet_finalize(no_options_left: bool) -> None:
+    """PETSc's finalize writes nothing to standard output that the command line did not ask for.
+
+    PETSc 3.21 lists the unused options on standard output at PetscFinalize (3.18 does not):
+    a refused run's options, the Python interpreter's own arguments; and with -help it prints
+    the help of -log_view there.  On a closed or full standard output that write fails and the
+    process ends with PETSc's error page after our one line.  We refuse options ourselves
+    (app/options), so the list says nothing new (unless -options_left was given); the help was
+    printed while the run read its options.  Python's exit handlers run before petsc4py's
+    PetscFinalize, so the database is as set here when it is read.
+    """
+    PETSc = sys.modules.get("petsc4py.PETSc")
+    if PETSc is not None and PETSc.Sys.isInitialized() and not PETSc.Sys.isFinalized():
+        opts = PETSc.Options()
+        if no_options_left:
+            opts.setValue("options_left", "0")
+        opts.delValue("help")

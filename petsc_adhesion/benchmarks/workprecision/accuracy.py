@@ -9,10 +9,13 @@ import sys
 import time
 
 import numpy as np
-import petsc4py
 
-petsc4py.init(sys.argv)
-from petsc4py import PETSc
+from ...core.start import start_petsc
+
+# ./run bench has started PETSc with its command line; run alone (the scaling study's worker, whose
+# arguments are not PETSc options: PETSc 3.21 lists them as unused at its exit) PETSc reads none
+start_petsc([sys.argv[0]])
+from petsc4py import PETSc  # noqa: E402
 
 from ...app.options.reading import AppOptions, read_settings
 from ...discretization import grid
