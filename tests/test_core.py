@@ -548,6 +548,12 @@ def test_python_errors_gives_the_callbacks_own_exception():
     with pytest.raises(Outside, match="inside"):
         with python_errors():
             wrapped(Outside("inside"))
+    with pytest.raises(Outside, match="nested"):          # wrapped at each level of callbacks
+        with python_errors():
+            try:
+                wrapped(Outside("nested"))
+            except PETSc.Error as inner:
+                raise PETSc.Error(101) from inner
     with pytest.raises(PETSc.Error) as own:
         with python_errors():
             raise PETSc.Error(73)

@@ -362,7 +362,7 @@ REFUSED = {
 
 def _heights() -> bytes:
     z = np.random.default_rng(3).normal(size=200)
-    return "".join(f"{v!r}\n" for v in 0.5 * (z - z.mean()) / z.std()).encode()
+    return "".join(f"{float(v)!r}\n" for v in 0.5 * (z - z.mean()) / z.std()).encode()
 
 
 @pytest.fixture(scope="module")

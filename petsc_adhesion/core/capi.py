@@ -27,13 +27,18 @@ def python_errors():
     petsc4py 3.18 to 3.21 re-raise a callback's exception as it is; 3.22 and later raise
     PETSc.Error (101, "Unhandled Python Exception") from it, and the domain guard's,
     the signal handlers' and the problems' own exceptions would all read as PETSc errors
-    (measured with petsc4py 3.26: the guard test and a SIGTERM during the error bars).
+    (measured with petsc4py 3.26: the guard test and a SIGTERM during the error bars), and a callback
+    called from within another (a shell Jacobian's product inside SNES) is wrapped at each level
+    (a SIGTERM during a corrector: PETSc.Error from PETSc.Error from the signal's exception).
     """
     try:
         yield
     except PETSc.Error as e:
+        # a callback inside a callback (a shell matrix's product inside SNES) wraps it once more
         cause = e.__cause__
-        if cause is None or isinstance(cause, PETSc.Error):
+        while isinstance(cause, PETSc.Error):
+            cause = cause.__cause__
+        if cause is None:
             raise
         raise cause.with_traceback(cause.__traceback__) from None
 
