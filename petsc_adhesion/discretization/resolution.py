@@ -88,10 +88,12 @@ def measured_zone(r: np.ndarray, P: np.ndarray) -> float:
     return float(r[k] - half) / INNER_SHARE
 
 
-def zone_of(model, law, r: np.ndarray | None = None, P: np.ndarray | None = None) -> float:
-    """The cohesive zone to resolve: :func:`cohesive_zone`, or for a rough soft sphere (mu from MU_SOFT)
-    the wider :func:`measured_zone` of the state (r, P) where it is given and wider."""
-    zone = cohesive_zone(model, law)
+def zone_of(model, law, r: np.ndarray | None = None, P: np.ndarray | None = None,
+            formula: float | None = None) -> float:
+    """The cohesive zone to resolve: :func:`cohesive_zone` (``formula`` when the caller has it), or for a
+    rough soft sphere (mu from MU_SOFT) the wider :func:`measured_zone` of the state (r, P) where it is
+    given and wider."""
+    zone = cohesive_zone(model, law) if formula is None else formula
     if r is None or law.smooth or model.mu < MU_SOFT:
         return zone
     seen = measured_zone(np.asarray(r), np.asarray(P))
@@ -117,7 +119,7 @@ def check(model, law, states, folds: int) -> str:
             h = np.diff(r)
             spacing.append(h[max(0, k - 1):k + 1].max())
             where.append(r[k])
-            needs.append(zone_of(model, law, r, P) / NODES_PER_ZONE)
+            needs.append(zone_of(model, law, r, P, zone) / NODES_PER_ZONE)
     if not spacing:
         return ""
     hmax, lo, hi = max(spacing), min(where), max(where)

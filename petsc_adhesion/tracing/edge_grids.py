@@ -55,16 +55,17 @@ CORE_SHARE = 0.02
 COARSE_MARGIN = 4
 
 
-def _zone(model) -> float:
-    """The cohesive zone of the model, roughness included (:func:`~petsc_adhesion.discretization.resolution.cohesive_zone`)."""
-    return cohesive_zone(model, pressure_law(model))
+def _zone(model, given: float | None = None) -> float:
+    """The cohesive zone of the model, roughness included (:func:`~petsc_adhesion.discretization.resolution.cohesive_zone`),
+    or the one ``given`` (a rough soft sphere's, measured on its state)."""
+    return cohesive_zone(model, pressure_law(model)) if given is None else given
 
 
 def _fine(model, zone: float | None = None) -> float:
     """The spacing about the edge: the zone (default the model's, :func:`_zone`) over NODES_PER_ZONE,
     COARSE_MARGIN times finer for a sharp edge (so that its two coarser levels still resolve the zone and
     give the error bars), at most CONTACT_SPACING."""
-    zone = _zone(model) if zone is None else zone
+    zone = _zone(model, zone)
     return min(zone / NODES_PER_ZONE / (COARSE_MARGIN if soft(model) else 1), CONTACT_SPACING)
 
 
@@ -113,7 +114,7 @@ def scaled_grid_for(model, a: float, level: int = 0, rmax: float = RMAX, band: f
     its state, :func:`~petsc_adhesion.discretization.resolution.zone_of`).
     """
     big = soft(model)
-    zone = _zone(model) if zone is None else zone
+    zone = _zone(model, zone)
     return EdgeGrid(edge=a, fine=_fine(model, zone) / GROW**2, rmax=max(rmax * GROW**2, GROW * a),
                     band=2 * zone if band is None else band, contact=CONTACT_SPACING,
                     reach=math.sqrt(a * a + REACH**2) - a if big else REACH, core=CORE_SHARE * a if big else 0.0,
@@ -127,7 +128,7 @@ def scaled_band(model, a: float, peak: float, zone: float | None = None) -> floa
     rough surface the gap rises slowly at the edge, and the pinned level can lie far
     from the peak in r (0.34 at mu = 20, sigma = 1).  ``zone``: as in :func:`scaled_grid_for`.
     """
-    zone = _zone(model) if zone is None else zone
+    zone = _zone(model, zone)
     return max(2 * zone, abs(a - peak) + zone)
 
 
