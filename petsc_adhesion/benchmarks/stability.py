@@ -1,6 +1,6 @@
 """The stability matrix of docs/stability.md: every Tabor parameter and roughness, default settings.
 
-    ./run stability            # all cells, two at a time, into docs/stability.md (about 15 minutes)
+    ./run stability            # all cells, two at a time, into docs/stability.md (about 6 minutes)
     ./run stability 20 2       # one cell (mu, sigma), printed
 
 Each cell traces the curve from far apart to F >= 2 with the program's
