@@ -15,13 +15,25 @@ import stat
 
 from ..errors import InputError, printable
 
-__all__ = ["check_input", "file_problem", "MAX_INPUT_BYTES"]
+__all__ = ["check_input", "file_problem", "size_words", "MAX_INPUT_BYTES"]
 
 #: The largest input file read whole (2 GiB): a height map of 10^8 doubles; nothing larger is plausible.
 MAX_INPUT_BYTES = 2 << 30
 
 _KINDS = {stat.S_IFCHR: "a character device", stat.S_IFBLK: "a block device", stat.S_IFIFO: "a FIFO",
           stat.S_IFSOCK: "a socket", stat.S_IFDIR: "a directory"}
+
+
+def size_words(n: float) -> str:
+    """``n`` bytes in the largest binary unit that shows it as at least 1 (bytes, KiB, MiB, GiB, TiB), with the
+    digits that tell two sizes apart: a limit and a size over it never read the same ('0.0 GiB', '0 GiB')."""
+    n = float(n)
+    for unit in ("TiB", "GiB", "MiB", "KiB"):
+        scale = float(1 << {"KiB": 10, "MiB": 20, "GiB": 30, "TiB": 40}[unit])
+        if abs(n) >= scale:
+            value = n / scale
+            return f"{value:.0f} {unit}" if value == round(value) else f"{value:.3g} {unit}"
+    return f"{n:.0f} bytes"
 
 
 def file_problem(path: str, max_bytes: int = MAX_INPUT_BYTES) -> str | None:
@@ -42,7 +54,10 @@ def file_problem(path: str, max_bytes: int = MAX_INPUT_BYTES) -> str | None:
     if not os.access(path, os.R_OK):
         return "cannot be read (permission denied)"
     if st.st_size > max_bytes:
-        return f"has {st.st_size / 2**30:.1f} GiB, more than the {max_bytes / 2**30:.0f} GiB read whole"
+        has, limit = size_words(st.st_size), size_words(max_bytes)
+        if has == limit:                       # just over the limit: the bytes tell them apart
+            has, limit = f"{st.st_size} bytes", f"{max_bytes} bytes ({limit})"
+        return f"has {has}, more than the {limit} read whole"
     return None
 
 
