@@ -5,13 +5,15 @@ from __future__ import annotations
 import difflib
 import math
 import os
+import resource
 
 from petsc4py import PETSc
 
 from ... import brent
 from ...core import capi
-from ...discretization.preconditioning import memory_available, memory_needed
+from ...discretization.preconditioning import BASE_BYTES, memory_available, memory_needed
 from ...errors import InputError
+from ...io.inputs import size_words
 from ...model.parameters import Model
 from ...model.reference.jkr import jkr_zero_load
 from ...model.reference.rigid import load_beyond
@@ -19,7 +21,7 @@ from ...tracing.edge_grids import MU_TRUNCATED
 from .reading import _NUMBER, AppOptions, _strict_float, _strict_int
 from .table import ROUGHNESS_OPTIONS, SOLVER_PREFIXES, TABLE, Option
 
-__all__ = ["DOMAIN_SHARE", "smallest_domain", "check_consistency", "check_memory", "petsc_error", "PETSC_GLOBAL", "petsc_names", "check_unused", "check_petsc_values"]
+__all__ = ["DOMAIN_SHARE", "smallest_domain", "check_consistency", "check_memory", "memory_limits", "petsc_error", "PETSC_GLOBAL", "petsc_names", "check_unused", "check_petsc_values"]
 
 
 #: The attraction beyond r_m may carry at most this share of the DMT pull-off at contact.
@@ -100,20 +102,91 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
                          f"error in the bar) or take -grid_type uniform")
 
 
-def check_memory(grid_choice, pmat: str, curve: bool, ranks: int) -> None:
-    """Refuse, before any node is made, a grid whose matrices cannot fit in the memory this machine has left:
-    the dense influence matrix and, with -adh_pmat dense, G_H, the bordered matrix and their factors
-    (:func:`~petsc_adhesion.discretization.preconditioning.memory_needed`), split over the ranks."""
+#: Where a control group states the memory its processes may use, and what they use now (v2, then v1).
+CGROUP_MEMORY = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                 ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"))
+
+
+def _read_number(path: str) -> float | None:
+    """The number a /proc or /sys file holds ('max' and what is no number: None)."""
+    try:
+        with open(path) as f:
+            text = f.read().strip()
+        return float(text)
+    except (OSError, ValueError):
+        return None
+
+
+def _mapped_bytes() -> float:
+    """The address space this process maps now (VmSize), 0 where /proc does not say."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmSize:"):
+                    return float(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0.0
+
+
+def memory_limits(cgroups=CGROUP_MEMORY) -> list:
+    """Each limit on the memory this process may still take, as (bytes left, bytes of the limit or None, its
+    name, whether what the process holds now is counted in it already): the machine's available memory (MemAvailable), the address-space limit (RLIMIT_AS, as ``ulimit
+    -v`` sets it) less what the process maps already, and the control group's limit less what the group uses.
+    A limit that is not set (unlimited, 'max', a v1 group's near 2^63) is left out."""
+    out = []
+    machine = _mem_available()
+    if machine is not None:
+        out.append((machine, None, "this machine has", False))
+    try:
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    except (OSError, ValueError):
+        soft = resource.RLIM_INFINITY
+    if soft != resource.RLIM_INFINITY and soft > 0:
+        # what is mapped now holds the run's base already (BASE_BYTES of memory_needed): what is left of
+        # the limit is compared with the matrices alone (the third element: the base is counted)
+        out.append((soft - _mapped_bytes(), float(soft), "the address-space limit (ulimit -v, RLIMIT_AS)", True))
+    for limit_path, used_path in cgroups:
+        limit, used = _read_number(limit_path), _read_number(used_path)
+        if limit is not None and limit < 2.0**60:           # v1 says 'unlimited' as a number near 2^63
+            out.append((limit - (used or 0.0), limit, f"the control group's memory limit ({limit_path})", False))
+            break
+    return out
+
+
+def _mem_available() -> float | None:
+    """MemAvailable of /proc/meminfo in bytes, or None."""
+    try:
+        with open("/proc/meminfo") as f:
+            info = {ln.split(":")[0]: ln.split()[1] for ln in f}
+        return float(info["MemAvailable"]) * 1024
+    except (OSError, KeyError, ValueError, IndexError):
+        return None
+
+
+def check_memory(grid_choice, pmat: str, curve: bool, ranks: int, limits=None) -> None:
+    """Refuse, before any node is made, a grid whose matrices cannot fit in the memory this process may still
+    take: the dense influence matrix and, with -adh_pmat dense, G_H, the bordered matrix and their factors
+    (:func:`~petsc_adhesion.discretization.preconditioning.memory_needed`), split over the ranks, against the
+    smallest of the machine's available memory, the process's address-space limit and its control group's
+    limit (:func:`memory_limits`; ``limits`` given: those), the one that binds named."""
     n = grid_choice.size
     if n is None:
         return
-    need, have = memory_needed(n, pmat, curve, ranks), memory_available()
-    if need > have:
+    need = memory_needed(n, pmat, curve, ranks)
+    limits = memory_limits() if limits is None else limits
+    if not limits:
+        limits = [(memory_available(), None, "this machine has", False)]
+    # the shortfall under each limit: what the run still needs against what the limit leaves
+    short = [(need - (BASE_BYTES if counted else 0.0) - have, have, limit, name) for have, limit, name, counted in limits]
+    over, have, limit, name = max(short, key=lambda x: x[0])
+    if over > 0:
         option = "-grid_n" if grid_choice.kind == "uniform" else "-grid_paper_extra"
         cheaper = ", or -adh_pmat band" if pmat == "dense" else ""
-        raise InputError(f"{option}: N = {n} nodes need {need / 2**30:.1f} GiB a rank ({'a curve' if curve else 'a solve'}"
-                         f" with -adh_pmat {pmat}), this machine has {have / 2**30:.1f} GiB available; use fewer "
-                         f"nodes, more ranks{cheaper}")
+        where = f"{name} {size_words(max(have, 0.0))} available" if limit is None else \
+            f"{name} of {size_words(limit)} leaves {size_words(max(have, 0.0))}"
+        raise InputError(f"{option}: N = {n} nodes need {size_words(need)} a rank ({'a curve' if curve else 'a solve'}"
+                         f" with -adh_pmat {pmat}), {where}; use fewer nodes, more ranks{cheaper}")
 
 
 # -- PETSc's errors and options ------------------------------------------------------
