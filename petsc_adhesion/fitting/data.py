@@ -28,6 +28,8 @@ finite, a curve that does not turn back) is one line (:class:`CurveFileError`).
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import logging
 import os
 import re
@@ -35,6 +37,8 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from ..errors import printable as _printable
 
 __all__ = ["CurveFileError", "MeasuredCurve", "read_curve", "AFM_EXTENSIONS", "LENGTH_UNITS", "FORCE_UNITS",
            "MIN_POINTS", "MAX_TEXT_BYTES"]
@@ -50,10 +54,22 @@ FORCE_UNITS = {"n": 1.0, "mn": 1e-3, "un": 1e-6, "\u00b5n": 1e-6, "\u03bcn": 1e-
 MIN_POINTS = 10
 #: The largest text file read (a curve of 10^7 points).
 MAX_TEXT_BYTES = 1 << 30
+#: What an AFM measures, in SI: the piezo's travel over a curve (from a tenth of a nanometre to a millimetre;
+#: scanners travel up to about 100 um) and the largest force (a femtonewton to 0.1 mN: a stiff lever of
+#: 100 N/m bent by a micrometre), each with a decade or more to spare.  A column outside is in another unit
+#: than its header (or SI, without one) says.
+PLAUSIBLE_TRAVEL_M = (1e-10, 1e-3)
+PLAUSIBLE_FORCE_N = (1e-15, 1e-4)
+#: The travel and force of a typical curve: the unit said to be likely puts the column nearest these.
+TYPICAL_TRAVEL_M, TYPICAL_FORCE_N = 1e-7, 1e-8
 
 
 class CurveFileError(ValueError):
     """A file that holds no measured force curve; the message is one line, starting with the file's name."""
+
+
+class _TextCurveError(CurveFileError):
+    """A file read as text, columns of numbers, whose numbers cannot be the curve: not tried as an AFM file."""
 
 
 @dataclass(frozen=True)
@@ -106,6 +122,8 @@ def read_curve(path: str, index: int = 0) -> MeasuredCurve:
             if index:
                 raise CurveFileError(f"{_name(path)}: a text file holds one curve; index {index} asked for")
             return _read_text(path)
+        except _TextCurveError:
+            raise
         except CurveFileError as e:
             if ext not in AFM_EXTENSIONS:
                 raise
@@ -122,13 +140,28 @@ def read_curve(path: str, index: int = 0) -> MeasuredCurve:
 # -- plain text -----------------------------------------------------------------
 _SPLIT = re.compile(r"[,;\t ]+")
 _UNIT = re.compile(r"[(\[]\s*([^)\]]*?)\s*[)\]]\s*$")
+#: Fields of a decimal-comma file ("1,5;2,3", "1,5 2,3"), split on semicolons, tabs or blanks.
+_SPLIT_DECIMAL_COMMA = re.compile(r"[;\t ]+")
+_DECIMAL_COMMA = re.compile(r"[-+]?\d*,\d+(?:[eE][-+]?\d+)?|[-+]?\d+(?:[eE][-+]?\d+)?")
 
 
-def _numbers(line: str) -> list[float] | None:
+def _numbers(line: str, decimal_comma: bool = False) -> list[float] | None:
     try:
+        if decimal_comma:
+            return [float(x.replace(",", ".")) for x in _SPLIT_DECIMAL_COMMA.split(line.strip()) if x]
         return [float(x) for x in _SPLIT.split(line.strip()) if x]
     except ValueError:
         return None
+
+
+def _is_decimal_comma(line: str) -> bool:
+    """Whether a line of numbers writes its decimals with commas: two or more fields apart by semicolons, tabs
+    or blanks, each a number whose only separator is a comma inside it, one at least with such a comma, and no
+    point anywhere ("1,5;2,3" or "1,5 2,3"; "1, 5" and "1,5" are comma-separated columns)."""
+    if "." in line or "," not in line:
+        return False
+    fields = [x for x in _SPLIT_DECIMAL_COMMA.split(line.strip()) if x]
+    return len(fields) >= 2 and all(_DECIMAL_COMMA.fullmatch(x) for x in fields) and any("," in x for x in fields)
 
 
 def _unit(name: str, units: dict, what: str, column: int, path: str) -> float:
@@ -141,6 +174,41 @@ def _unit(name: str, units: dict, what: str, column: int, path: str) -> float:
         raise CurveFileError(f"{_name(path)}: column {column} '{name.strip()}': '{m.group(1)}' is no {what} unit "
                              f"(expected one of {', '.join(u for u in units if u.isascii())})")
     return scale
+
+
+#: How a force unit of FORCE_UNITS (kept in lower case) is written.
+_FORCE_SHOWN = {"n": "N", "mn": "mN", "un": "uN", "nn": "nN", "pn": "pN"}
+
+
+def _likely_unit(size: float, units: dict, typical: float, bounds: tuple) -> str | None:
+    """The unit of ``units`` that puts ``size`` (the raw numbers' size) inside ``bounds`` and nearest
+    ``typical``; None when none does."""
+    fits = [(abs(np.log10(size * scale / typical)), u) for u, scale in units.items()
+            if u.isascii() and bounds[0] <= size * scale <= bounds[1]]
+    return min(fits)[1] if fits else None
+
+
+def _plausible(raw: np.ndarray, scales: tuple, header: list | None, path: str) -> None:
+    """Refuse a column whose values, in the unit the header states (SI without a header), no AFM measures: a
+    piezo travel of metres or kilometres, forces of newtons (nm and nN numbers under an SI header), in one line
+    naming the column and the unit its numbers are likely in."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        sizes = (float(np.ptp(raw[:, 0])), float(np.max(np.abs(raw[:, 1]))))
+    checks = (("the piezo travels", "an AFM's piezo travels", PLAUSIBLE_TRAVEL_M, TYPICAL_TRAVEL_M, LENGTH_UNITS,
+               "m", {}),
+              ("the largest force is", "an AFM measures", PLAUSIBLE_FORCE_N, TYPICAL_FORCE_N, FORCE_UNITS, "N",
+               _FORCE_SHOWN))
+    for i, (what, afm, bounds, typical, units, si, shown) in enumerate(checks):
+        value = sizes[i] * scales[i]
+        if sizes[i] == 0 or bounds[0] <= value <= bounds[1]:
+            continue                    # a column that does not move is said by _curve
+        likely = _likely_unit(sizes[i], units, typical, bounds) if np.isfinite(sizes[i]) else None
+        hint = f"; its numbers are likely in {shown.get(likely, likely)}" if likely else ""
+        value_text = f"{value:.3g} {si}" if np.isfinite(value) else "more than any float holds"
+        column = f"column {i + 1} '{header[i].strip()}'" if header else f"column {i + 1} (no header: in {si})"
+        fix = "correct the header's unit" if header else "give a header with the units, such as 'z (nm), F (nN)'"
+        raise _TextCurveError(f"{_name(path)}: {column}: {what} {value_text}, where {afm} {bounds[0]:g} to "
+                             f"{bounds[1]:g} {si}{hint}: {fix}")
 
 
 def _read_text(path: str) -> MeasuredCurve:
@@ -158,19 +226,27 @@ def _read_text(path: str) -> MeasuredCurve:
     except UnicodeDecodeError:
         text = raw.decode("latin-1")
     rows, header, scale_z, scale_F = [], None, 1.0, 1.0
+    decimal_comma = None                     # decided on the first row of numbers with a comma, then held
     for number, line in enumerate(text.splitlines(), 1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
             continue
-        values = _numbers(stripped)
+        if decimal_comma is None and "," in stripped:      # the first row of numbers with a comma decides
+            if _is_decimal_comma(stripped):
+                decimal_comma = True
+            elif _numbers(stripped) is not None:
+                decimal_comma = False
+        values = _numbers(stripped, bool(decimal_comma))
         if values is None:
             if rows or header is not None:
-                raise CurveFileError(f"{_name(path)}: line {number} is not numbers: '{stripped[:60]}'")
+                raise CurveFileError(f"{_name(path)}: line {number} is not numbers"
+                                     f"{' with decimal commas, as the first row' if decimal_comma else ''}: "
+                                     f"'{_printable(stripped[:60])}'")
             header = [h for h in re.split(r"\s*[,;\t]\s*", stripped)] if re.search(r"[,;\t]", stripped) \
                 else stripped.split()
             if len(header) < 2:
-                raise CurveFileError(f"{_name(path)}: the header '{stripped[:60]}' names one column; expected "
-                                     f"the piezo displacement and the force")
+                raise CurveFileError(f"{_name(path)}: the header '{_printable(stripped[:60])}' names one column; "
+                                     f"expected the piezo displacement and the force")
             scale_z = _unit(header[0], LENGTH_UNITS, "length", 1, path)
             scale_F = _unit(header[1], FORCE_UNITS, "force", 2, path)
             continue
@@ -181,6 +257,8 @@ def _read_text(path: str) -> MeasuredCurve:
     if not rows:
         raise CurveFileError(f"{_name(path)}: no rows of numbers")
     data = np.array(rows, dtype=float)
+    if np.all(np.isfinite(data)):            # what is not finite is said by _curve
+        _plausible(data, (scale_z, scale_F), header, path)
     return _curve(data[:, 0] * scale_z, data[:, 1] * scale_F, path, "text", None, None, {})
 
 
@@ -195,18 +273,22 @@ def _read_afm(path: str, index: int) -> MeasuredCurve:
     # ValueError and the like from its readers
     own = tuple(getattr(afmformats.errors, n) for n in ("AFMFileFormatError", "MissingMetaDataError")
                 if hasattr(getattr(afmformats, "errors", None), n))
-    log = logging.getLogger("afmformats")      # it logs each recipe that fails, with a traceback: one line is ours
-    level = log.level
+    # afmformats logs each recipe that fails, with a traceback, and the readers beneath it (igor2) log what
+    # they could not decode, raw bytes and all, through Python's last-resort handler: every logger is quiet
+    # and anything printed is kept, while the file is read; one line is ours
+    disabled = logging.root.manager.disable
     try:
-        log.setLevel(logging.CRITICAL + 1)
-        with warnings.catch_warnings():
+        logging.disable(logging.CRITICAL)
+        with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()), \
+                contextlib.redirect_stderr(io.StringIO()):
             warnings.simplefilter("ignore")
             curves = afmformats.load_data(str(path), modality="force-distance")
     except (Exception, *own) as e:
         why = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise CurveFileError(f"{_name(path)}: not a force-distance curve afmformats reads ({why[:120]})") from None
+        raise CurveFileError(f"{_name(path)}: not a force-distance curve afmformats reads "
+                             f"({_printable(why)[:120]})") from None
     finally:
-        log.setLevel(level)
+        logging.disable(disabled)
     if not curves:
         raise CurveFileError(f"{_name(path)}: afmformats finds no force-distance curve in it")
     if not 0 <= index < len(curves):
