@@ -88,8 +88,26 @@ def file_error(path: str, opened: tuple = ()) -> str | None:
     return None
 
 
+#: The variables PETSc reads as options at start-up, which petsc4py hands to Python as text: each must be UTF-8.
+TEXT_VARIABLES = ("PETSC_OPTIONS", "PETSC_OPTIONS_YAML")
+
+
+def undecodable_variable() -> str | None:
+    """The first of :data:`TEXT_VARIABLES` whose value is not UTF-8 (Python keeps its bytes as surrogates, which
+    PETSc's options and petsc4py cannot take), said in one line; None when all are."""
+    for name in TEXT_VARIABLES:
+        value = os.environ.get(name)
+        if value is not None and not _utf8(value):
+            return f"{name}: '{printable(value)}' is not valid UTF-8: write it in UTF-8, or unset it"
+    return None
+
+
 def environment_error(argv: list[str]) -> str | None:
-    """What PETSc would abort on, or silently skip, in PETSC_OPTIONS and the .petscrc files."""
+    """What PETSc would abort on, or silently skip, in PETSC_OPTIONS and the .petscrc files; a variable PETSc
+    reads that is not UTF-8."""
+    bad = undecodable_variable()
+    if bad:
+        return bad
     env = os.environ.get("PETSC_OPTIONS", "").split()
     word = stray_word(env)
     if word is not None:
