@@ -76,19 +76,52 @@ def test_architecture_md_names_every_module():
     assert not missing, missing
 
 
+# -- the citation patterns and their examples (the one part of this file not searched for them) --
+#: What cites a file or folder outside the repository: the notes and paths of the machine the project was built
+#: on, a document of the team's beside the repository, a path climbing out of it, an issue number.
+OUTSIDE = (r"\bNOTES\b", r"/work/", r"(?<![\w/.])/work\b", r"\.\./shared", r"\bpeers\.md\b", r"\bSTYLE\.md\b",
+           r"\bscopes\.md\b", r"\bcommon\.md\b", r"\bprompts/", r"\bissue \d+", r"(?<![\w.])/home/\w",
+           r"/root/")
+#: Texts and whether they cite outside the repository.
+EXAMPLES = [
+    ("see peers.md for the band", True), ("STYLE.md says so", True), ("../shared/notes", True),
+    ("/work/main/.venv/bin/python", True), ("cd /work && ls", True), ("/home/alice/x", True), ("issue 33", True),
+    ("docs/performance.md", False), ("benchmarks/peers.py", False), ("/tmp/petsc-adhesion-check.XXXX", False),
+    ("the work of adhesion", False), ("home/away", False)]
+# -- end of the citation patterns --
+#: The files of the repository that are read: the code, the tests, the docs, the options, the scripts.
+CITING = ("petsc_adhesion", "tests", "docs", "options")
+SCRIPTS = ("README.md", "run", "pyproject.toml")
+
+
+def _outside(text: str) -> list:
+    return [p for p in OUTSIDE if re.search(p, text)]
+
+
 def test_nothing_cites_a_file_outside_the_repository():
-    """The docs, the code and the tests cite the repository's own documents, never the notes or paths of the
-    machine the project was built on."""
+    """The docs, the code and the tests (and README, ./run, pyproject.toml) cite the repository's own documents,
+    never the notes or paths of the machine the project was built on, nor a document beside the repository
+    (OUTSIDE).  This file is read too, but for its table of
+    patterns and examples."""
     bad = []
-    for top in ("petsc_adhesion", "tests", "docs", "options"):
+    for top in CITING:
         for folder, _, files in os.walk(os.path.join(ROOT, top)):
             for name in files:
-                if name.endswith((".py", ".md", ".opts")) and name != "test_docs.py":
-                    text = open(os.path.join(folder, name), encoding="utf-8").read()
-                    for pattern in (r"\bNOTES\b", r"/work/", r"\.\./shared", r"\bissue \d+"):
-                        if re.search(pattern, text):
-                            bad.append(f"{top}/{os.path.relpath(os.path.join(folder, name), os.path.join(ROOT, top))}: {pattern}")
-    for name in ("README.md",):
-        text = open(os.path.join(ROOT, name)).read()
-        bad += [f"{name}: {p}" for p in (r"\bNOTES\b", r"/work/", r"\.\./shared") if re.search(p, text)]
+                if name.endswith((".py", ".md", ".opts", ".json", ".txt", ".csv")):
+                    path = os.path.join(folder, name)
+                    with open(path, encoding="utf-8", errors="replace") as f:
+                        text = f.read()
+                    if path == os.path.abspath(__file__):
+                        start, end = "# -- the citation patterns", "# -- end of the citation patterns"
+                        text = text[:text.index(start)] + text[text.index(end):]
+                    bad += [f"{os.path.relpath(path, ROOT)}: {p}" for p in _outside(text)]
+    for name in SCRIPTS:
+        with open(os.path.join(ROOT, name), encoding="utf-8") as f:
+            bad += [f"{name}: {p}" for p in _outside(f.read())]
     assert not bad, bad
+
+
+@pytest.mark.parametrize("text, cites", EXAMPLES)
+def test_the_outside_patterns_tell_citations_apart(text, cites):
+    """The patterns find each kind of citation outside the repository and leave the repository's own names."""
+    assert bool(_outside(text)) == cites, (text, _outside(text))
