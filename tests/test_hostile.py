@@ -77,6 +77,8 @@ def cli(*args, np=1, cwd, env=None, timeout=HANG) -> subprocess.CompletedProcess
             else:
                 full[k] = v
         cmd = [sys.executable, "-m", "petsc_adhesion", *map(str, args)]
+        if np > 1:                                  # the environment given to every rank
+            cmd = [shutil.which("mpiexec"), "-n", str(np), *cmd]
         return subprocess.run(cmd, cwd=cwd, env=full, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return subprocess.CompletedProcess(args, None, "", f"HANG: no answer within {timeout} s")
@@ -923,3 +925,467 @@ def test_solve_without_an_approach_is_refused_at_once(lam):
         pa.solve(lam)
     assert time.perf_counter() - t0 < 1.0
     assert str(info.value).startswith("-adh_lambda"), info.value
+
+
+# =========================================================================================================
+# 9. the newer probe's classes: true refusals, damaged files, the process's limits, MPI's surroundings,
+#    environment text, measured curves, every file the program writes drawn, ./run's variables
+# =========================================================================================================
+def _sizes(msg: str) -> tuple:
+    """The two sizes of a 'has X, more than the Y read whole' line, in bytes."""
+    units = {"bytes": 1, "KiB": 1 << 10, "MiB": 1 << 20, "GiB": 1 << 30, "TiB": 1 << 40}
+    m = re.search(r"has ([\d.]+) (\w+), more than the ([\d.]+) (\w+)", msg)
+    assert m, msg
+    return float(m.group(1)) * units[m.group(2)], float(m.group(3)) * units[m.group(4)]
+
+
+@pytest.mark.parametrize("size, limit", [(1500, 1000), (1001, 1000), (5 << 20, 1 << 20), ((1 << 20) + 3, 1 << 20),
+                                         (3 << 30, 2 << 30)])
+def test_a_size_refusal_says_true_sizes(tmp_path, size, limit):
+    """Guarantee 9: a file over the size read whole is said with its size and the limit each in a unit that
+    shows them (never '0.0 GiB' against '0 GiB'): the size said is over the limit said, both within 0.5% of
+    the truth.  (A sparse file: no disk is used.)"""
+    from petsc_adhesion.io.inputs import file_problem
+
+    path = tmp_path / "big"
+    with open(path, "wb") as f:
+        f.truncate(size)
+    said_size, said_limit = _sizes(file_problem(str(path), limit))
+    assert said_size > said_limit > 0
+    assert abs(said_size - size) <= 0.005 * size and abs(said_limit - limit) <= 0.005 * limit
+
+
+def test_an_options_file_of_one_long_comment(tmp_path):
+    """Guarantee 9 on the command line: an options file of one comment line just over the 16 MiB read whole
+    (the probe's case: it was said as 'has 0.0 GiB, more than the 0 GiB'): exit 2, one line with its true size
+    against the true limit, nothing written."""
+    from petsc_adhesion.app.optionsfile import MAX_OPTIONS_BYTES
+
+    (tmp_path / "long.opts").write_text("#" + "x" * MAX_OPTIONS_BYTES + "\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    msg = one_line(cli(*SOLVE, "-options_file", "long.opts", "-summary", out / "s.json", cwd=tmp_path))
+    assert msg.startswith("-options_file: 'long.opts' has "), msg
+    said_size, said_limit = _sizes(msg)
+    assert said_size == MAX_OPTIONS_BYTES + 2 and said_limit == MAX_OPTIONS_BYTES, msg
+    assert listing(out) == []
+
+
+#: 64 bytes overwritten at this many evenly spread places of a result file, one place a file
+DAMAGE_PLACES = 40
+
+
+def _damaged_copies(src, folder, places=DAMAGE_PLACES) -> list:
+    data = open(src, "rb").read()
+    out = []
+    for k in range(places):
+        at = int(len(data) * (k + 0.5) / places)
+        bad = bytearray(data)
+        bad[at:at + 64] = bytes([0xA5]) * min(64, len(data) - at)
+        path = os.path.join(folder, f"bad{k:02d}.h5")
+        with open(path, "wb") as f:
+            f.write(bad)
+        out.append(path)
+    return out
+
+
+@pytest.fixture(scope="module")
+def result_files(tmp_path_factory):
+    """A curve's and a solve's -out files (cheap: N = 101)."""
+    folder = tmp_path_factory.mktemp("results")
+    runs = pool({"curve": functools.partial(cli, *CURVE, "-out", "c.h5", cwd=folder),
+                 "solve": functools.partial(cli, *SOLVE, "-out", "s.h5", cwd=folder)})
+    assert all(p.returncode == 0 for p in runs.values()), {k: p.stderr for k, p in runs.items()}
+    return {"curve": str(folder / "c.h5"), "solve": str(folder / "s.h5")}
+
+
+@pytest.mark.parametrize("kind", ["curve", "solve"])
+def test_plot_of_a_file_damaged_anywhere(result_files, tmp_path, capfd, kind):
+    """Guarantee 9: ``plot`` of a result file with 64 bytes overwritten at each of 40 places (its header, its
+    trees, its data): exit 2 and one line naming the file (the probe's case ended in h5py's 27-line traceback,
+    a RuntimeError of an attribute message), or the figure when the damage fell where plot does not read; never
+    an exception, never a partial figure."""
+    from petsc_adhesion.io.plot.command import command
+
+    refused = 0
+    for path in _damaged_copies(result_files[kind], str(tmp_path)):
+        png = path[:-3] + ".png"
+        status = command([path, "-o", png])
+        err = capfd.readouterr().err
+        assert status in (0, 2), (path, status, err)
+        if status == 2:
+            refused += 1
+            lines = err.splitlines()
+            assert len(lines) == 1 and lines[0].startswith(f"{PREFIX}plot: '{path}' "), err
+            assert re.search(r"is not an HDF5 file|damaged or incomplete|is not a petsc-adhesion result|"
+                             r"not a whole", lines[0]), lines[0]
+            assert not os.path.exists(png)
+        else:
+            assert err == "" and open(png, "rb").read(4) == b"\x89PNG"
+    assert refused >= 5, f"only {refused} of {DAMAGE_PLACES} damaged files refused"
+
+
+def test_plot_of_a_damaged_file_on_the_command_line(result_files, tmp_path):
+    """Guarantee 9, the probe's case on the command line: each damaged copy plot refuses is one line, exit 2,
+    nothing written (the first three such copies are run as the user runs them)."""
+    from petsc_adhesion.io.plot.command import command
+
+    bad = []
+    for path in _damaged_copies(result_files["curve"], str(tmp_path)):
+        if command([path, "-o", path[:-3] + ".png"]) == 2:
+            bad.append(path)
+    out = tmp_path / "out"
+    out.mkdir()
+    for path in bad[:3]:
+        msg = one_line(cli("plot", path, "-o", out / "x.png", cwd=tmp_path))
+        assert msg.startswith(f"plot: '{path}' "), msg
+    assert listing(out) == []
+
+
+def test_plot_of_a_file_the_machine_cannot_read(result_files, tmp_path, monkeypatch, capsys):
+    """Guarantee 9: an I/O error of the device while the file is read (EIO) is the machine's failure, not bad
+    input: exit 1, one line saying it cannot be read."""
+    from petsc_adhesion.io.plot import command as cmd
+
+    def eio(*a, **kw):
+        raise OSError(errno.EIO, "Input/output error")
+
+    monkeypatch.setattr(cmd.h5py, "File", eio)
+    assert cmd.command([result_files["curve"], "-o", str(tmp_path / "x.png")]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"{PREFIX}cannot read '{result_files['curve']}': Input/output error"], err
+    assert listing(tmp_path) == []
+
+
+def test_guess_damaged_anywhere(result_files, tmp_path):
+    """Guarantee 9: -adh_guess given a solve's file damaged at each of 40 places: read (when the damage fell
+    outside r and H) or InputError naming -adh_guess, never another exception."""
+    from petsc_adhesion.errors import InputError
+    from petsc_adhesion.io.guess import read_guess
+
+    refused = 0
+    for path in _damaged_copies(result_files["solve"], str(tmp_path)):
+        try:
+            read_guess(path, 0.0)
+        except InputError as e:
+            refused += 1
+            assert str(e).startswith("-adh_guess: ") and "\n" not in str(e), e
+    assert refused >= 5, refused
+
+
+def _limited_run(args, cwd, address_space):
+    """The command line under an address-space limit (as ``ulimit -v`` sets it)."""
+    import resource
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (address_space, address_space))
+
+    return subprocess.run([sys.executable, "-m", "petsc_adhesion", *map(str, args)], cwd=cwd, env=conftest._env(),
+                          capture_output=True, text=True, timeout=HANG, preexec_fn=limit)
+
+
+@pytest.mark.parametrize("what", ["curve", "solve", "spring", "soft"])
+def test_a_grid_over_the_address_space_limit(tmp_path, what):
+    """Guarantee 9: a grid whose matrices fit the machine but not the process's address-space limit (3 GiB:
+    N = 20000 needs 15 GiB for a curve, N = 8000 4.8 GiB for a solve; a spring's curve and a soft sphere's
+    (mu = 300) likewise) is refused before anything is made: exit 2, one line naming the grid option and the
+    limit (it ended in 'internal error: MemoryError' or a PETSc error), nothing written."""
+    args = {"curve": ("-adh_mu", "1", "-grid_type", "uniform", "-grid_n", "20000"),
+            "solve": ("-adh_mu", "1", "-adh_lambda", "-2", "-grid_type", "uniform", "-grid_n", "12000"),
+            "spring": ("-adh_mu", "2", "-afm_spring", "0.5", "-grid_type", "uniform", "-grid_n", "20000"),
+            "soft": ("-adh_mu", "300", "-grid_type", "uniform", "-grid_n", "20000")}[what]
+    proc = _limited_run((*args, "-summary", "s.json", "-out", "s.h5"), tmp_path, 3 << 30)
+    msg = one_line(proc)
+    assert msg.startswith("-grid_n: N = "), msg
+    assert "the address-space limit (ulimit -v, RLIMIT_AS) of 3 GiB leaves " in msg, msg
+    assert listing(tmp_path) == []
+
+
+def test_memory_limits_name_the_one_that_binds(tmp_path):
+    """Guarantee 9, in-process: the control group's limit (v2's memory.max less memory.current) is read from its
+    files, 'max' is no limit, and the refusal names the smallest of the limits given, with what it leaves."""
+    from petsc_adhesion.app.options.checks import check_memory, memory_limits
+    from petsc_adhesion.errors import InputError
+    from petsc_adhesion.tracing.trace import GridChoice
+
+    limit, used = tmp_path / "memory.max", tmp_path / "memory.current"
+    limit.write_text(f"{4 << 30}\n")
+    used.write_text(f"{1 << 30}\n")
+    found = [x for x in memory_limits(((str(limit), str(used)),)) if "control group" in x[2]]
+    assert found == [(float(3 << 30), float(4 << 30), f"the control group's memory limit ({limit})", False)]
+    limit.write_text("max\n")
+    assert not [x for x in memory_limits(((str(limit), str(used)),)) if "control group" in x[2]]
+
+    grid = GridChoice(kind="uniform", n=20000)
+    limits = [(64e9, None, "this machine has", False), (2.0 * (1 << 30), float(4 << 30), "the control group's "
+              "memory limit (/sys/fs/cgroup/memory.max)", False)]
+    with pytest.raises(InputError) as info:
+        check_memory(grid, "dense", True, 1, limits)
+    assert str(info.value).startswith("-grid_n: N = 20000 nodes need 15.2 GiB a rank") and \
+        "the control group's memory limit (/sys/fs/cgroup/memory.max) of 4 GiB leaves 2 GiB" in str(info.value)
+    check_memory(GridChoice(kind="uniform", n=101), "dense", True, 1, limits)      # fits: no refusal
+
+
+@pytest.mark.parametrize("np_", [pytest.param(1), pytest.param(2, marks=needs_mpiexec)])
+def test_shared_memory_folder_unusable(tmp_path, np_):
+    """Guarantee 9: on two ranks, a shared-memory folder the ranks cannot make their segments in (Open MPI's
+    backing directory a file, as an unwritable /dev/shm is) is refused before MPI starts: exit 2, one line
+    naming it with the remedy (it was Open MPI's page of warnings); one process makes no segment and runs."""
+    (tmp_path / "shm").write_text("a file, not a folder")
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = cli(*SOLVE, "-summary", out / "s.json", np=np_, cwd=tmp_path,
+               env={"OMPI_MCA_btl_vader_backing_directory": str(tmp_path / "shm")})
+    if np_ == 1:
+        assert proc.returncode == 0 and listing(out) == ["s.json"], proc.stderr
+        return
+    msg = ours_of_two_ranks(proc)
+    assert msg.startswith(f"OMPI_MCA_btl_vader_backing_directory: '{tmp_path / 'shm'}' is not a writable "
+                          f"directory"), msg
+    assert listing(out) == []
+
+
+def test_dev_shm_unusable_in_process(tmp_path, monkeypatch):
+    """Guarantee 9, in-process: /dev/shm itself not a writable folder, on a rank of two: the line names it and
+    says how to mend it; on one rank nothing is said."""
+    from petsc_adhesion.app import cli as app_cli
+
+    monkeypatch.setattr(app_cli, "SHARED_MEMORY_DEFAULT", str(tmp_path / "missing-shm"))
+    for v in app_cli.SHARED_MEMORY_VARIABLES:
+        monkeypatch.delenv(v, raising=False)
+    monkeypatch.delenv("TMPDIR", raising=False)
+    monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")
+    msg = app_cli.environment()
+    assert msg == (f"'{tmp_path / 'missing-shm'}' is not a writable directory (the ranks share memory through "
+                   f"files there): mount it writable (a tmpfs), or set OMPI_MCA_btl_vader_backing_directory to a "
+                   f"writable folder such as /tmp"), msg
+    monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "1")
+    assert app_cli.environment() is None
+
+
+@pytest.mark.parametrize("name, np_", [("PETSC_OPTIONS", 1), ("PETSC_OPTIONS_YAML", 1),
+                                       pytest.param("PETSC_OPTIONS", 2, marks=needs_mpiexec)])
+def test_environment_that_is_not_utf8(tmp_path, name, np_):
+    """Guarantee 9: PETSC_OPTIONS (or PETSC_OPTIONS_YAML) holding a byte that is not UTF-8 (0xff): exit 2, one
+    line naming the variable (it was 'internal error: UnicodeDecodeError', exit 1), nothing written; on two
+    ranks too."""
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = cli(*SOLVE, "-summary", out / "s.json", np=np_, cwd=tmp_path, env={name: "-adh_sigma \udcff"})
+    msg = one_line(proc) if np_ == 1 else ours_of_two_ranks(proc)
+    assert msg == f"{name}: '-adh_sigma \\xff' is not valid UTF-8: write it in UTF-8, or unset it", msg
+    assert listing(out) == []
+
+
+LOOPED = {"adh_guess": lambda p: (*SOLVE, "-adh_guess", p), "fit_curve": lambda p: (
+    "-fit_curve", p, "-phys_radius", "20e-9", "-phys_epsilon", "3e-10", "-phys_spring", "1"),
+    "options_file": lambda p: (*CURVE, "-options_file", p), "plot": lambda p: ("plot", p, "-o", "x.png"),
+    "cont_restart": lambda p: (*CURVE, "-cont_restart", p),
+    "adh_roughness_file": lambda p: (*CURVE, "-adh_roughness", "measured", "-adh_roughness_file", p)}
+
+
+@pytest.mark.parametrize("option", list(LOOPED))
+@pytest.mark.parametrize("where", ["two_links", "in_the_folder"])
+def test_input_through_a_symbolic_link_loop(tmp_path, option, where):
+    """Guarantee 9: an input behind a loop of two links (a -> b -> a), or in a folder that is a link to itself
+    (loop/x): exit 2 (the probe saw 1), one line naming the option and the loop, nothing written."""
+    os.symlink("b", tmp_path / "a")
+    os.symlink("a", tmp_path / "b")
+    os.symlink("loop", tmp_path / "loop")
+    path = "a" if where == "two_links" else "loop/x"
+    before = listing(tmp_path)
+    msg = one_line(cli(*LOOPED[option](path), cwd=tmp_path))
+    assert msg.startswith(f"{'plot' if option == 'plot' else '-' + option}: '{path}' is a symbolic link that loops"), \
+        msg
+    assert listing(tmp_path) == before
+
+
+def _curve_rows(header=True):
+    """A measured-like curve in nm and nN: a baseline, a linear contact, a pull-off of 4 nN."""
+    rng = np.random.default_rng(0)
+    z = np.linspace(0, 100, 200)
+    Fa = np.where(z > 80, (z - 80) * 0.5, 0.0)
+    Fr = np.maximum(np.where(z > 70, (z - 80) * 0.5, 0.0), -4.0 * (z > 70))
+    return np.r_[z, z[::-1]], np.r_[Fa, Fr[::-1]] + 0.01 * rng.standard_normal(400)
+
+
+def _write_curve(path, header, fmt, z, F):
+    with open(path, "w") as f:
+        f.write((header + "\n" if header else "") + "\n".join(fmt(a, b) for a, b in zip(z, F)) + "\n")
+    return str(path)
+
+
+FIT_TIP = ("-phys_radius", "20e-9", "-phys_epsilon", "3e-10", "-phys_spring", "1")
+#: text curves whose numbers no AFM measures in the units stated: (header, scale of z, of F, the line's start)
+IMPLAUSIBLE = {
+    "nm_under_metres": ("z (m), F (nN)", 1, 1, r"column 1 'z \(m\)': the piezo travels 100 m, .*likely in nm"),
+    "nN_under_newtons": ("z (nm), F (N)", 1, 1, r"column 2 'F \(N\)': the largest force is [\d.]+ N, .*likely in nN"),
+    "no_header_nm": ("", 1, 1e-9, r"column 1 \(no header: in m\): the piezo travels 100 m, .*give a header"),
+    "kilometres": ("z (km?), F (nN)", 1, 1, r"column 1 'z \(km\?\)': 'km\?' is no length unit"),
+    "near_1e300": ("z (nm), F (nN)", 1e298, 1e298, r"column 1 'z \(nm\)': the piezo travels 1e\+291 m"),
+    "beyond_floats_sum": ("", 1e306, 1e-9, r"column 1 \(no header: in m\): the piezo travels (1e\+308|more than)"),
+}
+
+
+@pytest.mark.parametrize("key", list(IMPLAUSIBLE))
+def test_a_curve_whose_units_lie(tmp_path, key):
+    """Guarantee 9: a -fit_curve text file whose numbers no AFM measures in the units its header states (nm
+    under a metres header ran past two minutes; values near 1e300 ended in 'internal error: OverflowError'):
+    exit 2 within seconds, one line naming the column and the likely unit, nothing written."""
+    header, sz, sF, says = IMPLAUSIBLE[key]
+    z, F = _curve_rows()
+    _write_curve(tmp_path / "c.csv", header, lambda a, b: f"{a * sz:.6g}, {b * sF:.6g}", z, F)
+    out = tmp_path / "out"
+    out.mkdir()
+    proc, elapsed = timed(lambda: cli("-fit_curve", "c.csv", *FIT_TIP, "-summary", out / "f.json", cwd=tmp_path))
+    msg = one_line(proc)
+    assert re.match(r"-fit_curve: 'c\.csv': " + says, msg), msg
+    assert elapsed < 30 and listing(out) == []
+
+
+@pytest.mark.parametrize("form", ["semicolons", "blanks", "tabs", "semicolons_no_header", "first_row_whole"])
+def test_a_decimal_comma_curve_is_read_as_such(tmp_path, form):
+    """Guarantee 9: a curve written with decimal commas ('1,5;2,3', '1,5 2,3', tabs; its first row whole
+    numbers) reads as the same curve written with points, to the digits written (it was split at the commas
+    into wrong columns and ended in numpy's warnings)."""
+    from petsc_adhesion.fitting.data import read_curve
+
+    z, F = _curve_rows()
+    if form == "first_row_whole":
+        z[0], F[0] = 0.0, 0.0
+    points = read_curve(_write_curve(tmp_path / "p.csv", "z (nm), F (nN)", lambda a, b: f"{a:.6g}, {b:.6g}", z, F))
+    sep = {"semicolons": ";", "blanks": " ", "tabs": "\t", "semicolons_no_header": ";", "first_row_whole": ";"}[form]
+    header = "" if form == "semicolons_no_header" else f"z (nm){sep}F (nN)".replace(" (", "(") if sep != ";" else \
+        "z (nm);F (nN)"
+    scale = 1e-9 if form == "semicolons_no_header" else 1.0
+    comma = read_curve(_write_curve(tmp_path / "c.csv", header, lambda a, b: f"{a * scale:.6g}{sep}{b * scale:.6g}"
+                                    .replace(".", ","), z, F))
+    assert comma.turn == points.turn
+    np.testing.assert_allclose(comma.z, points.z, rtol=1e-5, atol=1e-15)
+    np.testing.assert_allclose(comma.F, points.F, rtol=1e-5, atol=1e-20)
+
+
+def test_a_decimal_comma_curve_that_changes_its_mind(tmp_path):
+    """Guarantee 9: a file whose rows start with decimal commas and then use points is refused in one line
+    naming the first row that is not numbers as the first were; on the command line too."""
+    z, F = _curve_rows()
+    rows = [f"{a:.6g};{b:.6g}".replace(".", ",") for a, b in zip(z, F)]
+    rows[50] = "12.5;1.5"
+    (tmp_path / "c.csv").write_text("z (nm);F (nN)\n" + "\n".join(rows) + "\n")
+    msg = one_line(cli("-fit_curve", "c.csv", *FIT_TIP, cwd=tmp_path))
+    assert msg.startswith("-fit_curve: 'c.csv': line 52 is not numbers with decimal commas, as the first row: "
+                          "'12.5;1.5'"), msg
+
+
+def test_a_truncated_afm_file_is_one_line(tmp_path):
+    """Guarantee 9: the Asylum .ibw of tests/data cut at half and at 300 bytes: one line each, with no raw bytes
+    before it (igor2 logged the bytes it could not shape), exit 2."""
+    pytest.importorskip("afmformats")
+    data = open(os.path.join(conftest.ROOT, "tests", "data", "fmt-igor-fd_SiN_FD_plot.ibw"), "rb").read()
+    for n in (len(data) // 2, 300):
+        (tmp_path / "t.ibw").write_bytes(data[:n])
+        msg = one_line(cli("-fit_curve", "t.ibw", *FIT_TIP, cwd=tmp_path))
+        assert msg.startswith("-fit_curve: 't.ibw': not a force-distance curve afmformats reads"), msg
+
+
+@pytest.fixture(scope="module")
+def fit_file(tmp_path_factory):
+    """The -out file of a fit of the golden synthetic curve (tests/golden.py's fit case)."""
+    folder = tmp_path_factory.mktemp("fit")
+    proc = cli("-fit_curve", os.path.join(conftest.ROOT, "tests", "data", "golden", "curve.csv"),
+               "-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9", "-phys_spring", "1", "-out", "f.h5",
+               cwd=folder, timeout=900)
+    assert proc.returncode in (0, 3), proc.stderr[-1500:]
+    return str(folder / "f.h5")
+
+
+def test_plot_draws_a_fit_file(fit_file, tmp_path):
+    """Guarantee 9: ``plot`` draws every file the program writes: a fit's -out file is drawn (it was refused
+    as 'not a petsc-adhesion result'), exit 0, a PNG of the measured points and the fitted model."""
+    proc = cli("plot", fit_file, "-o", tmp_path / "f.png", cwd=tmp_path)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert (tmp_path / "f.png").read_bytes().startswith(b"\x89PNG") and (tmp_path / "f.png").stat().st_size > 10_000
+
+
+def test_plot_of_a_pull_off_fit_says_there_is_no_curve(tmp_path):
+    """Guarantee 9: a pull-off fit's file has no curve to draw: exit 2, one line saying so, nothing written."""
+    assert cli("-fit_pull_off", "12.46e-9", "-phys_radius", "20e-9", "-phys_young1", "150e9", "-phys_poisson1",
+               "0.27", "-phys_epsilon", "0.3e-9", "-out", "p.h5", cwd=tmp_path).returncode == 0
+    msg = one_line(cli("plot", "p.h5", "-o", "p.png", cwd=tmp_path))
+    assert msg == "plot: a fit of a pull-off force has no curve to draw", msg
+    assert listing(tmp_path) == ["p.h5"]
+
+
+# -- ./run's variables, in a copy of the script with a fake install: nothing is installed ------------------
+def _run_script(tmp_path, *args, env=None, installed=False):
+    """bash run ARGS in a copy of ./run beside pyproject.toml; ``installed``: a fake .venv whose stamp is
+    current (its python a script that succeeds), so that setup finds the install in place."""
+    for name in ("run", "pyproject.toml"):
+        shutil.copy(os.path.join(conftest.ROOT, name), tmp_path / name)
+    if installed:
+        import hashlib
+
+        venv = tmp_path / ".venv"
+        (venv / "bin").mkdir(parents=True, exist_ok=True)
+        (venv / "bin" / "python").write_text("#!/bin/sh\nexit 0\n")
+        (venv / "bin" / "python").chmod(0o755)
+        (venv / ".mpi").write_text("system Debian's Open MPI (mpiexec)\n")
+        stamp = hashlib.sha1((tmp_path / "pyproject.toml").read_bytes() + (tmp_path / "run").read_bytes())
+        (venv / ".installed").write_text(stamp.hexdigest() + "\n")
+    full = {k: v for k, v in os.environ.items() if not k.startswith("RUN_") and k not in ("NP",)}
+    full.update(HOME=str(tmp_path), **(env or {}))
+    return subprocess.run(["bash", str(tmp_path / "run"), *args], cwd=tmp_path, env=full, capture_output=True,
+                          text=True, timeout=60)
+
+
+RUN_BAD = {"RUN_NO_APT": ["yes", "0", "true"], "RUN_MPI": ["openmpi", "System"], "RUN_BLAS": ["mkl"],
+           "NP": ["0", "two", "-1", "1.5"], "RUN_PYTHON": ["/nonexistent/python3"], "RUN_CHECK_USER": ["Root User"]}
+RUN_GOOD = {"RUN_NO_APT": ["1", ""], "RUN_MPI": ["system", "wheel", ""], "RUN_BLAS": ["system", "wheel"],
+            "NP": ["1", "2"], "RUN_PYTHON": [sys.executable], "RUN_CHECK_USER": ["runcheck"]}
+
+
+@pytest.mark.parametrize("name, value", [(n, v) for n, vs in RUN_BAD.items() for v in vs])
+def test_run_refuses_a_variable_out_of_its_values(tmp_path, name, value):
+    """Guarantee 9: a ./run variable given a value it does not document (RUN_NO_APT=yes was ignored): exit 2,
+    one line naming it and what it takes, before anything is done (no .venv made)."""
+    proc = _run_script(tmp_path, "check-variables", env={name: value})
+    assert proc.returncode == 2, (proc.returncode, proc.stderr)
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"run: {name}='{value}' "), proc.stderr
+    assert not (tmp_path / ".venv").exists()
+
+
+@pytest.mark.parametrize("name, value", [(n, v) for n, vs in RUN_GOOD.items() for v in vs])
+def test_run_takes_a_documented_value(tmp_path, name, value):
+    """Guarantee 9: each documented value of each variable is taken (./run check-variables: exit 0, silent)."""
+    proc = _run_script(tmp_path, "check-variables", env={name: value})
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+
+
+@pytest.mark.parametrize("given", [{"RUN_NO_APT": "1"}, {"RUN_BLAS": "system"},
+                                   {"RUN_BLAS": "wheel", "RUN_NO_APT": "1"}])
+def test_run_says_an_install_variable_waits_for_the_next_install(tmp_path, given):
+    """Guarantee 9: a variable that chooses how to install, given where the install exists (it was ignored
+    without a word): ./run setup says in one line that it applies to the next install and how to make one now,
+    and leaves the install as it was (exit 0)."""
+    proc = _run_script(tmp_path, "setup", env=given, installed=True)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1, proc.stderr
+    shown = ", ".join(f"{k}={given[k]}" for k in ("RUN_BLAS", "RUN_NO_APT") if k in given)
+    assert lines[0].startswith(f"run: {shown}: appl") and "to the next install" in lines[0] and \
+        f"rm {tmp_path}/.venv/.installed, then ./run setup" in lines[0], lines[0]
+    assert _run_script(tmp_path, "setup", installed=True).stderr == ""        # nothing given: nothing said
+
+
+@pytest.mark.parametrize("what", ["TMPDIR", "shm"])
+def test_run_checks_mpis_surroundings_before_mpiexec(tmp_path, what):
+    """Guarantee 9: NP=2 ./run study with a TMPDIR or a shared-memory folder that is no writable folder: one
+    line naming it with the remedy before mpiexec starts (Open MPI's own page otherwise), exit 2."""
+    (tmp_path / "afile").write_text("x")
+    env = {"NP": "2", "TMPDIR" if what == "TMPDIR" else "OMPI_MCA_btl_vader_backing_directory": str(tmp_path / "afile")}
+    proc = _run_script(tmp_path, "study", "x.opts", env=env, installed=True)
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and "is not a writable directory" in lines[0], proc.stderr
+    assert lines[0].startswith("run: TMPDIR=" if what == "TMPDIR" else f"run: '{tmp_path / 'afile'}'"), lines[0]

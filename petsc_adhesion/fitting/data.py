@@ -147,8 +147,9 @@ _DECIMAL_COMMA = re.compile(r"[-+]?\d*,\d+(?:[eE][-+]?\d+)?|[-+]?\d+(?:[eE][-+]?
 
 def _numbers(line: str, decimal_comma: bool = False) -> list[float] | None:
     try:
-        if decimal_comma:
-            return [float(x.replace(",", ".")) for x in _SPLIT_DECIMAL_COMMA.split(line.strip()) if x]
+        if decimal_comma:               # a point in a file of decimal commas: a row written otherwise
+            return None if "." in line else \
+                [float(x.replace(",", ".")) for x in _SPLIT_DECIMAL_COMMA.split(line.strip()) if x]
         return [float(x) for x in _SPLIT.split(line.strip()) if x]
     except ValueError:
         return None

@@ -18,7 +18,9 @@ def read_guess(path: str, wall: float) -> tuple[np.ndarray, np.ndarray]:
         import h5py
         with h5py.File(path, "r") as f:
             r0, h0 = f["grid/r"][()], f["solution/H"][()]
-    except (OSError, KeyError, TypeError) as e:
+    except (OSError, KeyError, TypeError, ValueError, IndexError, AttributeError, RuntimeError) as e:
+        # a file damaged inside: h5py raises any of these (RuntimeError from a heap or an attribute message
+        # that runs off its buffer)
         raise InputError(f"-adh_guess: cannot read grid/r and solution/H from '{shown}' "
                          f"({printable(first_line(e))}); give the -out file of a fixed-approach solve") from None
     if not (np.issubdtype(r0.dtype, np.floating) and np.issubdtype(h0.dtype, np.floating)
