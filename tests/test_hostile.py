@@ -1389,3 +1389,32 @@ def test_run_checks_mpis_surroundings_before_mpiexec(tmp_path, what):
     lines = proc.stderr.splitlines()
     assert len(lines) == 1 and "is not a writable directory" in lines[0], proc.stderr
     assert lines[0].startswith("run: TMPDIR=" if what == "TMPDIR" else f"run: '{tmp_path / 'afile'}'"), lines[0]
+
+
+#: numbers that under- or overflow in the cantilever's, the fit's and the soft sphere's options (the newer
+#: probe: -afm_spring 1e-300 traced to lambda = -1.7e100, -phys_spring 1e-300 ended in numpy's overflow
+#: warnings): (arguments, the option named)
+NEW_NUMBERS = {
+    "spring_underflows": ((*CURVE, "-afm_spring", "1e-300"), "-afm_spring"),
+    "spring_of_a_soft_sphere_underflows": (("-adh_mu", "300", "-afm_spring", "1e-300"), "-afm_spring"),
+    "lever_underflows": (("-fit_curve", "c.csv", *FIT_TIP[:4], "-phys_spring", "1e-300"), "-phys_spring"),
+    "lever_overflows": (("-fit_curve", "c.csv", *FIT_TIP[:4], "-phys_spring", "1e300"), "-phys_spring"),
+    "pull_off_subnormal": (("-fit_pull_off", "5e-324", "-phys_radius", "20e-9", "-phys_young1", "150e9",
+                            "-phys_poisson1", "0.27", "-phys_epsilon", "0.3e-9"), "-fit_pull_off"),
+    "soft_sphere_sigma_huge": (("-adh_mu", "300", "-adh_sigma", "1e300"), "-adh_sigma"),
+}
+
+
+@pytest.mark.parametrize("key", list(NEW_NUMBERS))
+def test_new_options_numbers_that_under_or_overflow(tmp_path, key):
+    """Guarantee 4 for the cantilever, the fit and the soft sphere: exit 2, one line naming the option and
+    the range it takes (a subnormal pull-off: the mu it would need), nothing written."""
+    args, option = NEW_NUMBERS[key]
+    z, F = _curve_rows()
+    _write_curve(tmp_path / "c.csv", "z (nm), F (nN)", lambda a, b: f"{a:.6g}, {b:.6g}", z, F)
+    out = tmp_path / "out"
+    out.mkdir()
+    msg = one_line(cli(*args, "-summary", out / "s.json", cwd=tmp_path))
+    assert msg.startswith(f"{option}: expected a finite real in " if key != "pull_off_subnormal" else
+                          f"{option}: P = 4.941e-324 N needs mu below 1e-12"), msg
+    assert listing(out) == []

@@ -131,9 +131,10 @@ def _mapped_bytes() -> float:
 
 def memory_limits(cgroups=CGROUP_MEMORY) -> list:
     """Each limit on the memory this process may still take, as (bytes left, bytes of the limit or None, its
-    name, whether what the process holds now is counted in it already): the machine's available memory (MemAvailable), the address-space limit (RLIMIT_AS, as ``ulimit
-    -v`` sets it) less what the process maps already, and the control group's limit less what the group uses.
-    A limit that is not set (unlimited, 'max', a v1 group's near 2^63) is left out."""
+    name, whether what the process holds now is counted in it already): the machine's available memory
+    (MemAvailable), the address-space limit (RLIMIT_AS, as ``ulimit -v`` sets it) less what the process maps
+    already, and the control group's limit less what the group uses.  A limit that is not set (unlimited,
+    'max', a v1 group's near 2^63) is left out."""
     out = []
     machine = _mem_available()
     if machine is not None:
@@ -178,7 +179,8 @@ def check_memory(grid_choice, pmat: str, curve: bool, ranks: int, limits=None) -
     if not limits:
         limits = [(memory_available(), None, "this machine has", False)]
     # the shortfall under each limit: what the run still needs against what the limit leaves
-    short = [(need - (BASE_BYTES if counted else 0.0) - have, have, limit, name) for have, limit, name, counted in limits]
+    short = [(need - (BASE_BYTES if counted else 0.0) - have, have, limit, name)
+             for have, limit, name, counted in limits]
     over, have, limit, name = max(short, key=lambda x: x[0])
     if over > 0:
         option = "-grid_n" if grid_choice.kind == "uniform" else "-grid_paper_extra"

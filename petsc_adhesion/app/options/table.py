@@ -169,13 +169,14 @@ TABLE = {o.name: o for o in [
            "on its grid's coarser (or finer) nested levels, Richardson-extrapolated"),
     Option("target_error", "real", None, "refine each event's levels until its error bars (lambda and F) are "
            "below this", 0.0, 1.0, lo_open=True),
-    # the measuring machine (an AFM cantilever)
+    # the measuring machine (an AFM cantilever).  K below 1e-12 puts the base F / K beyond 1e12 for a unit force
+    # (-afm_spring 1e-300 traced to lambda = -1.7e100 and ended early); no AFM lever is softer than about
+    # 1e-3 N/m, so -phys_spring takes three decades below that (1e-300 N/m ended in numpy's overflow warnings)
     Option("afm_spring", "real", None, "drive the approach through a spring of this stiffness K (units 2 pi R "
            "gamma / epsilon; an AFM cantilever): its base Z = lambda + F / K jumps in and off where dZ/ds = 0, "
-           "reported with their landings and the energy of a cycle (default: a rigid machine only)", 0.0, 1e12,
-           lo_open=True),
+           "reported with their landings and the energy of a cycle (default: a rigid machine only)", 1e-12, 1e12),
     Option("phys_spring", "real", None, "spring constant k of the cantilever (N/m), with the other -phys_ "
-           "options: K = k epsilon / (2 pi R gamma), as -afm_spring", 0.0, 1e9, lo_open=True),
+           "options: K = k epsilon / (2 pi R gamma), as -afm_spring", 1e-6, 1e9),
     # studies: a sweep over cases (petsc_adhesion.app.study)
     Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 1000.0),
     Option("study_sigma", "sweep", (), "study: the roughness sigma of its cases", 0.0, 5.0),
