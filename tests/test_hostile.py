@@ -1418,3 +1418,52 @@ def test_new_options_numbers_that_under_or_overflow(tmp_path, key):
     assert msg.startswith(f"{option}: expected a finite real in " if key != "pull_off_subnormal" else
                           f"{option}: P = 4.941e-324 N needs mu below 1e-12"), msg
     assert listing(out) == []
+
+
+PULL_OFF_FIT = ("-fit_pull_off", "1e-8", "-phys_radius", "20e-9", "-phys_young1", "150e9", "-phys_poisson1", "0.27",
+                "-phys_epsilon", "0.3e-9")
+#: the older classes (outputs judged before any work, options without effect, resources) for the cantilever,
+#: CSV, energy, fit and soft-sphere options: (arguments given the folder, how the line starts)
+NEW_OPTIONS = {
+    "csv_a_fifo": (lambda f: (*CURVE, "-afm_spring", "0.5", "-csv", _special("fifo", f"{f}/ff")), "-csv: "),
+    "csv_events_a_directory": (lambda f: (*CURVE, "-afm_spring", "0.5", "-csv_events", _special("directory", f"{f}/d")),
+                               "-csv_events: "),
+    "csv_a_device": (lambda f: (*CURVE, "-csv", "/dev/null"), "-csv: '/dev/null' is a character device"),
+    "csv_events_a_dangling_link": (lambda f: (*CURVE, "-csv_events", _special("link_dangling", f"{f}/l")),
+                                   "-csv_events: "),
+    "csv_and_events_one_file": (lambda f: (*CURVE, "-csv", "c.csv", "-csv_events", "c.csv"),
+                                "-csv_events: 'c.csv' is also the file of -csv"),
+    "spring_in_a_solve": (lambda f: (*SOLVE, "-afm_spring", "0.5"), "-afm_spring: applies to a curve"),
+    "csv_in_a_solve": (lambda f: (*SOLVE, "-csv", "x.csv"), "-csv: applies to a curve"),
+    "csv_events_in_a_fit": (lambda f: (*PULL_OFF_FIT, "-csv_events", "e.csv"), "-csv_events: not with -fit_pull_off"),
+    "spring_in_a_fit": (lambda f: (*PULL_OFF_FIT, "-afm_spring", "1"), "-afm_spring: not with -fit_pull_off"),
+    "soft_sphere_grid_too_large": (lambda f: ("-adh_mu", "300", "-grid_type", "uniform", "-grid_n", "200000"),
+                                   "-grid_n: N = 200000 nodes need 1.46 TiB"),
+    "spring_grid_too_large": (lambda f: ("-adh_mu", "1", "-afm_spring", "0.5", "-grid_type", "uniform", "-grid_n",
+                                         "200000"), "-grid_n: N = 200000 nodes need 1.46 TiB"),
+}
+
+
+@pytest.mark.parametrize("key", list(NEW_OPTIONS))
+def test_the_older_classes_for_the_newer_options(tmp_path, key):
+    """Guarantees 1, 3 and 7 for the cantilever, CSV, energy (a spring run's), fit and soft-sphere options: an
+    output that is no regular file, two outputs on one file, an option the run would ignore, a grid too large:
+    exit 2, one line naming the option, nothing written (the folder as it was)."""
+    args = NEW_OPTIONS[key][0](str(tmp_path))
+    before = snapshot(tmp_path)
+    msg = one_line(cli(*args, cwd=tmp_path))
+    assert msg.startswith(NEW_OPTIONS[key][1]), msg
+    assert snapshot(tmp_path) == before
+
+
+def test_a_failed_spring_run_leaves_the_earlier_csv_files(tmp_path):
+    """Guarantee 2 for -csv and -csv_events (a spring run's points and events, its jumps and energy): a later
+    run over the same names that fails (no solution at the start) leaves them byte for byte."""
+    names = ("-out", "c.h5", "-csv", "c.csv", "-csv_events", "e.csv", "-summary", "c.json")
+    first = cli(*CURVE, "-afm_spring", "0.5", *names, cwd=tmp_path)
+    assert first.returncode in (0, 3), first.stderr
+    earlier = snapshot(tmp_path)
+    assert sorted(earlier) == ["c.csv", "c.h5", "c.json", "e.csv"]
+    msg = one_line(cli(*CURVE, "-afm_spring", "0.5", "-nat_snes_max_it", "1", *names, cwd=tmp_path), 1)
+    assert msg.startswith("no solution at the start"), msg
+    assert snapshot(tmp_path) == earlier
