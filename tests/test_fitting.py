@@ -42,8 +42,9 @@ def test_text_with_units_in_its_header_is_read_in_si(tmp_path):
 
 def test_text_without_header_is_si_and_either_direction(tmp_path):
     z, F = _vee()
-    d = read_curve(_write(tmp_path / "c.txt", "\n".join(f"{-a:g}\t{b:g}" for a, b in zip(z, F))))
-    assert d.direction == -1 and d.turn == 30 and np.allclose(d.z, -z)
+    # in SI as an AFM measures (nm and nN): numbers no AFM gives in SI are refused (test_hostile.py)
+    d = read_curve(_write(tmp_path / "c.txt", "\n".join(f"{-a * 1e-9:g}\t{b * 1e-9:g}" for a, b in zip(z, F))))
+    assert d.direction == -1 and d.turn == 30 and np.allclose(d.z, -z * 1e-9, rtol=1e-5, atol=0)   # 6 digits written
 
 
 @pytest.mark.parametrize("text, says", [

@@ -258,9 +258,11 @@ def _read_text(path: str) -> MeasuredCurve:
     if not rows:
         raise CurveFileError(f"{_name(path)}: no rows of numbers")
     data = np.array(rows, dtype=float)
-    if np.all(np.isfinite(data)):            # what is not finite is said by _curve
-        _plausible(data, (scale_z, scale_F), header, path)
-    return _curve(data[:, 0] * scale_z, data[:, 1] * scale_F, path, "text", None, None, {})
+    with np.errstate(over="ignore"):         # a product beyond floats is said by _plausible
+        curve = _curve(data[:, 0] * scale_z, data[:, 1] * scale_F, path, "text", None, None, {})
+    # what is no curve in any unit (too few points, no turn, a constant force) is said first, by _curve
+    _plausible(data, (scale_z, scale_F), header, path)
+    return curve
 
 
 # -- afmformats ------------------------------------------------------------------
