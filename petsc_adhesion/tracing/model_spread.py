@@ -99,12 +99,11 @@ def parse_rules(text: str) -> tuple:
     for item in text.split(","):
         law, _, p = item.strip().partition(":")
         if law not in LAWS:
-            raise ValueError(f"'{item.strip()}': expected law:parameter with law one of {', '.join(LAWS)}")
+            raise ValueError(f"'{item.strip()}': expected law:parameter, the law one of {', '.join(LAWS)}")
         try:
-            value = float(p)
+            rules.append(Rule(law, float(p)))
         except ValueError:
             raise ValueError(f"'{item.strip()}': {law} takes {LAWS[law][3]}") from None
-        rules.append(Rule(law, value))
     if len(set(rules)) != len(rules):
         raise ValueError(f"'{text}': a rule named twice")
     return tuple(rules)
