@@ -283,11 +283,12 @@ def _quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, 
     warning = None
     if spread > limit:
         far_value = next(v for v, r in zip(values, rules) if r == far).value
-        bar = "no bar" if ref.err is None else f"bar {ref.err:.2g}"
-        rel = "" if math.isinf(relative) else f", {100 * relative:.0f}% of the value"
-        warning = (f"the {name} is {ref.value:.6g} ({bar}) under {reference.label} and {far_value:.6g} under "
-                   f"{far.label}: the roughness law moves it by {spread:.3g}{rel}, more than the numerics; "
-                   + _advice(reference))
+        size = [] if math.isinf(relative) else [f"{100 * relative:.0f}% of the value"]
+        if ref.err:
+            size.append(f"{spread / ref.err:.2g} times its error bar")
+        warning = (f"the {name} is {ref.value:.6g} under {reference.label} and {far_value:.6g} under "
+                   f"{far.label}: the roughness law moves it by {spread:.3g}"
+                   + (f" ({', '.join(size)})" if size else "") + "; " + _advice(reference))
     return Quantity(name, unit, ref, values, spread, relative, warning)
 
 
