@@ -44,14 +44,15 @@ def cost(mu: float, sigma: float) -> dict:
     """The curve's time (with error bars) and its spread's (four laws, events only), and the pull-off's
     largest relative spread."""
     model = Model(mu=mu, sigma=sigma)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     curve = trace_curve(model)
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     spread = model_spread(curve, model)
-    t2 = time.perf_counter()
+    t2, c2 = time.perf_counter(), time.process_time()
     q = spread.quantity("pull-off F")
-    return {"mu": mu, "sigma": sigma, "curve_s": t1 - t0, "spread_s": t2 - t1, "relative": q.relative,
-            "warns": bool(spread.warnings), "notes": len(spread.notes)}
+    return {"mu": mu, "sigma": sigma, "curve_s": t1 - t0, "spread_s": t2 - t1, "curve_cpu_s": c1 - c0,
+            "spread_cpu_s": c2 - c1, "relative": q.relative, "warns": bool(spread.warnings),
+            "notes": len(spread.notes), "rules": {r.label: t for r, t in zip(spread.rules, spread.rule_times_s)}}
 
 
 def probe() -> tuple:
@@ -82,11 +83,14 @@ def markdown(rows: list, probed: tuple) -> str:
             + ("; the warning fires." if q.warning else "."), "",
             "**The cost** of the spread (four curves, events only) against the curve's own (with its error bars), "
             "the Hermite rule of 16 points, grids that follow the edge:", "",
-            "| mu | sigma | curve (s) | spread (s) | spread / curve | pull-off: relative spread | warns |",
-            "|---|---|---|---|---|---|---|"]
+            "| mu | sigma | curve: wall, CPU (s) | spread: wall, CPU (s) | spread / curve (CPU) | "
+            "each law's share of the spread | pull-off: relative spread | warns |",
+            "|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        out.append(f"| {r['mu']:g} | {r['sigma']:.3g} | {r['curve_s']:.2f} | {r['spread_s']:.2f} | "
-                   f"{r['spread_s'] / r['curve_s']:.2f} | {r['relative']:.3g} | {'yes' if r['warns'] else 'no'} |")
+        share = ", ".join(f"{k} {100 * t / r['spread_s']:.0f}%" for k, t in r["rules"].items())
+        out.append(f"| {r['mu']:g} | {r['sigma']:.3g} | {r['curve_s']:.1f}, {r['curve_cpu_s']:.1f} | "
+                   f"{r['spread_s']:.1f}, {r['spread_cpu_s']:.1f} | {r['spread_cpu_s'] / r['curve_cpu_s']:.2f} | "
+                   f"{share} | {r['relative']:.3g} | {'yes' if r['warns'] else 'no'} |")
     return "\n".join(out) + "\n"
 
 

@@ -192,8 +192,8 @@ class ModelSpread:
     ``reference``: the rule the curve was traced with; ``rules``: the others, in the order of every
     :attr:`Quantity.values`; ``quantities``: one per event quantity of the reference; ``notes``: where a law
     has another set of events (that is its spread), or its curve failed or ended early; ``wall_time_s``:
-    the time of all the laws' curves; ``force_nN``, ``approach_nm``: the units of F and lambda in nN and nm
-    with physical inputs (None without).
+    the time of all the laws' curves, ``rule_times_s`` of each; ``force_nN``, ``approach_nm``: the units of
+    F and lambda in nN and nm with physical inputs (None without).
     """
 
     reference: Rule
@@ -201,6 +201,7 @@ class ModelSpread:
     quantities: tuple
     notes: tuple
     wall_time_s: float
+    rule_times_s: tuple = ()
     force_nN: float | None = None
     approach_nm: float | None = None
 
@@ -312,9 +313,10 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
     models = [r.model(model) for r in rules]
     quick = replace(request, error_bars=False, profiles=False, target_error=None)
     ref = curve_values(curve)
-    alts, notes = [], []
+    alts, notes, times = [], [], []
     t0 = time.perf_counter()
     for rule, m in zip(rules, models):
+        times.append(time.perf_counter())
         try:
             alt = curve_values(trace_curve(m, grid_choice, solver, settings, quick, comm=comm))
         except (RuntimeError, FloatingPointError) as why:
@@ -328,6 +330,7 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
             notes.append(diff)
         alts.append(alt)
     wall = time.perf_counter() - t0
+    times = tuple(b - a for a, b in zip(times, [*times[1:], t0 + wall]))
     none = CurveValues((), None, Missing("not traced"), False)
     names, own = _matched(ref, none)
     matched = [_matched(ref, none if alt is None else alt)[1] for alt in alts]
@@ -344,7 +347,7 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
         quantities.append(_quantity("energy of a cycle", "energy", ref.energy, values, rules, reference))
     bodies = model.bodies
     units = bodies.scales() if bodies is not None else None
-    return ModelSpread(reference, rules, tuple(quantities), tuple(notes), wall,
+    return ModelSpread(reference, rules, tuple(quantities), tuple(notes), wall, times,
                        None if units is None else units["force_N"] * 1e9,
                        None if units is None else units["approach_m"] * 1e9)
 
