@@ -168,12 +168,13 @@ def curve_values(curve) -> CurveValues:
 class Quantity:
     """One quantity of the reference curve across the laws.
 
-    ``name``: e.g. "pull-off F", "snap_on lambda", "snap_off #2 F", "energy"; ``unit``: "F", "lambda" or
-    "energy" (the scale it is in); ``reference``: its value and bar; ``values``: under each rule of
-    :attr:`ModelSpread.rules`, in their order, Missing where the law's curve has no such event; ``spread``:
-    the largest distance from the reference over the laws that have it (None: none has); ``relative``: that
-    over the reference's magnitude (for lambda at least 1, epsilon: its zero is a convention); ``warning``: one line where the spread exceeds both
-    :data:`WARN_BARS` bars and :data:`WARN_RELATIVE` of the value (None else).
+    ``name``: e.g. "pull-off F", "snap_on lambda", "snap_off #2 F", "energy of a cycle"; ``unit``: "F",
+    "lambda" or "energy" (the scale it is in); ``reference``: its value and bar; ``values``: under each rule
+    of :attr:`ModelSpread.rules`, in their order, Missing where the law's curve has no such event;
+    ``spread``: the largest distance from the reference over the laws that have it (None: none has);
+    ``relative``: that over the reference's magnitude (for lambda at least 1, epsilon: its zero is a
+    convention); ``warning``: one line where the spread exceeds both :data:`WARN_BARS` bars and
+    :data:`WARN_RELATIVE` of the value (None else).
     """
 
     name: str
@@ -280,13 +281,14 @@ def _quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, 
     # lambda = 0 does not make any spread large
     scale = max(abs(ref.value), 1.0) if unit == "lambda" else abs(ref.value)
     relative = spread / scale if scale else (0.0 if spread == 0 else math.inf)
-    limit = max(WARN_BARS * (ref.err or 0.0), WARN_RELATIVE * scale)
+    bar = ref.err if ref.err is not None and math.isfinite(ref.err) else 0.0    # no bar: the 10 % alone
+    limit = max(WARN_BARS * bar, WARN_RELATIVE * scale)
     warning = None
     if spread > limit:
         far_value = next(v for v, r in zip(values, rules) if r == far).value
         size = [] if math.isinf(relative) else [f"{100 * relative:.0f}% of the value"]
-        if ref.err:
-            size.append(f"{spread / ref.err:.2g} times its error bar")
+        if bar:
+            size.append(f"{spread / bar:.2g} times its error bar")
         warning = (f"the {name} is {ref.value:.6g} under {reference.label} and {far_value:.6g} under "
                    f"{far.label}: the roughness law moves it by {spread:.3g}"
                    + (f" ({', '.join(size)})" if size else "") + "; " + _advice(reference))

@@ -52,7 +52,8 @@ class Option:
                 return what
             return f"{what} in {left}{_fmt(self.lo)}, {_fmt(self.hi)}{right}"
         return {"string": "a file name", "flag": "true or false",
-                "rules": "comma-separated law:parameter from " + ", ".join(f"{k}:{v}" for k, v in self.choices)}[self.kind]
+                "rules": "comma-separated law:parameter from " + ", ".join(f"{k}:{v}" for k, v in self.choices),
+                }[self.kind]
 
 
 def _fmt(x: float) -> str:
