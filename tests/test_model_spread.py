@@ -131,13 +131,13 @@ def test_a_law_with_other_events_is_its_spread():
 def test_rules():
     assert parse_rules("hermite:32, truncated_gaussian:3,weibull:-1") == (
         Rule("hermite", 32), Rule("truncated_gaussian", 3.0), Rule("weibull", -1.0))
-    for bad in ("hermite:2.5", "hermite:1", "gauss:3", "truncated_gaussian", "weibull:1",
+    for bad in ("hermite:2.5", "hermite:1", "hermite:401", "gauss:3", "truncated_gaussian", "weibull:1",
                 "truncated_gaussian:3,truncated_gaussian:3"):
         with pytest.raises(ValueError):
             parse_rules(bad)
     tg = Model(mu=1.0, sigma=0.3, roughness="truncated_gaussian", roughness_cutoff=4.0)
     assert default_rules(tg) == (Rule("truncated_gaussian", 3.0), Rule("weibull", 0.0))
-    assert default_rules(Model(sigma=0.3, hermite_points=20))[0] == Rule("hermite", 40)
+    assert default_rules(Model(sigma=0.3, hermite_points=200))[0] == Rule("hermite", 400)
     with pytest.raises(ValueError, match="own law"):
         model_spread(None, tg, rules=(Rule("truncated_gaussian", 4.0),))
 

@@ -41,7 +41,8 @@ WARN_RELATIVE = 0.1
 #: The event kinds compared, matched by kind and order (the pull-off, the most tensile F_min, apart).
 KINDS = ("snap_on", "snap_off", "equilibrium", "jump_in", "jump_off")
 #: The laws a rule names, and the Model field its parameter sets: name -> (field, cast, (lo, hi), in words).
-LAWS = {"hermite": ("hermite_points", int, (2, 200), "points of the Gauss-Hermite rule, an integer in [2, 200]"),
+#: Hermite up to 400 points: twice the largest -adh_hermite_points, the default rule of a reference at 200.
+LAWS = {"hermite": ("hermite_points", int, (2, 400), "points of the Gauss-Hermite rule, an integer in [2, 400]"),
         "truncated_gaussian": ("roughness_cutoff", float, (1e-6, 10.0),
                                "the highest asperity K in standard deviations, in [1e-06, 10]"),
         "weibull": ("roughness_skewness", float, Weibull.SKEWNESS,
