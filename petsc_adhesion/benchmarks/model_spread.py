@@ -84,7 +84,7 @@ def markdown(rows: list, probed: tuple) -> str:
             "**The cost** of the spread (four curves, events only) against the curve's own (with its error bars), "
             "the Hermite rule of 16 points, grids that follow the edge:", "",
             "| mu | sigma | curve: wall, CPU (s) | spread: wall, CPU (s) | spread / curve (CPU) | "
-            "each law's share of the spread | pull-off: relative spread | warns |",
+            "each law's share of the spread's wall time | pull-off: relative spread | warns |",
             "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         share = ", ".join(f"{k} {100 * t / r['spread_s']:.0f}%" for k, t in r["rules"].items())
