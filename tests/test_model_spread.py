@@ -177,3 +177,20 @@ def test_the_options(argv, expected):
     finally:
         for k in given:
             db.delValue(k)
+
+
+def test_behind_a_spring_the_jumps_are_compared():
+    """An AFM cantilever (K = 1 at mu = 1, sigma = 0.1): its jumps in and off are quantities of the spread,
+    each law's the jumps its own curve behind the spring has."""
+    spring = CurveRequest(error_bars=False, spring=1.0)
+    model = Model(mu=1.0, sigma=0.1, rmax=10.0)
+    curve = trace_curve(model, COARSE, request=spring)
+    rule = Rule("truncated_gaussian", 3.0)
+    spread = model_spread(curve, model, COARSE, request=spring, rules=(rule,))
+    direct = trace_curve(rule.model(model), COARSE, request=spring)
+    for kind in ("jump_in", "jump_off"):
+        (mine,), (theirs,) = curve.events_of(kind), direct.events_of(kind)
+        q = spread.quantity(f"{kind} F")
+        assert q.reference.value == mine.F and q.values[0].value == theirs.F
+        assert q.spread == abs(theirs.F - mine.F) and q.relative < WARN_RELATIVE and not q.warning
+        assert spread.quantity(f"{kind} lambda").values[0].value == theirs.lam
