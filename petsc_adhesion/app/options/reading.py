@@ -15,11 +15,12 @@ from ...model.parameters import Model
 from ...model.parameters import tabor
 from ...model.physical import Bodies
 from ...model.roughness import Measured
+from ...tracing.model_spread import Rule, default_rules, parse_rules
 from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, step_scale
 from .table import TABLE, Option
 
 __all__ = ["AppOptions", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
-           "read_request", "read_settings", "read_spring"]
+           "read_request", "read_settings", "read_spring", "read_model_spread"]
 
 
 #: The smallest positive Tabor parameter: below it the coupling mu^(3/2) of eq. (12) and the JKR scales
@@ -157,6 +158,16 @@ class AppOptions:
         if raw.lower() in ("0", "false", "no", "off"):
             return False
         raise self._bad(o, raw)
+
+    def rules(self, name: str):
+        """The roughness laws of a list law:parameter (:func:`~.model_spread.parse_rules`), or the default."""
+        o, raw = TABLE[name], self._raw(name)
+        if raw is None:
+            return o.default
+        try:
+            return parse_rules(raw)
+        except ValueError as why:
+            raise InputError(f"-{name}: {printable(str(why))}") from None
 
     def given(self) -> dict:
         """Every option in the database as given: name -> value string (None for a bare flag).
@@ -373,3 +384,24 @@ def read_settings(opts: AppOptions, model: Model | None = None):
                           observable_step=opts.real("cont_dF_max"), observable_max=opts.real("cont_F_max"),
                           p_max=math.inf if lam_max is None else lam_max, max_steps=opts.int("cont_max_steps"),
                           pc_reuse_its=opts.int("adh_pc_reuse_its"), monitor=opts.flag("cont_monitor"))
+
+
+def read_model_spread(opts: AppOptions, model: Model) -> tuple | None:
+    """The roughness laws ``model``'s curve is traced again under for its model spread (-adh_model_spread,
+    -adh_model_spread_rules; :func:`~petsc_adhesion.tracing.model_spread.model_spread`), or None for none: by
+    default every rough model has one, a smooth one none."""
+    wanted, rules = opts.flag("adh_model_spread"), opts.rules("adh_model_spread_rules")
+    rough = model.roughness != "none" and model.sigma > 0
+    if wanted is False:
+        if rules is not None:
+            raise InputError("-adh_model_spread_rules: not with -adh_model_spread false, which computes no spread")
+        return None
+    if not rough:
+        if wanted or rules is not None:
+            name = "adh_model_spread" if wanted else "adh_model_spread_rules"
+            raise InputError(f"-{name}: a smooth surface (sigma = 0) has no roughness law to vary")
+        return None
+    if rules is not None and Rule.of(model) in rules:
+        raise InputError(f"-adh_model_spread_rules: {Rule.of(model).label} is the model's own law, not an "
+                         "alternative to it")
+    return default_rules(model) if rules is None else rules

@@ -29,7 +29,7 @@ class Option:
     """One application option: its kind, default, help and accepted values."""
 
     name: str
-    kind: str          # "real" | "int" | "choice" | "string" | "flag" | "reals"
+    kind: str          # "real" | "int" | "choice" | "string" | "flag" | "reals" | "rules"
     default: object
     help: str
     lo: float = -math.inf
@@ -51,7 +51,9 @@ class Option:
             if self.lo == -math.inf and self.hi == math.inf:
                 return what
             return f"{what} in {left}{_fmt(self.lo)}, {_fmt(self.hi)}{right}"
-        return {"string": "a file name", "flag": "true or false"}[self.kind]
+        return {"string": "a file name", "flag": "true or false",
+                "rules": "comma-separated law:parameter from " + ", ".join(f"{k}:{v}" for k, v in self.choices),
+                }[self.kind]
 
 
 def _fmt(x: float) -> str:
@@ -95,6 +97,12 @@ TABLE = {o.name: o for o in [
            "(needs -phys_epsilon)", 0.0, 1.0, lo_open=True),
     Option("adh_quadrature_points", "int", Model.quadrature_points, "truncated_gaussian, weibull: points of "
            "the quadrature's moving part at the wall (its fixed panels get 2/3 as many)", 2, 400),
+    Option("adh_model_spread", "flag", None, "trace a rough curve's events again under other roughness laws "
+           "(events only) and say how far they move: the model's spread beside the numerical bar (default: true "
+           "when sigma > 0; docs/model.md)"),
+    Option("adh_model_spread_rules", "rules", None, "the laws of -adh_model_spread (default: hermite with twice "
+           "the points under hermite, truncated_gaussian:3, truncated_gaussian:4, weibull:0; the reference's own "
+           "left out)", choices=(("hermite", "N"), ("truncated_gaussian", "K"), ("weibull", "skewness"))),
     Option("adh_rmax", "real", None, f"end r_m of the computational domain (default: {RMAX:g} on grids that "
            f"follow the contact edge, {grid.PAPER_RMAX:g} as in the paper otherwise)", 0.0, 1e3, lo_open=True),
     Option("adh_farfield", "flag", Model.farfield, "add the rigid sphere's attraction beyond r_m to the load: "

@@ -1,0 +1,196 @@
+"""The model spread (tracing/model_spread.py): a rough curve's events under the other roughness laws.
+
+Truths: a smooth model has no law to vary; at sigma = 0.05 every law's average is the
+Lennard-Jones law to O(sigma^2) (docs/model.md), so the laws agree far inside 10 %;
+at the silica probe's sigma = 1.67 the Hermite rule's outermost node sets the pull-off
+(16 and 32 points differ by a factor of 2, the truncated Gaussian at K = 3 is 12 times
+the 32-point rule's); each law's values are those of trace_curve run under it directly;
+and the truncated Gaussian's distance from K to K + 1 falls with the weight of the
+Gaussian's tail beyond K sigma (1.3e-3, 6.3e-5, 5.7e-7 at K = 3, 4, 5).
+"""
+import math
+
+import pytest
+
+from petsc_adhesion.errors import InputError
+from petsc_adhesion.model.parameters import Model
+from petsc_adhesion.model.physical import Bodies
+from petsc_adhesion.tracing.measured import Measured, Missing
+from petsc_adhesion.tracing.model_spread import (Rule, default_rules, model_spread, parse_rules, report_lines,
+                                                 WARN_RELATIVE)
+from petsc_adhesion.tracing.trace import CurveRequest, GridChoice, trace_curve
+
+QUICK = CurveRequest(error_bars=False)
+#: A coarse grid where the laws are compared with one another on it (its error common to all of them).
+COARSE = GridChoice("uniform", n=101)
+#: A 5 um silica probe on a silicon wafer (E and nu of docs/materials.md), w = 0.05 J/m^2, epsilon = 0.3 nm,
+#: rms 0.5 nm: mu = 0.577, sigma = 1.67.
+PROBE = Bodies(radius=5e-6, young1=73e9, poisson1=0.17, young2=130e9, poisson2=0.28, gamma=0.05, epsilon=3e-10,
+               rms=5e-10)
+
+
+@pytest.fixture(scope="module")
+def probe():
+    model = Model(mu=PROBE.mu, sigma=PROBE.sigma, bodies=PROBE)
+    curve = trace_curve(model)
+    return model, curve, model_spread(curve, model)
+
+
+@pytest.fixture(scope="module")
+def slight():
+    model = Model(mu=1.0, sigma=0.05)
+    curve = trace_curve(model)
+    return model, curve, model_spread(curve, model)
+
+
+def test_a_smooth_model_has_no_spread():
+    model = Model(mu=1.0)
+    curve = trace_curve(model, GridChoice("uniform", n=101), request=QUICK)
+    spread = model_spread(curve, model)
+    assert isinstance(spread, Missing) and "sigma = 0" in spread.reason
+    assert report_lines(spread) == [f"model spread: none ({spread.reason})"]
+
+
+def test_at_small_sigma_the_laws_agree(slight):
+    model, curve, spread = slight
+    assert [r.label for r in spread.rules] == ["hermite:32", "truncated_gaussian:3", "truncated_gaussian:4",
+                                               "weibull:0"]
+    names = [q.name for q in spread.quantities]
+    assert names == ["pull-off lambda", "pull-off F", "snap_on lambda", "snap_on F", "snap_off lambda",
+                     "snap_off F", "equilibrium lambda", "energy of a cycle"]
+    assert not spread.notes and not spread.warnings
+    for q in spread.quantities:
+        assert all(isinstance(v, Measured) for v in q.values)
+        # the laws differ (the spread is measured, not 0) by O(sigma^2) = 2.5e-3 (measured at most 6.8e-4); the
+        # cycle's energy, the small area between two branches, relatively more (measured 4.1e-3)
+        assert 0 < q.relative < (1e-2 if q.unit == "energy" else 2.5e-3) < WARN_RELATIVE, q
+    # the reference is the curve's own pull-off, bar and all
+    po = spread.quantity("pull-off F").reference
+    assert (po.value, po.err) == (curve.pull_off.F, curve.pull_off.F_err)
+
+
+def test_at_the_probes_roughness_the_rule_sets_the_pull_off(probe):
+    model, curve, spread = probe
+    assert model.sigma == pytest.approx(5 / 3) and model.mu == pytest.approx(0.5774, abs=1e-4)
+    q = spread.quantity("pull-off F")
+    F = {r.label: v.value for r, v in zip(spread.rules, q.values)}
+    F[spread.reference.label] = q.reference.value
+    nN = {k: v * spread.force_nN for k, v in F.items()}
+    # the brief's figures: -17.77 nN (16 points), 7.65 (32), 49.8 (K = 4), 93.6 (K = 3)
+    assert nN["hermite:16"] == pytest.approx(-17.77, abs=0.01)
+    assert nN["truncated_gaussian:3"] / nN["hermite:32"] > 12
+    assert nN["truncated_gaussian:3"] < nN["truncated_gaussian:4"] < nN["hermite:16"] < nN["hermite:32"] < 0
+    assert q.spread == pytest.approx(abs(F["truncated_gaussian:3"] - F["hermite:16"]))
+    assert q.relative > 4 and q.warning is not None
+    assert "truncated_gaussian:3" in q.warning and "-adh_roughness measured" in q.warning
+    lines = report_lines(spread)
+    assert any(line.startswith("WARNING: the pull-off F") for line in lines)
+    assert any("-17.77 nN" in line for line in lines)
+
+
+def test_the_spread_holds_each_laws_own_curve(probe):
+    """The values are those of trace_curve run under the law directly (the same events, to the bit)."""
+    model, curve, spread = probe
+    for k in (1, 2):                         # hermite:32 and truncated_gaussian:3
+        rule = spread.rules[k]
+        direct = trace_curve(Model(mu=model.mu, sigma=model.sigma, bodies=PROBE, roughness=rule.law,
+                                   **({"hermite_points": 32} if rule.law == "hermite" else
+                                      {"roughness_cutoff": rule.parameter})), request=QUICK)
+        F = spread.quantity("pull-off F").values[k]
+        lam = spread.quantity("equilibrium lambda").values[k]
+        assert F.value == direct.pull_off.F and F.err is None
+        assert lam.value == direct.events_of("equilibrium")[0].lam
+
+
+def test_the_truncated_gaussians_spread_falls_as_its_cutoff_grows():
+    """K = 3 against K = 4, 5, 6 at sigma = 0.05: each step of K moves the pull-off less, as the weight of the
+    tail beyond K sigma (ratios >= 19 a step; measured 4.6e-4, 2.4e-5, 4.3e-7), and the spread is the
+    largest distance, K = 3 to 6."""
+    model = Model(mu=1.0, sigma=0.05, roughness="truncated_gaussian", roughness_cutoff=3.0, rmax=10.0)
+    curve = trace_curve(model, COARSE, request=QUICK)
+    assert not curve.warnings                                   # the grid resolves the cohesive zone
+    s = model_spread(curve, model, COARSE, request=QUICK,
+                     rules=tuple(Rule("truncated_gaussian", K) for K in (4, 5, 6)))
+    q = s.quantity("pull-off F")
+    F = [q.reference.value, *(v.value for v in q.values)]
+    steps = [abs(b - a) for a, b in zip(F, F[1:])]
+    assert steps[0] < 1e-3
+    assert steps[0] > 10 * steps[1] > 100 * steps[2] > 0
+    assert q.spread == pytest.approx(abs(F[3] - F[0]), rel=1e-12) and not s.warnings
+
+
+def test_a_law_with_other_events_is_its_spread():
+    """mu = 2, sigma = 0.36: past the Hermite rule's critical roughness (0.327), short of the truncated
+    Gaussian's (0.537 at K = 3): one law has hysteresis, the other not."""
+    model = Model(mu=2.0, sigma=0.36)
+    curve = trace_curve(model, request=QUICK)
+    spread = model_spread(curve, model, request=QUICK, rules=(Rule("truncated_gaussian", 3.0),))
+    assert not curve.warnings
+    assert not curve.events_of("snap_on")
+    assert len(spread.notes) == 1 and "hysteresis itself depends on the law" in spread.notes[0]
+    energy = spread.quantity("energy of a cycle")
+    assert energy.reference.value == 0 and energy.values[0].value > 0 and math.isinf(energy.relative)
+    assert energy.warning is not None
+
+
+def test_rules():
+    assert parse_rules("hermite:32, truncated_gaussian:3,weibull:-1") == (
+        Rule("hermite", 32), Rule("truncated_gaussian", 3.0), Rule("weibull", -1.0))
+    for bad in ("hermite:2.5", "hermite:1", "hermite:401", "gauss:3", "truncated_gaussian", "weibull:1",
+                "truncated_gaussian:3,truncated_gaussian:3"):
+        with pytest.raises(ValueError):
+            parse_rules(bad)
+    tg = Model(mu=1.0, sigma=0.3, roughness="truncated_gaussian", roughness_cutoff=4.0)
+    assert default_rules(tg) == (Rule("truncated_gaussian", 3.0), Rule("weibull", 0.0))
+    assert default_rules(Model(sigma=0.3, hermite_points=200))[0] == Rule("hermite", 400)
+    with pytest.raises(ValueError, match="own law"):
+        model_spread(None, tg, rules=(Rule("truncated_gaussian", 4.0),))
+
+
+@pytest.mark.parametrize("argv, expected", [
+    ([], "default"), (["-adh_sigma", "0"], None), (["-adh_model_spread", "false"], None),
+    (["-adh_model_spread_rules", "weibull:-1"], (Rule("weibull", -1.0),)),
+    (["-adh_model_spread_rules", "hermite:16"], "-adh_model_spread_rules: hermite:16 is the model's own law"),
+    (["-adh_model_spread_rules", "hermite:2.5"], "-adh_model_spread_rules: 'hermite:2.5': hermite takes points"),
+    (["-adh_sigma", "0", "-adh_model_spread", "true"], "-adh_model_spread: a smooth surface"),
+    (["-adh_model_spread", "false", "-adh_model_spread_rules", "weibull:0"], "-adh_model_spread_rules: not with"),
+])
+def test_the_options(argv, expected):
+    from petsc4py import PETSc
+
+    from petsc_adhesion.app.options.reading import AppOptions, read_model, read_model_spread
+
+    db = PETSc.Options()
+    args = ["-adh_sigma", "0.3", *argv]
+    given = dict(zip(args[::2], args[1::2]))
+    for k, v in given.items():
+        db.setValue(k, v)
+    try:
+        opts = AppOptions(db)
+        if isinstance(expected, str) and expected.startswith("-"):
+            with pytest.raises(InputError) as err:
+                read_model_spread(opts, read_model(opts))
+            assert str(err.value).startswith(expected)
+        else:
+            got = read_model_spread(opts, read_model(opts))
+            assert got == (default_rules(read_model(opts)) if expected == "default" else expected)
+    finally:
+        for k in given:
+            db.delValue(k)
+
+
+def test_behind_a_spring_the_jumps_are_compared():
+    """An AFM cantilever (K = 1 at mu = 1, sigma = 0.1): its jumps in and off are quantities of the spread,
+    each law's the jumps its own curve behind the spring has."""
+    spring = CurveRequest(error_bars=False, spring=1.0)
+    model = Model(mu=1.0, sigma=0.1, rmax=10.0)
+    curve = trace_curve(model, COARSE, request=spring)
+    rule = Rule("truncated_gaussian", 3.0)
+    spread = model_spread(curve, model, COARSE, request=spring, rules=(rule,))
+    direct = trace_curve(rule.model(model), COARSE, request=spring)
+    for kind in ("jump_in", "jump_off"):
+        (mine,), (theirs,) = curve.events_of(kind), direct.events_of(kind)
+        q = spread.quantity(f"{kind} F")
+        assert q.reference.value == mine.F and q.values[0].value == theirs.F
+        assert q.spread == abs(theirs.F - mine.F) and q.relative < WARN_RELATIVE and not q.warning
+        assert spread.quantity(f"{kind} lambda").values[0].value == theirs.lam
