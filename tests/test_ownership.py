@@ -42,13 +42,18 @@ def _files():
             yield from (os.path.join(folder, n) for n in sorted(names) if n.endswith(".py"))
 
 
+#: methods that change a list, dict or set in place: called on another object's field, they write it
+MUTATORS = {"append", "extend", "insert", "pop", "remove", "clear", "update", "sort", "reverse", "add", "discard",
+            "setdefault", "popitem"}
+
+
 def _mine(node) -> bool:
     return isinstance(node, ast.Name) and node.id in ("self", "cls")
 
 
 def findings(source: str, name: str = "<source>") -> list[tuple[str, int, str, str]]:
-    """(module, line, kind, expression) of every write to an attribute of an object other than self, and
-    every read of a _private attribute of one."""
+    """(module, line, kind, expression) of every write to an attribute of an object other than self (an
+    assignment, or a method of MUTATORS called on it), and every read of a _private attribute of one."""
     out = []
     for node in ast.walk(ast.parse(source, name)):
         targets = []
@@ -67,6 +72,9 @@ def findings(source: str, name: str = "<source>") -> list[tuple[str, int, str, s
                     out.append((name, el.lineno, "write", ast.unparse(el)))      # obj.field[i] = ...
         if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in ("setattr", "delattr"):
             out.append((name, node.lineno, "write", ast.unparse(node)))
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in MUTATORS \
+                and isinstance(node.func.value, ast.Attribute) and not _mine(node.func.value.value):
+            out.append((name, node.lineno, "write", ast.unparse(node.func.value)))    # obj.field.append(...)
         if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__") \
                 and not _mine(node.value):
             out.append((name, node.lineno, "private", ast.unparse(node)))
@@ -85,13 +93,15 @@ def test_the_scan_sees_what_it_forbids():
               "    other.values['F'] = 0.0\n"
               "    a, other.b = 1, 2\n"
               "    setattr(other, 'c', 3)\n"
+              "    other.found.append(rows)\n"
+              "    rows.append(other)\n"
               "    return other._x, rows\n"
               "class C:\n"
               "    def g(self):\n"
               "        self.a, self._b = 1, self._c\n")
     got = [(line, kind) for _, line, kind, _ in findings(source)]
-    assert got.count((7, "private")) == 1 and len(got) == 6
-    assert {line for line, kind in got if kind == "write"} == {2, 3, 4, 5, 6}
+    assert got.count((9, "private")) == 1 and len(got) == 7
+    assert {line for line, kind in got if kind == "write"} == {2, 3, 4, 5, 6, 7}
 
 
 def test_no_object_writes_another_objects_fields_or_reads_its_privates():
