@@ -75,10 +75,12 @@ class FoldSystem:
         self.jacobian = self.bordered = self.pmat = self.ksp = None
         self.rhs = self.z = self.work = None
         try:
-            self.jacobian = PETSc.Mat().createPython((self.sizes, self.sizes), _Shell(self.jacobian_mult), comm=self.comm)
+            self.jacobian = PETSc.Mat().createPython((self.sizes, self.sizes), _Shell(self.jacobian_mult),
+                                                     comm=self.comm)
             self.jacobian.setUp()
             # the bordered matrix of g, its PC matrix and solver
-            self.bordered = PETSc.Mat().createPython((self.sizes, self.sizes), _Shell(self.bordered_mult, self.bordered_mult_transpose), comm=self.comm)
+            self.bordered = PETSc.Mat().createPython(
+                (self.sizes, self.sizes), _Shell(self.bordered_mult, self.bordered_mult_transpose), comm=self.comm)
             self.bordered.setUp()
             self.pmat = base.create_pmat(1)
             self.rhs, self.z, self.work = (self.create_vec() for _ in range(3))
