@@ -62,6 +62,10 @@ class Interrupted(BaseException):
         self.restart = None          # the checkpoint to go on from (-cont_restart), once one is saved
         self.done = None             # the run's exit status when the signal came after its results were written
 
+    def resumable(self, path: str) -> None:
+        """Name the checkpoint saved before the signal, the one to go on from (-cont_restart)."""
+        self.restart = path
+
 
 def printable(text) -> str:
     """``text`` (str or bytes) with control characters and undecodable bytes escaped, for one line."""

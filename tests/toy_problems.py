@@ -192,10 +192,10 @@ class Toy:
         if self.xmin is None or not self.guard_on:
             return 1.0
         toward = y > 0
-        alpha = float(np.min(self.to_wall * (x[toward] - self.xmin) / y[toward], initial=1.0))
-        if alpha < 1.0:
-            self.counts["shortened"] += 1
-        return alpha
+        return float(np.min(self.to_wall * (x[toward] - self.xmin) / y[toward], initial=1.0))
+
+    def record_guard(self) -> None:
+        self.counts["shortened"] += 1
 
     def observe(self, x, p, xdot, pdot):
         return self.observables(np.asarray(x), p, np.asarray(xdot), pdot)

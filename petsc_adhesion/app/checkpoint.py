@@ -248,13 +248,15 @@ class Checkpoint:
         Least time in seconds from the end of one save to the next (0: at every pause).
     restart : str or None
         A checkpoint to go on from (its state is read by :func:`open_checkpoint`).
+    saved : dict or None
+        That checkpoint's state as read (its arrays on rank 0 only).
     """
 
-    def __init__(self, path, comm, fingerprint: dict, interval: float = INTERVAL, restart=None):
+    def __init__(self, path, comm, fingerprint: dict, interval: float = INTERVAL, restart=None, saved=None):
         self.path, self.comm, self.fp, self.interval, self.restart = path, comm, fingerprint, interval, restart
         self.mpi = comm.tompi4py()
         self.rank0 = self.mpi.Get_rank() == 0
-        self.saved = None           # the state read for the restart (its arrays on rank 0 only)
+        self.saved = saved          # the state read for the restart (its arrays on rank 0 only)
         self.last = time.perf_counter()
         self.rows = {}              # segment number -> {"x", "xdot": gathered rows (rank 0)}, "n": points sent
         if path and self.rank0:
@@ -334,7 +336,7 @@ class Checkpoint:
             yield
         except Interrupted as e:
             if self.exists():
-                e.restart = self.path
+                e.resumable(self.path)
             raise
 
     def exists(self) -> bool:
@@ -364,7 +366,7 @@ def open_checkpoint(opts, targets: dict, inputs: dict, comm, study: bool = False
     if path is None and opts.db.hasName("cont_checkpoint_interval") and opts.string("cont_checkpoint") != "none":
         raise InputError("-cont_checkpoint_interval: times the saves of a checkpoint, and this run saves none (no "
                          "-out, -summary or -plot to keep it beside, nor -cont_checkpoint); remove it")
-    ck = Checkpoint(path, comm, fp, opts.real("cont_checkpoint_interval"), restart)
+    interval = opts.real("cont_checkpoint_interval")
 
     def check():
         if comm.getRank() != 0:
@@ -387,9 +389,9 @@ def open_checkpoint(opts, targets: dict, inputs: dict, comm, study: bool = False
                              f"version can take up")
         return tree, meta
 
-    got = collective(comm, check)
+    got, saved = collective(comm, check), None
     if restart is not None:
         mpi = comm.tompi4py()
         meta = mpi.bcast(got[1] if mpi.Get_rank() == 0 else None, root=0)
-        ck.saved = got[0] if mpi.Get_rank() == 0 else _decode(json.loads(meta), None)
-    return ck
+        saved = got[0] if mpi.Get_rank() == 0 else _decode(json.loads(meta), None)
+    return Checkpoint(path, comm, fp, interval, restart, saved)

@@ -184,7 +184,7 @@ class Bordered:
             self.p = float(p)
             self.set_border(xdot, float(pdot))
             self.linearize(True)
-        self.reuse.stale = state["pending"]
+        self.reuse.restore(state["pending"])
 
     def destroy(self) -> None:
         """Free the PETSc objects made here."""

@@ -26,7 +26,7 @@ first point), the arclength corrector ``arc_`` (also every tangent along it).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 from petsc4py import PETSc
@@ -36,7 +36,7 @@ from .bordered import Bordered
 from .newton import Tolerances, PC_REUSE_ITS, Newton, krylov_retry
 from .protocol import POINT_FIELDS, Point, check_point
 
-__all__ = ["Settings", "Continuation", "NATURAL_PREFIX", "CORRECTORS"]
+__all__ = ["Settings", "Continuation", "Correction", "NATURAL_PREFIX", "CORRECTORS"]
 
 #: Options prefix of the natural corrector (and the first point).
 NATURAL_PREFIX = "nat_"
@@ -102,6 +102,33 @@ class Settings:
         return cls(**d)
 
 
+@dataclass(frozen=True, eq=False)
+class Correction:
+    """What a corrector gives back: the corrected point (x, p) with its tangent (xdot, pdot), the work it
+    took, and whether it converged and, if not, why.
+
+    ``reason``: "converged"; "outside" (the natural predictor left the domain); "diverged" (Newton did not
+    converge, or the arclength predictor left the domain); "tangent" (the tangent's solve failed).
+    A failed correction holds no point.
+    """
+
+    corrector: str                      # "natural" | "arclength" ("" for a step's own start)
+    converged: bool
+    reason: str = "converged"
+    x: np.ndarray | None = None         # local part
+    p: float = math.nan
+    xdot: np.ndarray | None = None
+    pdot: float = math.nan
+    newton_its: int = 0
+    ksp_its: int = 0                    # Newton's Krylov iterations
+    tangent_its: int = 0                # the tangent solve's
+
+    @classmethod
+    def failed(cls, corrector: str, reason: str) -> Correction:
+        """A correction that did not converge, for ``reason``."""
+        return cls(corrector, False, reason)
+
+
 class Continuation:
     """Trace a curve of G(x, p) = 0 from a start point; collect the points and step statistics.
 
@@ -131,6 +158,11 @@ class Continuation:
         self.folds = 0
         self.stop: tuple[str, float] | None = None
         self.ds = self.set.ds
+
+    @property
+    def size(self) -> int:
+        """The number of x's unknowns on this rank."""
+        return self._x.getLocalSize()
 
     def inner(self, u: np.ndarray, v: np.ndarray) -> float:
         """<u, v> of local parts, summed over ranks."""
@@ -184,11 +216,11 @@ class Continuation:
         curve.  None when it fails.
         """
         guess = Point(x=x.getArray(readonly=True).copy(), p=p, xdot=xdot, pdot=pdot)
-        sol = self.arclength(guess, 0.0)
-        if sol is None:
+        c = self.arclength(guess, 0.0)
+        if not c.converged:
             return None
-        x1, p1, (xdot1, pdot1, kits), its, lits, _ = sol
-        return self.make_point(x1, p1, xdot1, pdot1, newton_its=its, ksp_its=lits + kits, corrector="regrid")
+        return self.make_point(c.x, c.p, c.xdot, c.pdot, newton_its=c.newton_its, ksp_its=c.ksp_its + c.tangent_its,
+                               corrector="regrid")
 
     # -- one step -------------------------------------------------------------
     def natural_ok(self, a: Point) -> bool:
@@ -196,43 +228,49 @@ class Continuation:
         s = self.set
         return s.corrector == "natural" or (s.corrector == "auto" and abs(a.pdot) >= s.switch)
 
-    def natural(self, a: Point, ds: float, tangent: bool = True, guess=None):
+    def natural(self, a: Point, ds: float, tangent: bool = True, guess=None) -> Correction:
         """Natural corrector (eq. 20-22) at p = a.p + ds a.pdot; tangent of eq. (16)-(19).  ``guess``: a
         first iterate (x, p) other than the predictor, moved along a's tangent to that p."""
         p = a.p + ds * a.pdot
         x = a.x + ds * a.xdot if guess is None else guess[0] + (p - guess[1]) / a.pdot * a.xdot  # eq. (20)
         if not self.pb.inside(x):
-            return None
+            return Correction.failed("natural", "outside")
         self._x.setArray(x)
         if not self.newton.solve(p, self._x, retry=True):   # eq. (21)-(22)
-            return None
+            return Correction.failed("natural", "diverged")
         x = self._x.getArray(readonly=True).copy()
         its, kits = self.newton.iterations
         tan = self.natural_tangent(x, p, a) if tangent else (a.xdot, a.pdot, 0)
-        return None if tan is None else (x, p, tan, its, kits, "natural")
+        if tan is None:
+            return Correction.failed("natural", "tangent")
+        return Correction("natural", True, x=x, p=p, xdot=tan[0], pdot=tan[1], newton_its=its, ksp_its=kits,
+                          tangent_its=tan[2])
 
-    def arclength(self, a: Point, ds: float, tangent: bool = True, guess=None):
+    def arclength(self, a: Point, ds: float, tangent: bool = True, guess=None) -> Correction:
         """Pseudo-arclength corrector (eq. 24-25) at distance ds (from ``guess`` (x, p) if given, else the
         predictor); tangent of the bordered system."""
         sol = self.bordered.correct(a, ds, guess)
         if sol is None:
-            return None
+            return Correction.failed("arclength", "diverged")
         x, p, its, kits = sol
         tan = self.bordered.tangent(x, p, a.xdot, a.pdot) if tangent else (a.xdot, a.pdot, 0)
-        return None if tan is None else (x, p, tan, its, kits, "arclength")
+        if tan is None:
+            return Correction.failed("arclength", "tangent")
+        return Correction("arclength", True, x=x, p=p, xdot=tan[0], pdot=tan[1], newton_its=its, ksp_its=kits,
+                          tangent_its=tan[2])
 
-    def correct(self, a: Point, ds: float, tangent: bool = True, guess=None):
+    def correct(self, a: Point, ds: float, tangent: bool = True, guess=None) -> Correction:
         """The point at step ds from a: the corrector the mode asks for, the other as fallback.
 
         The natural one serves only away from folds (|pdot| >= ``natural_fallback``),
         where p is a good parameter; near the wall of a fine roughness rule it is
         the more robust of the two.  Without ``tangent`` the point gets a's.
-        Returns (x, p, (xdot, pdot, tangent KSP its), Newton its, KSP its, corrector) or None.
+        A failed :class:`Correction` is the last corrector's tried.
         """
         s = self.set
         first, second = (self.natural, self.arclength) if self.natural_ok(a) else (self.arclength, self.natural)
         sol = first(a, ds, tangent, guess)
-        if sol is None and (second is self.arclength or abs(a.pdot) >= s.natural_fallback) \
+        if not sol.converged and (second is self.arclength or abs(a.pdot) >= s.natural_fallback) \
                 and s.corrector != "natural":
             sol = second(a, ds, tangent, guess)
         return sol
@@ -276,17 +314,17 @@ class Continuation:
         """One predictor-corrector step of length ds from a, or None (retry smaller)."""
         s = self.set
         sol = self.correct(a, ds, guess=self.extrapolate(a, ds))
-        if sol is None:
+        if not sol.converged:
             return None
-        x, p, (xdot, pdot, tangent_its), its, kits, kind = sol
+        x, p, xdot, pdot = sol.x, sol.p, sol.xdot, sol.pdot
         # the corrector's distance from the predictor grows as ds^2 times the curvature;
         # a step that had to travel far may have cut across a fold pair unseen
         dx = x - (a.x + ds * a.xdot)
         deviation = math.sqrt(self.inner(dx, dx) + (p - a.p - ds * a.pdot) ** 2) / ds
         if deviation > s.max_deviation or self.inner(a.xdot, xdot) + a.pdot * pdot < s.min_turn_cosine:
             return None
-        b = self.make_point(x, p, xdot, pdot, ds=ds, newton_its=its, ksp_its=kits + tangent_its,
-                            corrector=kind, deviation=deviation)
+        b = self.make_point(x, p, xdot, pdot, ds=ds, newton_its=sol.newton_its, ksp_its=sol.ksp_its + sol.tangent_its,
+                            corrector=sol.corrector, deviation=deviation)
         # the observable is what users read: resolve the curve in it too
         if s.observable is not None and abs(b.values[s.observable] - a.values[s.observable]) > self._observable_bound(a):
             return None
@@ -421,6 +459,18 @@ class Continuation:
         if "newton" in state:
             self.newton.restore(state["newton"])
             self.bordered.restore(state["bordered"])
+
+    def turn_around(self, label: str) -> None:
+        """Put the points of a run traced backward in the curve's order, tangents and rates reversed.
+
+        The first becomes the start (no step); every other one's step is the one from the point before it,
+        its length that point's distance along its own tangent, <xdot_a, x_b - x_a> + pdot_a (p_b - p_a)
+        (the backward run's corrector measured it from the other end), and its corrector is ``label``.
+        """
+        pts = [p.reversed() for p in reversed(self.points)]
+        self.points = [replace(pts[0], ds=0.0, corrector="start")] + [
+            replace(b, ds=self.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p), corrector=label)
+            for a, b in zip(pts, pts[1:])]
 
     def destroy(self) -> None:
         """Free the PETSc objects made here."""

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import brent
+from .continuation import Correction
 from .protocol import Point
 
 __all__ = ["Fold", "Extremum", "Zero", "ParameterValue", "Found", "EventFinder", "jumps", "EVENT_TOL", "SUBSTEPS", "DIP_XTOL"]
@@ -155,6 +156,10 @@ class Found:
     estimate: dict | None = None  # best values and error bars, when asked for (error_estimate.event_errors)
     arc: tuple | None = None      # a fold: (point(s), s0, s, s1), the arc it was located on, s its place
 
+    def land(self, point, by, step: int) -> None:
+        """Record where a fold's jump lands: ``point``, located by the EventFinder ``by`` on its step ``step``."""
+        self.landing, self.landing_by, self.landing_step = point, by, step
+
 
 class EventFinder:
     """Watch accepted steps for sign changes of the events' test functions; locate them.
@@ -183,12 +188,12 @@ class EventFinder:
                         and abs(fa) < min(abs(ev.test(before)), abs(fb)):
                     self._pairs(ev, ((before, a, len(pts) - 3), (a, b, len(pts) - 2)))
                 continue
-            point, sb = self._arc(a, b, ev.needs_tangent)
+            point, sb = self.arc(a, b, ev.needs_tangent)
             at = self._root(point, 0.0, sb, ev.test, 0.0)
             self.found.append(Found(ev, ev.label(fa), point(at, True), len(pts) - 2, fa,
                                     arc=(point, 0.0, at, sb) if isinstance(ev, Fold) else None))
 
-    def _arc(self, a, b, tangent: bool, arclength: bool = False):
+    def arc(self, a, b, tangent: bool, arclength: bool = False):
         """(point(s, tangent), sb): the corrected point at distance s from a on the step a -> b
         (cached; RuntimeError when the corrector fails), and b's distance.  With ``arclength`` the
         pseudo-arclength corrector throughout, which follows the curve through folds where the
@@ -204,15 +209,16 @@ class EventFinder:
         def point(s, tangent=tangent):
             if s not in cache or (tangent and cache[s].corrector != "event"):
                 guess = cont.between(a, b, sb, s, natural) if s else None
-                sol = correct(a, s, tangent, guess) if s else (a.x, a.p, (a.xdot, a.pdot, 0), 0, 0, "")
-                if sol is None:                       # a factorization kept from afar: once more, fresh
+                sol = correct(a, s, tangent, guess) if s else Correction("", True, x=a.x, p=a.p, xdot=a.xdot,
+                                                                            pdot=a.pdot)
+                if not sol.converged:                 # a factorization kept from afar: once more, fresh
                     cont.newton.reuse.expire()
                     cont.bordered.reuse.expire()
                     sol = correct(a, s, tangent, guess)
-                if sol is None:
+                if not sol.converged:
                     raise RuntimeError(f"event location failed near {cont.pb.parameter} = {a.p:.6g}")
-                x, p, (xdot, pdot, _), *_ = sol
-                cache[s] = cont.make_point(x, p, xdot, pdot, corrector="event" if tangent else "untangented")
+                cache[s] = cont.make_point(sol.x, sol.p, sol.xdot, sol.pdot,
+                                           corrector="event" if tangent else "untangented")
             return cache[s]
 
         return point, sb
@@ -223,7 +229,7 @@ class EventFinder:
         Without ``tangent`` the evaluations skip the tangent solve (f must not
         need it); the located point gets its own tangent at the end.
         """
-        point, sb = self._arc(a, b, tangent)
+        point, sb = self.arc(a, b, tangent)
         return point(self._root(point, 0.0, sb, f, level), True)
 
     def _root(self, point, s0: float, s1: float, f, level: float) -> float:
@@ -248,10 +254,10 @@ class EventFinder:
         for a, b, segment in steps:
             if any(f.segment == segment and isinstance(f.event, Fold) for f in self.found):
                 continue
-            _, sb = self._arc(a, b, False, arclength=True)
+            _, sb = self.arc(a, b, False, arclength=True)
             walk = self._walk(a, sb / SUBSTEPS)
             t = [ev.test(c) for c in walk]
-            arcs = [(self._arc(walk[k], walk[k + 1], True, arclength=True), 0.0) for k in range(len(t) - 1)
+            arcs = [(self.arc(walk[k], walk[k + 1], True, arclength=True), 0.0) for k in range(len(t) - 1)
                     if t[k] * t[k + 1] <= 0 and t[k] != 0]
             k = int(np.argmin(np.abs(t)))
             if not arcs and 0 < k < len(t) - 1:
@@ -270,17 +276,16 @@ class EventFinder:
         walk = [a]
         for _ in range(SUBSTEPS):
             sol = self.cont.arclength(walk[-1], h, True)
-            if sol is None:
+            if not sol.converged:
                 break
-            x, p, (xdot, pdot, _), *_ = sol
-            walk.append(self.cont.make_point(x, p, xdot, pdot, corrector="event"))
+            walk.append(self.cont.make_point(sol.x, sol.p, sol.xdot, sol.pdot, corrector="event"))
         return walk
 
     def _dip(self, ev, a, b) -> list:
         """The minimum of |pdot| on the arc a -> b: when pdot has the other sign there, the two pieces
         of the arc about it, each ((point(s), end), start) bracketing a fold, else []."""
         sign = np.sign(ev.test(a))
-        point, sb = self._arc(a, b, True, arclength=True)
+        point, sb = self.arc(a, b, True, arclength=True)
 
         def depth(s):
             d = sign * ev.test(point(s))
@@ -301,6 +306,37 @@ class EventFinder:
         a = self.cont.points[f.segment]
         return self.cont.inner(a.xdot, f.point.x - a.x) + a.pdot * (f.point.p - a.p)
 
+    def land_near(self, ev: Found, stable) -> bool:
+        """The landing of the fold ``ev`` on the step of the next fold of its control (forward jump) or of the
+        one before (backward), whose other end is unstable: on the arc that fold was located on, beyond it
+        (before it), then, for a pair inside one step, from that arc's end to the step's end (from the step's
+        start to the arc's start).  Found or not."""
+        fold = ev.event
+        folds = [f for f in self.found if f.event is fold]
+        k = next(i for i, f in enumerate(folds) if f is ev) + (1 if ev.before > 0 else -1)
+        other = folds[k] if 0 <= k < len(folds) else None
+        if other is None or other.arc is None:
+            return False
+        pts, cf = self.cont.points, fold.value(ev.point)
+        point, s0, at, s1 = other.arc
+        landing = ev.landing         # a landing located before stands; the finder it names is set anew
+        pieces = [(point, at, s1)] if ev.before > 0 else [(point, s0, at)]
+        if other.segment == ev.segment:
+            pieces.append((point(s1), pts[ev.segment + 1]) if ev.before > 0 else (pts[ev.segment], point(s0)))
+        for piece in pieces:
+            if len(piece) == 3:
+                arc, lo, hi = piece
+                if (fold.value(arc(lo)) - cf) * (fold.value(arc(hi)) - cf) <= 0 and \
+                        stable(arc(hi if ev.before > 0 else lo)):
+                    landing = arc(self._root(arc, lo, hi, fold.value, cf), True)
+            elif stable(piece[0]) and stable(piece[1]) and \
+                    (fold.value(piece[0]) - cf) * (fold.value(piece[1]) - cf) <= 0:
+                landing = self.locate(*piece, fold.value, level=cf, tangent=False)
+            if landing is not None:
+                ev.land(landing, self, other.segment)
+                return True
+        return False
+
     def jumps(self, stable=None) -> None:
         """For each fold, the state it jumps to (``Found.landing``): :func:`jumps` on this one curve."""
         jumps([self], stable)
@@ -316,7 +352,7 @@ class EventFinder:
     def restore(self, state: list[dict], finder_at) -> None:
         """Take up :meth:`state`; ``finder_at(number)``: the finder of that number (IndexError for none).
         ValueError for events that are not this finder's."""
-        found, size, steps = [], self.cont._x.getLocalSize(), len(self.cont.points) - 1
+        found, size, steps = [], self.cont.size, len(self.cont.points) - 1
         for d in state:
             ints = (d["event"], d["segment"], d["landing_step"])
             if not all(isinstance(i, int) and not isinstance(i, bool) for i in ints) or \
@@ -329,7 +365,7 @@ class EventFinder:
                 if not isinstance(d["landing_by"], int) or d["landing_by"] < 0:
                     raise ValueError("a landing on no segment")
                 by = finder_at(d["landing_by"])
-            landing = Point.from_state(d["landing"], by.cont._x.getLocalSize()) if by is not None else None
+            landing = Point.from_state(d["landing"], by.cont.size) if by is not None else None
             found.append(Found(self.events[d["event"]], d["label"], Point.from_state(d["point"], size), d["segment"],
                                float(d["before"]), landing=landing, landing_by=by, landing_step=d["landing_step"],
                                estimate=d["estimate"]))
@@ -358,42 +394,10 @@ def jumps(finders, stable=None) -> None:
             at = steps.index((finder, ev.segment))
             cf = fold.value(ev.point)
             order = steps[at + 1:] if ev.before > 0 else steps[at - 1::-1] if at else []
-            if _near_landing(finder, ev, ok):
+            if finder.land_near(ev, ok):
                 continue
             for owner, j in order:
                 a, b = owner.cont.points[j], owner.cont.points[j + 1]
                 if ok(a) and ok(b) and (fold.value(a) - cf) * (fold.value(b) - cf) <= 0:
-                    ev.landing = owner.locate(a, b, fold.value, level=cf, tangent=False)
-                    ev.landing_by, ev.landing_step = owner, j
+                    ev.land(owner.locate(a, b, fold.value, level=cf, tangent=False), owner, j)
                     break
-
-
-def _near_landing(finder: EventFinder, ev: Found, stable) -> bool:
-    """The landing of the fold ``ev`` on the step of the next fold of its control (forward jump) or of the
-    one before (backward), whose other end is unstable: on the arc that fold was located on, beyond it
-    (before it), then, for a pair inside one step, from that arc's end to the step's end (from the step's
-    start to the arc's start).  Found or not."""
-    fold = ev.event
-    folds = [f for f in finder.found if f.event is fold]
-    k = next(i for i, f in enumerate(folds) if f is ev) + (1 if ev.before > 0 else -1)
-    other = folds[k] if 0 <= k < len(folds) else None
-    if other is None or other.arc is None:
-        return False
-    pts, cf = finder.cont.points, fold.value(ev.point)
-    point, s0, at, s1 = other.arc
-    pieces = [(point, at, s1)] if ev.before > 0 else [(point, s0, at)]
-    if other.segment == ev.segment:
-        pieces.append((point(s1), pts[ev.segment + 1]) if ev.before > 0 else (pts[ev.segment], point(s0)))
-    for piece in pieces:
-        if len(piece) == 3:
-            arc, lo, hi = piece
-            if (fold.value(arc(lo)) - cf) * (fold.value(arc(hi)) - cf) <= 0 and \
-                    stable(arc(hi if ev.before > 0 else lo)):
-                ev.landing = arc(finder._root(arc, lo, hi, fold.value, cf), True)
-        elif stable(piece[0]) and stable(piece[1]) and \
-                (fold.value(piece[0]) - cf) * (fold.value(piece[1]) - cf) <= 0:
-            ev.landing = finder.locate(*piece, fold.value, level=cf, tangent=False)
-        if ev.landing is not None:
-            ev.landing_by, ev.landing_step = finder, other.segment
-            return True
-    return False

@@ -75,10 +75,12 @@ class FoldSystem:
         self.jacobian = self.bordered = self.pmat = self.ksp = None
         self.rhs = self.z = self.work = None
         try:
-            self.jacobian = PETSc.Mat().createPython((self.sizes, self.sizes), _FoldJacobian(self), comm=self.comm)
+            self.jacobian = PETSc.Mat().createPython((self.sizes, self.sizes), _Shell(self.jacobian_mult),
+                                                     comm=self.comm)
             self.jacobian.setUp()
             # the bordered matrix of g, its PC matrix and solver
-            self.bordered = PETSc.Mat().createPython((self.sizes, self.sizes), _BorderedG(self), comm=self.comm)
+            self.bordered = PETSc.Mat().createPython(
+                (self.sizes, self.sizes), _Shell(self.bordered_mult, self.bordered_mult_transpose), comm=self.comm)
             self.bordered.setUp()
             self.pmat = base.create_pmat(1)
             self.rhs, self.z, self.work = (self.create_vec() for _ in range(3))
@@ -243,6 +245,10 @@ class FoldSystem:
         with self._at_parameter(self.guard):
             return self.base.step_fraction(x[:self.nloc], y[:self.nloc])
 
+    def record_guard(self) -> None:
+        """The base problem counts the steps its guard shortened."""
+        self.base.record_guard()
+
     def observe(self, x: np.ndarray, s: float, xdot: np.ndarray, sdot: float):
         """p and the base problem's observables at the fold; the rate of p along the fold curve."""
         u, p = self.split(x)
@@ -251,6 +257,32 @@ class FoldSystem:
             values, _ = self.base.observe(u, p, np.zeros_like(u), 0.0)
         name = self.base.parameter
         return {name: p, **values}, {name: pdot}
+
+    def bordered_mult(self, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """y = [[G_u, psi], [phi^T, 0]] x = [G_u xu + psi xg; phi . xu] (the bordered matrix of g)."""
+        xu, xg = self.split(x.getArray(readonly=True))
+        self._u.setArray(xu)
+        with python_errors():
+            self.base.jacobian.mult(self._u, self._y)
+        y.setArray(self.join(self._y.getArray(readonly=True) + xg * self.psi, self._dot(self.phi, xu)))
+
+    def bordered_mult_transpose(self, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """y = [G_u^T xu + phi xg; psi . xu]: the transpose of :meth:`bordered_mult`."""
+        xu, xg = self.split(x.getArray(readonly=True))
+        self._u.setArray(xu)
+        self.base.jacobian_transpose(self._u, self._y)
+        y.setArray(self.join(self._y.getArray(readonly=True) + xg * self.phi, self._dot(self.psi, xu)))
+
+    def jacobian_mult(self, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """y = [[G_u, G_p], [g_u, g_p]] x = [G_u xu + G_p xp; g_u . xu + g_p xp] (the fold system's Jacobian)."""
+        xu, xp = self.split(x.getArray(readonly=True))
+        self._u.setArray(xu)
+        with python_errors():
+            self.base.jacobian.mult(self._u, self._y)
+        g = self._dot(self.row, xu)
+        if self.g_p:
+            g += self.g_p * xp
+        y.setArray(self.join(self._y.getArray(readonly=True) + xp * self.gp, g))
 
     def destroy(self) -> None:
         """Free the PETSc objects made here, the base problem's too."""
@@ -279,44 +311,17 @@ def _bordered_ksp(comm, M: PETSc.Mat, P: PETSc.Mat, base) -> PETSc.KSP:
     return ksp
 
 
-class _BorderedG:
-    """MatPython context of [[G_u, psi], [phi^T, 0]] and its transpose."""
+class _Shell:
+    """MatPython context that hands y = M x (and y = M^T x) to its owner's ``mult`` (``mult_transpose``):
+    the shell holds no state of its own."""
 
-    def __init__(self, fs: FoldSystem):
-        self.fs = fs
+    def __init__(self, mult, mult_transpose=None):
+        self._mult, self._mult_transpose = mult, mult_transpose
 
     def mult(self, mat, x, y):
-        """y = [G_u xu + psi xg; phi . xu]."""
-        fs = self.fs
-        xu, xg = fs.split(x.getArray(readonly=True))
-        fs._u.setArray(xu)
-        with python_errors():
-            fs.base.jacobian.mult(fs._u, fs._y)
-        y.setArray(fs.join(fs._y.getArray(readonly=True) + xg * fs.psi, fs._dot(fs.phi, xu)))
+        """y = M x."""
+        self._mult(x, y)
 
     def multTranspose(self, mat, x, y):
-        """y = [G_u^T xu + phi xg; psi . xu]."""
-        fs = self.fs
-        xu, xg = fs.split(x.getArray(readonly=True))
-        fs._u.setArray(xu)
-        fs.base.jacobian_transpose(fs._u, fs._y)
-        y.setArray(fs.join(fs._y.getArray(readonly=True) + xg * fs.phi, fs._dot(fs.psi, xu)))
-
-
-class _FoldJacobian:
-    """MatPython context of the fold system's Jacobian [[G_u, G_p], [g_u, g_p]]."""
-
-    def __init__(self, fs: FoldSystem):
-        self.fs = fs
-
-    def mult(self, mat, x, y):
-        """y = [G_u xu + G_p xp; g_u . xu + g_p xp]."""
-        fs = self.fs
-        xu, xp = fs.split(x.getArray(readonly=True))
-        fs._u.setArray(xu)
-        with python_errors():
-            fs.base.jacobian.mult(fs._u, fs._y)
-        g = fs._dot(fs.row, xu)
-        if fs.g_p:
-            g += fs.g_p * xp
-        y.setArray(fs.join(fs._y.getArray(readonly=True) + xp * fs.gp, g))
+        """y = M^T x."""
+        self._mult_transpose(x, y)

@@ -112,6 +112,10 @@ class PCReuse:
         self.stale = False
         return refill
 
+    def restore(self, pending: bool) -> None:
+        """Take up :meth:`state`'s ``pending``: whether the next linearization refills."""
+        self.stale = pending
+
     def filled(self, *at) -> None:
         """Record the point the matrix was just filled at (arrays copied)."""
         self.at = tuple(np.array(v) if isinstance(v, np.ndarray) else v for v in at)
@@ -178,10 +182,11 @@ def guard(problem, x: np.ndarray, Y: PETSc.Vec, y: np.ndarray | None = None) -> 
     """Shorten the Newton step Y (new x = x - y) by the problem's domain guard; True if shortened.
 
     ``y`` is the part of Y acting on x when Y also holds other unknowns.
-    The problem returns the same fraction on all ranks.
+    The problem returns the same fraction on all ranks; a shortened step is recorded with it.
     """
     alpha = problem.step_fraction(x, Y.getArray(readonly=True) if y is None else y)
     if alpha < 1.0:
+        problem.record_guard()
         Y.scale(alpha)
         return True
     return False
@@ -258,7 +263,7 @@ class Newton:
                 self.linearize(v, True)
             finally:
                 v.destroy()
-        self.reuse.stale = state["pending"]
+        self.reuse.restore(state["pending"])
 
     def solve(self, p: float, x: PETSc.Vec, retry: bool = False) -> bool:
         """Solve G(x; p) = 0 in place from the guess in x; True when converged.

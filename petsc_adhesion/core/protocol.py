@@ -77,7 +77,11 @@ class ContinuationProblem(Protocol):
         """Domain guard: whether the local part x is admissible (collective, the same on every rank)."""
 
     def step_fraction(self, x: np.ndarray, y: np.ndarray) -> float:
-        """Domain guard: the largest fraction of the Newton step x -> x - y allowed (the same on every rank)."""
+        """Domain guard: the largest fraction of the Newton step x -> x - y allowed (the same on every rank);
+        a query, which changes nothing."""
+
+    def record_guard(self) -> None:
+        """Count one Newton step the guard shortened (Newton calls it when :meth:`step_fraction` is below 1)."""
 
     def observe(self, x: np.ndarray, p: float, xdot: np.ndarray, pdot: float) -> tuple[dict, dict]:
         """Named observables at (x, p) and their rates d/ds along the tangent (xdot, pdot)."""
@@ -88,7 +92,9 @@ class TracedProblem(ContinuationProblem, Protocol):
     """What the tracer, the error bars, the results and the checkpoint need beside the protocol.
 
     A state x may hold unknowns beside the nodal separation (the contact radius in
-    the frame of the edge); these members give its physical meaning.
+    the frame of the edge); these members give its physical meaning, and
+    :meth:`carry` puts a point of another problem's curve into this one's unknowns,
+    so that code following a curve over grids asks no problem for its class.
     """
 
     #: the model (mu, sigma, roughness, r_m) the problem discretizes
@@ -112,8 +118,22 @@ class TracedProblem(ContinuationProblem, Protocol):
     def gather(self, local: np.ndarray) -> np.ndarray:
         """A whole nodal vector from its local parts, on every rank."""
 
+    def radius(self, x: np.ndarray) -> float:
+        """The contact radius of a state x (collective)."""
+
+    def radius_rate(self, point: Point, a: float) -> float:
+        """d(contact radius)/ds along the tangent of ``point``, whose contact radius is a (collective)."""
+
+    def carry(self, source: TracedProblem, point: Point, scale: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The state x and tangent xdot of ``point`` of ``source``'s curve, on this problem's local unknowns
+        (collective): how a curve goes on from one grid to another.  ``scale``: the contact radius to take
+        in a frame that scales with it (default: ``source.radius`` at the point)."""
+
     def stable(self, point: Point) -> bool:
         """Stable under displacement control at a point of the curve."""
+
+    def restore_counters(self, guarded: int) -> None:
+        """Take up the count of guarded Newton steps (:attr:`guarded`) a checkpoint saved."""
 
     def destroy(self) -> None:
         """Free the PETSc objects of the problem."""

@@ -23,44 +23,15 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from .. import brent
 from ..core.bordered import Border
 from ..model.pressure import pressure_law
 from ..model.reference.rigid import load_beyond, load_beyond_rates
+from .contact import SMOOTH_LEVEL, SMOOTH_PEAK, deformation_at, edge_level, peak_attraction, rate_at
 from .grid import l2_weights, load_weights
-from .preconditioning import Layout
-from .problem import TO_WALL, local_diagonal, norm_radius, step_scale
+from .plumbing import Plumbing
+from .problem import TO_WALL, norm_radius, step_scale
 
 __all__ = ["EdgeFrameProblem", "edge_level", "SMOOTH_LEVEL", "SMOOTH_PEAK", "peak_attraction"]
-
-
-#: H at the pinned contact edge of a smooth surface: a gap of 1.5 epsilon, inside the cohesive zone.
-SMOOTH_LEVEL = 0.5
-#: H of the smooth law's peak attraction: a gap of 3^(1/6) epsilon (eq. 5).
-SMOOTH_PEAK = 3.0 ** (1.0 / 6.0) - 1.0
-
-
-def peak_attraction(law) -> float:
-    """The H at which the law attracts most (P most negative), above its wall.
-
-    A rough average spreads the attraction over the heights, and the peak can lie
-    far from the wall + 1.5 of a smooth surface: with the 16-point Hermite rule at
-    sigma = 1 it is 0.24 above the wall.  Sampled on a geometric scale from the
-    wall, then refined by Brent's method between the neighbours of the best sample.
-    """
-    if law.smooth:
-        return SMOOTH_PEAK
-    reach = 2.0 * (law.wall + 1.0) + 3.0          # past the lowest heights' reach, for any law here
-    H = law.wall + np.geomspace(1e-4, reach, 2000)
-    k = int(np.argmin(law(H)[0]))
-    lo, hi = H[max(k - 1, 0)], H[min(k + 1, H.size - 1)]
-    return float(brent.minimum(lambda h: float(law(np.array([h]))[0][0]), lo, hi, xatol=1e-10))
-
-
-def edge_level(law) -> float:
-    """H at the pinned contact edge: as far beyond the law's peak attraction as a smooth surface's
-    SMOOTH_LEVEL is beyond its own, so inside the cohesive zone whatever the roughness."""
-    return SMOOTH_LEVEL if law.smooth else peak_attraction(law) + (SMOOTH_LEVEL - SMOOTH_PEAK)
 
 
 class EdgeFrameProblem:
@@ -84,15 +55,14 @@ class EdgeFrameProblem:
 
     def __init__(self, model, rho: np.ndarray, A: PETSc.Mat, scale: float, pmat):
         self.model, self.rho, self.A, self.scale, self.pc = model, rho, A, scale, pmat
-        self.comm = A.getComm()
-        self._mpi = self.comm.tompi4py()
+        self.plumbing = Plumbing(A, 1, self)     # owns A from here on
+        self.comm, self._mpi, self.layout, self.jacobian = \
+            self.plumbing.comm, self.plumbing.mpi, self.plumbing.layout, self.plumbing.jacobian
         self.law = pressure_law(model)
         self.level = edge_level(self.law)
         self.c = model.coupling
-        self.lo, self.hi = A.getOwnershipRange()
+        self.lo, self.hi, self.last = self.layout.lo, self.layout.hi, self.layout.last
         self.nloc, N = self.hi - self.lo, rho.size
-        self.last = self.comm.getRank() == self.comm.getSize() - 1
-        self.layout = Layout(self.lo, self.hi, N, self.last)
         local = rho[self.lo:self.hi]
         self.half_rho2 = 0.5 * local * local
         self.q = (8.0 / 3.0) * load_weights(rho)[self.lo:self.hi]
@@ -106,13 +76,7 @@ class EdgeFrameProblem:
         # a relative change of the contact radius weighs like a change of H by the step unit (max(1, mu):
         # H and lambda grow like mu towards the JKR end, the relative changes of a stay of order one)
         self.weights = np.append(w, (step_scale(model) / scale) ** 2) if self.last else w
-        self._pressure, self._Ap = A.createVecs()
         self.dp, self.column, self.a = np.zeros(self.nloc), np.zeros(self.nloc), scale
-        n1 = int(self.last)
-        self.jacobian = PETSc.Mat().createPython(((self.nloc + n1, N + 1), (self.nloc + n1, N + 1)),
-                                                 _Jacobian(self), comm=self.comm)
-        self.jacobian.setUp()
-        self._gather = None
         self.guarded = 0                  # Newton steps the domain guard shortened
 
     # -- x = (H, a) --------------------------------------------------------------------
@@ -143,16 +107,36 @@ class EdgeFrameProblem:
 
     def gather(self, local: np.ndarray) -> np.ndarray:
         """The whole nodal vector of local parts of H, on every rank."""
-        return np.concatenate(self._mpi.allgather(np.asarray(local)))
+        return self.plumbing.gather(local)
+
+    def radius_rate(self, point, a: float) -> float:
+        """d(contact radius)/ds along a point's tangent: the rate of the unknown a (collective)."""
+        return self.radius(point.xdot)
+
+    def carry(self, source, point, scale: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The state and tangent of ``point`` of ``source``'s curve on this problem's local unknowns (collective).
+
+        The nodes are taken at contact radius ``scale`` (default ``source``'s radius at the point):
+        the deformation D and the tangent's nodal part interpolated at scale rho
+        (:func:`~petsc_adhesion.discretization.contact.deformation_at`), then a and its rate
+        (``source.radius_rate``: with adot left 0 this frame, which weighs a's relative change by
+        (mu / a)^2, could orient its tangent against the curve's).
+        """
+        if scale is None:
+            scale = source.radius(point.x)
+        r = (scale * self.rho)[self.lo:self.hi]
+        x, xdot = deformation_at(source, point.x, r), rate_at(source, point.x, point.xdot, r)
+        adot = source.radius_rate(point, scale)
+        if self.last:
+            x, xdot = np.append(x, scale), np.append(xdot, adot)
+        return x, xdot
 
     # -- eq. 12, 14, 26 in the frame of the edge ------------------------------------------
     def residual(self, X: PETSc.Vec, lam: float, G: PETSc.Vec) -> None:
         """G(D, a, lambda): eq. (12) on the nodes a rho, and the pin."""
         d, a, d1 = self._split(X.getArray(readonly=True), pinned=True)
         pressure, _ = self.law(d + a * a * self.half_rho2)
-        self._pressure.setArray(pressure)
-        self.A.mult(self._pressure, self._Ap)
-        g = d + lam - self.c * a * self._Ap.getArray(readonly=True)
+        g = d + lam - self.c * a * self.plumbing.multiply(pressure)
         G.setArray(np.append(g, d1 + 0.5 * a * a - self.level) if self.last else g)
 
     def dG_dp(self, X: PETSc.Vec, lam: float, out: np.ndarray) -> np.ndarray:
@@ -197,9 +181,15 @@ class EdgeFrameProblem:
         alpha = float(np.min(TO_WALL * room[toward] / yh[toward], initial=1.0))
         if ya > 0:
             alpha = min(alpha, 0.5 * a / ya)
-        alpha = self._mpi.allreduce(alpha, op=MPI.MIN)
-        self.guarded += alpha < 1.0
-        return alpha
+        return self._mpi.allreduce(alpha, op=MPI.MIN)
+
+    def record_guard(self) -> None:
+        """Count a Newton step the domain guard shortened (:meth:`step_fraction` below 1)."""
+        self.guarded += 1
+
+    def restore_counters(self, guarded: int) -> None:
+        """Take up the count of guarded steps a checkpoint saved."""
+        self.guarded = guarded
 
     # -- linearization -----------------------------------------------------------------------
     def linearize(self, X: PETSc.Vec, lam: float) -> None:
@@ -207,17 +197,21 @@ class EdgeFrameProblem:
         d, self.a, _ = self._split(X.getArray(readonly=True))
         pressure, self.dp = self.law(d + self.a * self.a * self.half_rho2)
         # dG/da = -c Ahat (P + a^2 rho^2 P')
-        self._pressure.setArray(pressure + 2 * self.a * self.a * self.half_rho2 * self.dp)
-        self.A.mult(self._pressure, self._Ap)
-        self.column = -self.c * self._Ap.getArray(readonly=True)
+        self.column = -self.c * self.plumbing.multiply(pressure + 2 * self.a * self.a * self.half_rho2 * self.dp)
+
+    def jacobian_mult(self, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """y = J x, J = [[I - c a Ahat diag(P'), dG/da], [pin, a]] at the linearization point (the shell's)."""
+        vh, va, v1 = self._split(x.getArray(readonly=True), pinned=True)
+        yh = vh - self.c * self.a * self.plumbing.multiply(self.dp * vh) + va * self.column
+        y.setArray(np.append(yh, v1 + self.a * va) if self.last else yh)
+
+    def jacobian_diagonal(self, d: PETSc.Vec) -> None:
+        """d = diag J (for -pc_type jacobi on the shell)."""
+        dh = 1.0 - self.c * self.a * self.plumbing.diagonal() * self.dp
+        d.setArray(np.append(dh, self.a) if self.last else dh)
 
     def _dp_all(self) -> np.ndarray:
-        if self._gather is None:
-            self._dpv = self._pressure.duplicate()
-            self._gather, self._dpall = PETSc.Scatter.toAll(self._dpv)
-        self._dpv.setArray(self.dp)
-        self._gather.scatter(self._dpv, self._dpall, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        return self._dpall.getArray(readonly=True)
+        return self.plumbing.everywhere(self.dp)
 
     def jacobian_rows(self, out: np.ndarray) -> np.ndarray:
         """Local rows of dG/dD = I - c a Ahat diag(P'), dense, into ``out``."""
@@ -249,33 +243,4 @@ class EdgeFrameProblem:
 
     def destroy(self) -> None:
         """Free the PETSc objects held here, the influence matrix included."""
-        for obj in (self.jacobian, self._pressure, self._Ap, self.A):
-            obj.destroy()
-        if self._gather is not None:
-            for obj in (self._gather, self._dpv, self._dpall):
-                obj.destroy()
-
-
-class _Jacobian:
-    """MatPython context of [[I - c a Ahat diag(P'), dG/da], [pin, a]]."""
-
-    def __init__(self, problem: EdgeFrameProblem):
-        self.pb = problem
-        self._diag = None
-
-    def mult(self, mat, x, y):
-        """y = J x."""
-        pb = self.pb
-        vh, va, v1 = pb._split(x.getArray(readonly=True), pinned=True)
-        pb._pressure.setArray(pb.dp * vh)
-        pb.A.mult(pb._pressure, pb._Ap)
-        yh = vh - pb.c * pb.a * pb._Ap.getArray(readonly=True) + va * pb.column
-        y.setArray(np.append(yh, v1 + pb.a * va) if pb.last else yh)
-
-    def getDiagonal(self, mat, d):
-        """diag J (for -pc_type jacobi)."""
-        pb = self.pb
-        if self._diag is None:              # Ahat does not change: its diagonal once
-            self._diag = local_diagonal(pb.A)
-        dh = 1.0 - pb.c * pb.a * self._diag * pb.dp
-        d.setArray(np.append(dh, pb.a) if pb.last else dh)
+        self.plumbing.destroy()

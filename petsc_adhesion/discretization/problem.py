@@ -18,10 +18,12 @@ from petsc4py import PETSc
 from ..model.pressure import curvature, pressure_law, sigma_rates
 from ..model.reference.jkr import jkr_zero_load
 from ..model.reference.rigid import load_beyond, load_beyond_rates
+from .contact import contact_radius, deformation_at, rate_at
 from .grid import l2_weights, load_weights
-from .preconditioning import Dense, Layout
+from .plumbing import Plumbing
+from .preconditioning import Dense
 
-__all__ = ["Problem", "far_approach", "step_scale", "MU_SOFT", "norm_radius", "TO_WALL", "local_diagonal"]
+__all__ = ["Problem", "far_approach", "step_scale", "MU_SOFT", "norm_radius", "TO_WALL"]
 
 #: Newton may cover at most this fraction of the way to the wall in one step.
 TO_WALL = 0.9
@@ -80,29 +82,25 @@ class Problem:
 
     def __init__(self, model, r: np.ndarray, A: PETSc.Mat, pmat=None):
         self.model, self.r, self.A = model, r, A
-        self.comm = A.getComm()
-        self._mpi = self.comm.tompi4py()
+        self.plumbing = Plumbing(A, 0, self)     # owns A from here on
+        self.comm, self._mpi, self.layout, self.jacobian = \
+            self.plumbing.comm, self.plumbing.mpi, self.plumbing.layout, self.plumbing.jacobian
         self.law = pressure_law(model)
         self.c = model.coupling
-        self.lo, self.hi = A.getOwnershipRange()
-        self.layout = Layout(self.lo, self.hi, r.size, self.comm.getRank() == self.comm.getSize() - 1)
+        self.lo, self.hi = self.layout.lo, self.layout.hi
         local = r[self.lo:self.hi]
         self.shape = 0.5 * local * local
         self.q = (8.0 / 3.0) * load_weights(r)[self.lo:self.hi]
         self.weights = l2_weights(r, norm_radius(model))[self.lo:self.hi]
-        self._pressure, self._Ap = A.createVecs()
         self.dp = np.zeros(self.hi - self.lo)
         self.pc = pmat if pmat is not None else Dense()
-        self.jacobian = PETSc.Mat().createPython(A.getSizes(), _Jacobian(self), comm=self.comm)
-        self.jacobian.setUp()
-        self._gather = None
         self.guarded = 0                  # Newton steps the domain guard shortened
         self._own_law, self._laws, self._second = self.law, {}, None
 
     # -- state ------------------------------------------------------------------
     def create_vec(self) -> PETSc.Vec:
         """A vector of nodal values in the layout of G."""
-        return self.A.createVecLeft()
+        return self.plumbing.nodal_vec()
 
     def rigid(self, lam: float, H: PETSc.Vec) -> PETSc.Vec:
         """H = -lambda + r^2/2 (eq. 27), lifted where it would reach the wall.
@@ -121,9 +119,7 @@ class Problem:
     def residual(self, H: PETSc.Vec, lam: float, G: PETSc.Vec) -> None:
         """G(H, lambda) of eq. (12) into G."""
         pressure, _ = self.pressure(H)
-        self._pressure.setArray(pressure)
-        self.A.mult(self._pressure, self._Ap)
-        G.setArray(H.getArray(readonly=True) + (lam - self.shape) - self.c * self._Ap.getArray(readonly=True))
+        G.setArray(H.getArray(readonly=True) + (lam - self.shape) - self.c * self.plumbing.multiply(pressure))
 
     def dG_dp(self, H: PETSc.Vec, lam: float, out: np.ndarray) -> np.ndarray:
         """G_lambda of eq. (23): ones, on the local rows."""
@@ -174,7 +170,31 @@ class Problem:
 
     def gather(self, local: np.ndarray) -> np.ndarray:
         """The whole nodal vector of local parts, on every rank."""
-        return np.concatenate(self._mpi.allgather(np.asarray(local)))
+        return self.plumbing.gather(local)
+
+    # -- the contact edge, and a point carried onto this grid ---------------------------------
+    def radius(self, h: np.ndarray) -> float:
+        """The contact radius of a state: where H first rises through the edge level
+        (:func:`~petsc_adhesion.discretization.contact.contact_radius`); collective."""
+        return contact_radius(self, h)
+
+    def radius_rate(self, point, a: float) -> float:
+        """d(contact radius)/ds along the tangent of a point whose contact radius is a (collective): a central
+        difference over a step that moves H by about 1e-6 of the contact radius."""
+        xdot = point.xdot
+        size = self._mpi.allreduce(float(np.max(np.abs(xdot), initial=0.0)), op=MPI.MAX)
+        if size == 0.0:
+            return 0.0
+        h = 1e-6 * max(a, 1e-3) / size
+        return (self.radius(point.x + h * xdot) - self.radius(point.x - h * xdot)) / (2 * h)
+
+    def carry(self, source, point, scale: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The state and tangent of ``point`` of ``source``'s curve on this grid's local nodes (collective):
+        the deformation H - r^2/2 interpolated, r^2/2 added back
+        (:func:`~petsc_adhesion.discretization.contact.deformation_at`), and the tangent's nodal part;
+        ``scale`` (a contact radius for the frame of the edge) is not needed here."""
+        r = self.r[self.lo:self.hi]
+        return deformation_at(source, point.x, r) + 0.5 * r * r, rate_at(source, point.x, point.xdot, r)
 
     def inside(self, h: np.ndarray) -> bool:
         """True when every gap of the local H values h is open, on all ranks."""
@@ -187,9 +207,15 @@ class Problem:
         """
         room = h - self.law.wall
         toward = y > 0
-        alpha = self._mpi.allreduce(float(np.min(TO_WALL * room[toward] / y[toward], initial=1.0)), op=MPI.MIN)
-        self.guarded += alpha < 1.0
-        return alpha
+        return self._mpi.allreduce(float(np.min(TO_WALL * room[toward] / y[toward], initial=1.0)), op=MPI.MIN)
+
+    def record_guard(self) -> None:
+        """Count a Newton step the domain guard shortened (:meth:`step_fraction` below 1)."""
+        self.guarded += 1
+
+    def restore_counters(self, guarded: int) -> None:
+        """Take up the count of guarded steps a checkpoint saved."""
+        self.guarded = guarded
 
     # -- linearization --------------------------------------------------------------
     def linearize(self, H: PETSc.Vec, lam: float) -> None:
@@ -198,12 +224,16 @@ class Problem:
 
     def dp_all(self) -> np.ndarray:
         """P'(H) at the linearization point on all nodes, on every rank."""
-        if self._gather is None:
-            self._dpv = self.create_vec()
-            self._gather, self._dpall = PETSc.Scatter.toAll(self._dpv)
-        self._dpv.setArray(self.dp)
-        self._gather.scatter(self._dpv, self._dpall, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        return self._dpall.getArray(readonly=True)
+        return self.plumbing.everywhere(self.dp)
+
+    def jacobian_mult(self, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """y = G_H x = x - c A (P'(H) x) at the linearization point (eq. 23; the shell's)."""
+        self.plumbing.multiply_into(self.dp * x.getArray(readonly=True), y)
+        y.aypx(-self.c, x)
+
+    def jacobian_diagonal(self, d: PETSc.Vec) -> None:
+        """d = diag G_H = 1 - c A_ii P'_i, for -pc_type jacobi on the shell."""
+        d.setArray(1.0 - self.c * self.plumbing.diagonal() * self.dp)
 
     def jacobian_rows(self, out: np.ndarray) -> np.ndarray:
         """Local rows of G_H = I - c A diag(P'), dense, into ``out``."""
@@ -259,25 +289,20 @@ class Problem:
 
     def _apply(self, u: np.ndarray) -> np.ndarray:
         """A u on the local rows."""
-        self._pressure.setArray(u)
-        self.A.mult(self._pressure, self._Ap)
-        return self._Ap.getArray(readonly=True).copy()
+        return self.plumbing.multiply(u).copy()
 
     def _dot(self, u: np.ndarray, v: np.ndarray) -> float:
         return self._mpi.allreduce(float(np.dot(u, v)))
 
     def jacobian_transpose(self, x: PETSc.Vec, y: PETSc.Vec) -> None:
         """y = G_H^T x = x - c diag(P') A^T x at the linearization point."""
-        self.A.multTranspose(x, self._Ap)
-        y.setArray(x.getArray(readonly=True) - self.c * self.dp * self._Ap.getArray(readonly=True))
+        y.setArray(x.getArray(readonly=True) - self.c * self.dp * self.plumbing.multiply_transpose(x))
 
     def second_derivatives(self, h: np.ndarray, lam: float, v: np.ndarray, w: np.ndarray):
         """(w^T (dG_H/dH)[v], w^T (dG_H/dlambda) v) at the linearization point: G_H = I - c A diag(P'(H))
         (eq. 23) gives -c (A^T w) P''(H) v elementwise, and G_H does not depend on lambda.  P'' by
         :func:`~petsc_adhesion.model.pressure.curvature`."""
-        self._pressure.setArray(w)
-        self.A.multTranspose(self._pressure, self._Ap)
-        return -(self.c * self._Ap.getArray(readonly=True) * curvature(self.law, h) * v), 0.0
+        return -(self.c * self.plumbing.multiply_transpose(w) * curvature(self.law, h) * v), 0.0
 
     def parameter_derivatives(self, name: str, h: np.ndarray, lam: float, v: np.ndarray, w: np.ndarray,
                               gap: float):
@@ -299,39 +324,4 @@ class Problem:
 
     def destroy(self) -> None:
         """Free the PETSc objects held here, the influence matrix included."""
-        for obj in (self.jacobian, self._pressure, self._Ap, self.A):
-            obj.destroy()
-        if self._gather is not None:
-            for obj in (self._gather, self._dpv, self._dpall):
-                obj.destroy()
-
-
-class _Jacobian:
-    """MatPython context of G_H: y = x - c A (P'(H) x), diagonal 1 - c A_ii P'_i."""
-
-    def __init__(self, problem: Problem):
-        self.pb = problem
-        self._diag = None
-
-    def mult(self, mat, x, y):
-        """y = G_H x (eq. 23)."""
-        pb = self.pb
-        pb._pressure.setArray(pb.dp * x.getArray(readonly=True))
-        pb.A.mult(pb._pressure, y)
-        y.aypx(-pb.c, x)
-
-    def getDiagonal(self, mat, d):
-        """d = diag G_H, for -pc_type jacobi on the shell."""
-        pb = self.pb
-        if self._diag is None:
-            self._diag = local_diagonal(pb.A)
-        d.setArray(1.0 - pb.c * self._diag * pb.dp)
-
-
-def local_diagonal(A: PETSc.Mat) -> np.ndarray:
-    """The local part of A's diagonal (the Vec PETSc makes for it freed at once)."""
-    d = A.getDiagonal()
-    try:
-        return d.getArray(readonly=True).copy()
-    finally:
-        d.destroy()
+        self.plumbing.destroy()

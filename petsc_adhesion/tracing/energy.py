@@ -127,7 +127,7 @@ class _Pieces:
         if (k, j) not in self.arcs:
             seg = self.segments[k]
             a, b = seg.cont.points[j], seg.cont.points[j + 1]
-            self.arcs[k, j] = seg.finder._arc(a, b, True, arclength=True)[0]
+            self.arcs[k, j] = seg.finder.arc(a, b, True, arclength=True)[0]
         return self.arcs[k, j]
 
     def _along(self, k: int, j: int, pt) -> float:

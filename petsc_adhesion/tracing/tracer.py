@@ -32,11 +32,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from mpi4py import MPI
 
-from .. import brent
 from ..core.continuation import Continuation, Settings
 from ..core.events import EVENT_TOL, EventFinder
 from ..discretization import grid
-from ..discretization.edge_frame import EdgeFrameProblem, edge_level
+from ..discretization.contact import contact_radius, crossing
+from ..discretization.edge_frame import EdgeFrameProblem
 from ..discretization.influence import create_influence
 from ..discretization.problem import Problem
 from ..discretization.resolution import zone_of
@@ -71,49 +71,7 @@ def state_zone(problem, x: np.ndarray) -> float:
     return zone_of(problem.model, problem.law, problem.nodes(x), problem.gather(pressure))
 
 
-def contact_radius(problem, x: np.ndarray) -> float:
-    """Where H first rises through the edge level from the centre (0 when H(0) is above it); collective.
-
-    :func:`crossing` of the nodal H, as docs/numerics.md defines it."""
-    return crossing(problem.nodes(x), problem.gather(problem.separation(x)), edge_level(problem.law))
-
-
-def crossing(r: np.ndarray, H: np.ndarray, level: float) -> float:
-    """The first r where H rises through ``level`` (0 when H(0) is above it), on the cubic through the four
-    nodes about the crossing (three where the grid has no fourth).
-
-    Linear interpolation would err by h^2 t (1 - t) H'' / 2 with t the crossing's place in its element:
-    a term that jumps as refinement moves the nodes past the crossing and spoils the extrapolation of
-    the error bars; the cubic's error is O(h^4) and smooth enough.
-
-    >>> r = np.linspace(0.0, 2.0, 9)
-    >>> round(crossing(r, -1.0 + r**2 / 2, 0.0), 12)        # exact for a parabola: sqrt(2)
-    1.414213562373
-    """
-    if H[0] >= level:
-        return 0.0
-    k = int(np.argmax(H >= level))
-    if not H[k] >= level:                       # never rises through it on this grid
-        return float(r[-1])
-    lo = min(max(k - 2, 0), max(len(r) - 4, 0))
-    idx = np.arange(lo, min(lo + 4, len(r)))
-    rr, hh = r[idx], H[idx] - level
-
-    def g(t: float) -> float:
-        """The Lagrange polynomial through (rr, hh) at t."""
-        total = 0.0
-        for i in range(len(rr)):
-            w = np.prod([(t - rr[j]) / (rr[i] - rr[j]) for j in range(len(rr)) if j != i])
-            total += hh[i] * w
-        return total
-
-    a, b = float(r[k - 1]), float(r[k])
-    if g(a) * g(b) > 0:                         # cannot happen but for round-off at a node
-        return a if abs(H[k - 1] - level) < abs(H[k] - level) else b
-    return brent.root(g, a, b, xtol=1e-15 * max(1.0, b), rtol=4 * np.finfo(float).eps, maxiter=100)
-
-
-@dataclass
+@dataclass(frozen=True)
 class Segment:
     """A stretch of the curve on one grid: its problem, continuation and events."""
 
@@ -131,35 +89,6 @@ class Segment:
         self.problem.destroy()
 
 
-def _carry(old, new, x: np.ndarray, scale: float, xdot: np.ndarray | None = None) -> np.ndarray:
-    """The state x of ``old`` (or, with ``xdot``, its tangent's nodal part) on ``new``'s local nodes,
-    ``new``'s nodes taken at contact radius ``scale`` if it is in the frame of the edge.
-
-    H grows like r^2/2 (eq. 27): its deformation D = H - r^2/2 is interpolated
-    instead, since the far grid's spacing h would cost the quadratic h^2/8, and
-    is what the frame of the edge takes as its unknown.  A tangent carries over
-    linearly: its nodal part (dH/ds, or dD/ds in the frame of the edge).
-    """
-    r_old = old.nodes(x)
-    scaled = isinstance(new, EdgeFrameProblem)
-    r_new = (scale * new.rho if scaled else new.r)[new.lo:new.hi]
-    if xdot is not None:
-        return np.interp(r_new, r_old, old.gather(xdot[:old.hi - old.lo]))
-    field = old.gather(old.separation(x) - 0.5 * r_old[old.lo:old.hi] ** 2)
-    return np.interp(r_new, r_old, field) + (0.0 if scaled else 0.5 * r_new * r_new)
-
-
-def _radius_rate(problem, pt, a: float) -> float:
-    """d(contact radius)/ds along the tangent of a point of the physical frame (collective): a central
-    difference over a step that moves H by about 1e-6 of the contact radius."""
-    xdot = pt.xdot
-    size = problem.comm.tompi4py().allreduce(float(np.max(np.abs(xdot), initial=0.0)), op=MPI.MAX)
-    if size == 0.0:
-        return 0.0
-    h = 1e-6 * max(a, 1e-3) / size
-    return (contact_radius(problem, pt.x + h * xdot) - contact_radius(problem, pt.x - h * xdot)) / (2 * h)
-
-
 def carry(old: Segment, new: Segment, pt, scale: float | None = None):
     """The point ``pt`` of ``old``'s curve put on ``new``'s: interpolated, then a zero-length arclength
     correction there (regular at folds), its tangent oriented like pt's; None when that fails.
@@ -167,18 +96,8 @@ def carry(old: Segment, new: Segment, pt, scale: float | None = None):
     ``scale``: the contact radius to start from in the frame of the edge (default: pt's own,
     or where its H rises through the edge level).
     """
-    src, dst = old.problem, new.problem
-    scaled = isinstance(dst, EdgeFrameProblem)
-    if scaled and scale is None:
-        scale = src.radius(pt.x) if isinstance(src, EdgeFrameProblem) else contact_radius(src, pt.x)
-    shaped, slope = _carry(src, dst, pt.x, scale), _carry(src, dst, pt.x, scale, pt.xdot)
-    if scaled:
-        # the contact radius's rate: the tangent's own in the frame of the edge, else a difference
-        # quotient along it (with adot left 0 the new frame, which weighs a's relative change by
-        # (mu / a)^2, could orient its tangent against the curve's)
-        adot = src.radius(pt.xdot) if isinstance(src, EdgeFrameProblem) else _radius_rate(src, pt, scale)
-        if dst.last:
-            shaped, slope = np.append(shaped, scale), np.append(slope, adot)
+    dst = new.problem
+    shaped, slope = dst.carry(old.problem, pt, scale)      # each problem knows its own unknowns
     x = dst.create_vec()
     x.setArray(shaped)
     out = new.cont.project(x, pt.p, slope, pt.pdot)
@@ -257,11 +176,11 @@ class Tracer:
 
     def segment(self, kind: str, at: float | None = None, before: Segment | None = None,
                 level: int | None = None, settings: Settings | None = None, band: float | None = None,
-                zone: float | None = None) -> Segment:
+                zone: float | None = None, far: bool = False) -> Segment:
         """A segment of ``kind`` (fixed, edge, scaled) centred on ``at`` at refinement ``level`` (default:
         the tracer's), continuing ``before``'s budget, or with ``settings`` of its own; ``band``: the
         fine band of a scaled segment (:func:`scaled_band`), ``zone`` the cohesive zone its grid resolves
-        (:func:`state_zone`; None: the model's)."""
+        (:func:`state_zone`; None: the model's); ``far``: the far branch (:meth:`extend_back`)."""
         level = self.level if level is None else level
         if kind == "fixed":
             nodes = grid.nested(self.nodes, level - self.level)
@@ -291,7 +210,7 @@ class Tracer:
             raise
         # events located to tol in units of the curve's size (lambda grows like mu towards the JKR end)
         tol = (self.tol or EVENT_TOL) * s.unit
-        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, tol),
+        return Segment(kind, design, problem, cont, EventFinder(cont, self.events, tol), far=far,
                        zone=zone if kind == "scaled" else None)
 
     def run(self, lam0: float, started=None, pause=None) -> list[Segment]:
@@ -343,7 +262,8 @@ class Tracer:
             return None
         settings = replace(self.set, ds=self.set.ds, ds_max=1e15, p_min=p_min, p_max=math.inf,
                            observable_max=math.inf, max_steps=FAR_STEPS, max_folds=0, monitor=False)
-        seg = self.segment(first.kind, first.grid.edge if first.grid is not None else None, settings=settings)
+        seg = self.segment(first.kind, first.grid.edge if first.grid is not None else None, settings=settings,
+                           far=True)
         try:
             x = seg.problem.create_vec()
             x.setArray(a.x)
@@ -359,14 +279,9 @@ class Tracer:
             seg.destroy()
             raise RuntimeError(f"the far branch could not be traced back to lambda = {p_min:.6g} "
                                f"({seg.cont.stop[0]} at lambda = {seg.cont.points[-1].p:.6g})")
-        # in the curve's order; a point's step is then the one from the point before it, its length that
-        # point's distance along its own tangent (the corrector of the backward run measured it from the
-        # other end), and "far" marks it so that an event search on it takes that distance
-        pts = [p.reversed() for p in reversed(seg.cont.points)]
-        seg.cont.points = [replace(pts[0], ds=0.0, corrector="start")] + [
-            replace(b, ds=seg.cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p), corrector="far")
-            for a, b in zip(pts, pts[1:])]
-        seg.far = True
+        # in the curve's order; "far" marks its steps so that an event search on one takes its distance
+        # along the tangent of the point before it (Continuation.turn_around)
+        seg.cont.turn_around("far")
         self.segments.insert(0, seg)
         return seg
 
@@ -401,14 +316,14 @@ class Tracer:
             zone = st.get("zone")
             if zone is not None and not (isinstance(zone, float) and math.isfinite(zone) and zone > 0):
                 raise ValueError(f"segment {k + 1} resolves a cohesive zone of {zone!r}")
-            seg = self.segment(st["kind"], st["at"], settings=settings, band=st["band"], zone=zone)
+            seg = self.segment(st["kind"], st["at"], settings=settings, band=st["band"], zone=zone,
+                               far=st.get("far", False) is True)
             self.segments.append(seg)
             if seg.problem.layout.N != st["N"]:
                 raise ValueError(f"a segment {k + 1} of {st['N']} nodes, where this version makes {seg.problem.layout.N}")
-            seg.problem.guarded = st["guarded"]
+            seg.problem.restore_counters(st["guarded"])
             if not isinstance(st.get("far", False), bool) or st.get("far") and (k > 0 or st["kind"] == "scaled"):
                 raise ValueError(f"segment {k + 1} marked as the far branch where none can be")
-            seg.far = st.get("far", False)
             seg.cont.restore(cont)
         for seg, st in zip(self.segments, state["segments"]):
             seg.finder.restore(st["events"], lambda k: self.segments[k].finder)
