@@ -34,11 +34,11 @@ from .tracing.curve import Curve, Event, Solution  # noqa: E402
 from .version import __version__  # noqa: E402
 
 __all__ = ["__version__", "curve", "solve", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
-           "SolverChoice", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError"]
+           "SolverChoice", "PetscSettings", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError"]
 
 #: Names loaded on first use (their modules import petsc4py.PETSc, which starts PETSc).
 _LAZY = {"trace_curve": "tracing.trace", "solve_at": "tracing.trace", "GridChoice": "tracing.trace",
-         "SolverChoice": "tracing.trace", "CurveRequest": "tracing.trace", "curve_settings": "tracing.trace",
+         "SolverChoice": "tracing.trace", "PetscSettings": "core.newton", "CurveRequest": "tracing.trace", "curve_settings": "tracing.trace",
          "Settings": "core.continuation", "Model": "model.parameters", "Bodies": "model.physical"}
 
 

@@ -5,18 +5,23 @@
     print(c.pull_off.F, "+-", c.pull_off.F_err)
     s = pa.solve(-2.0, mu=1.0, snes_rtol=1e-12)                   # H(r), P(r), F at lambda = -2
 
-Each call is one run (:func:`petsc_adhesion.app.run.execute`) on the options
+Each call is one run (:func:`petsc_adhesion.app.run.execute`) of the options
 given as keywords: ``grid_n=201`` is ``-grid_n 201``, ``True`` a bare flag,
 ``False`` ``false``, a list a comma-separated value, ``None`` leaves the option
-out.  They are read into the library's objects and checked as the command line
-reads and checks them (the same one-line :class:`~petsc_adhesion.errors.InputError`,
-unknown options refused, before any work), and the library computes
+out.  They are read into the library's objects as values, without argv and
+without PETSc's options database (:class:`~petsc_adhesion.app.options.reading.Given`),
+and checked as the command line reads and checks its options (the same one-line
+:class:`~petsc_adhesion.errors.InputError`, unknown options refused, before any
+work); the library computes with those objects
 (:func:`~petsc_adhesion.tracing.trace.trace_curve`,
-:func:`~petsc_adhesion.tracing.trace.solve_at`); PETSc's options
-(``arc_snes_rtol=1e-10``, ``pc_type="lu"``) reach its solvers, and
-``PETSC_OPTIONS`` and ``.petscrc`` are read as at the command line's start.
-Each call has an options database of its own, so calls in one process do not
-see each other's options, nor the caller's (calls from several threads run one at a time); a call destroys the PETSc objects it
+:func:`~petsc_adhesion.tracing.trace.solve_at`).  PETSc's solver options
+(``arc_snes_rtol=1e-10``, ``pc_type="lu"``) become each solver's
+:class:`~petsc_adhesion.core.newton.PetscSettings`, under the command line's
+prefixes (``nat_``, ``arc_``, none for the solve); an option its solver does not
+read is refused.  Calls in one process do not see each other's options, nor the
+caller's, nor ``PETSC_OPTIONS`` or ``.petscrc`` (what the command line reads at its
+start; options files are the command line's: ``options_file=`` is refused).  Calls
+from several threads run one at a time; the first may come from any thread.  A call destroys the PETSc objects it
 makes, failed calls too (a PETSc type name that does not exist,
 ``pc_type="nonesuch"``, included).  ``out=``, ``summary=`` and ``plot=`` write
 the command line's files, all or nothing.  Without options, the library's own
@@ -53,7 +58,7 @@ def curve(mu: float | None = None, sigma: float | None = None, **options) -> Cur
     """
     if "adh_lambda" in options:
         raise InputError("-adh_lambda: curve() traces the whole curve; solve(lam) solves at one approach")
-    return _run(_argv(options, adh_mu=mu, adh_sigma=sigma))
+    return _run(_given(options, adh_mu=mu, adh_sigma=sigma))
 
 
 def solve(lam: float, mu: float | None = None, sigma: float | None = None, **options) -> Solution:
@@ -64,14 +69,16 @@ def solve(lam: float, mu: float | None = None, sigma: float | None = None, **opt
     """
     if isinstance(lam, bool) or not isinstance(lam, (int, float, np.integer, np.floating)) or not math.isfinite(lam):
         raise InputError(f"-adh_lambda: solve(lam) needs the approach lam, a finite real; got {lam!r}")
-    return _run(_argv(options, adh_lambda=lam, adh_mu=mu, adh_sigma=sigma))
+    return _run(_given(options, adh_lambda=lam, adh_mu=mu, adh_sigma=sigma))
 
 
-# -- options into a command line ---------------------------------------------------------------
+# -- keywords into options ---------------------------------------------------------------------
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 #: What the command line does with these other than compute: the API computes.
 _REFUSED = {"help": "see help(petsc_adhesion.curve) and docs/usage.md",
-            "version": "see petsc_adhesion.__version__"}
+            "version": "see petsc_adhesion.__version__",
+            "options_file": "give the options as keywords (an options file is the command line's)",
+            "options_file_yaml": "give the options as keywords (an options file is the command line's)"}
 
 
 def _value(name: str, v) -> list[str]:
@@ -92,10 +99,11 @@ def _value(name: str, v) -> list[str]:
                      f"True for a bare flag, or a list")
 
 
-def _argv(options: dict, **named) -> list[str]:
-    """The command line of the keyword ``options`` and the named parameters (name -> value, None: not given)."""
+def _given(options: dict, **named) -> dict:
+    """The options of the keyword ``options`` and the named parameters (name -> value, None: not given), as
+    the command line's words would give them: name -> value string, None for a bare flag."""
     aliases = {"adh_mu": "mu", "adh_sigma": "sigma", "adh_lambda": "lam"}
-    argv = ["petsc_adhesion"]
+    given = {}
     for name, v in named.items():
         if v is not None and name in options:
             raise InputError(f"-{name}: given twice, as {aliases[name]} and as {name}")
@@ -105,45 +113,46 @@ def _argv(options: dict, **named) -> list[str]:
         if name in _REFUSED:
             raise InputError(f"-{name}: not in the Python API; {_REFUSED[name]}")
         if v is not None:
-            argv += [f"-{name}", *_value(name, v)]
-    return argv
+            words = _value(name, v)
+            if name.lower() in given:
+                raise InputError(f"-{name}: given twice (option names ignore case)")
+            given[name.lower()] = words[0] if words else None
+    return given
 
 
 # -- a run --------------------------------------------------------------------------------------
-#: One run at a time in a process: PETSc's options database is the process's, and a run reads its options
-#: from it while it runs; two threads calling at once would read each other's.  The second call waits.
+#: One run at a time in a process: PETSc is the process's (its objects, its error state, the solvers' options
+#: under their own prefixes in its database) and not made for two threads at once.  The second call waits.
 _ONE_AT_A_TIME = threading.RLock()
 
-def _run(argv: list[str]):
-    """The run of ``argv`` in an options database of its own: the library's result, on every rank.  Its
-    errors raise: InputError for bad input, RuntimeError otherwise."""
-    from .cli import input_error
-
-    bad = input_error(argv)
-    if bad:
-        raise InputError(bad)
+def _run(given: dict):
+    """The run of the options ``given`` (a :class:`~.options.reading.Given`, no options database): the
+    library's result, on every rank.  Its errors raise: InputError for bad input, RuntimeError otherwise."""
     from ..core.start import start_petsc
 
     start_petsc(["petsc_adhesion"])                 # options are the run's own: none at start-up
     from petsc4py import PETSc
 
-    from ..core import capi
     from ..errors import collective
     from . import run
-    from .options.checks import petsc_error
-    from .options.reading import AppOptions
+    from .options.checks import PETSC_GLOBAL, petsc_error
+    from .options.reading import AppOptions, Given
 
+    for name in given:
+        if name in PETSC_GLOBAL:
+            raise InputError(f"-{name}: PETSc's own option of a program's start or end, not of one call; "
+                             f"not in the Python API")
     failed = result = None
-    with _ONE_AT_A_TIME, capi.options_from(argv):
+    with _ONE_AT_A_TIME:
+        opts = AppOptions(Given(given))
         try:
-            opts = AppOptions()
             if collective(PETSc.COMM_WORLD, run.is_study, opts):
                 raise InputError("-study_mu, -study_sigma, -study_option: a study of many cases runs from the "
                                  "command line (petsc-adhesion -options_file FILE); the Python API traces one curve")
             run.refuse_study_options(opts)
-            _, result = run.execute(opts, argv, report=False)
+            _, result = run.execute(opts, ["petsc_adhesion"], report=False)
         except PETSc.Error as e:
-            bad = petsc_error(e)                       # reads the run's options: inside the block
+            bad = petsc_error(e, opts)
             failed = bad if isinstance(bad, InputError) else RuntimeError(bad)
         except (InputError, RuntimeError, FloatingPointError, OSError) as e:
             failed = e

@@ -96,7 +96,7 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
     if opts.string("adh_guess") is not None and lam is None:
         raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
     opts.read_all()
-    check_unused(_is_app)
+    check_unused(_is_app, opts.db)
     check_consistency(opts, model)
     check_petsc_values(opts.db)
     targets = {k: opts.string(k) for k in _OUTPUTS if opts.string(k)}
@@ -126,12 +126,13 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         progress = Progress(comm, sys.stderr.isatty() if shown is None else shown, opts.real("progress_interval"))
         with ck.on_interrupt():
             result = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, checkpoint=ck,
-                                 progress=progress, started=check_unused)
+                                 progress=progress, started=lambda: check_unused(db=opts.db))
     else:
         guess = None if req.guess is None else \
             collective(comm, read_guess, req.guess, pressure_law(req.model).wall)
-        result = solve_at(req.lam, req.model, req.grid, req.solver, guess=guess, started=check_unused)
-    check_unused()
+        result = solve_at(req.lam, req.model, req.grid, req.solver, guess=guess,
+                          started=lambda: check_unused(db=opts.db))
+    check_unused(db=opts.db)
     status = 3 if req.lam is None and not result.complete else 0
     files = None
     try:

@@ -34,12 +34,11 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 from petsc4py import PETSc
 
-from ..core import capi
+from ..core.newton import is_solvers_own
 from ..errors import InputError, Interrupted, collective, say
 from ..io.layout import case_tree
 from ..io.resultset import check_targets, mark_done, written
@@ -48,7 +47,7 @@ from ..tracing.curve import program_record
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
 from .options.checks import check_unused
-from .options.reading import AppOptions, read_model
+from .options.reading import AppOptions, Given, read_model
 from .options.table import TABLE
 from .optionsfile import options_files
 from .progress import clock
@@ -76,6 +75,8 @@ class Case:
     index: int
     values: dict                                      # option name -> value
     error: str | None = field(default=None)          # why it cannot run, or None
+    #: its options read into the library's objects (:class:`~petsc_adhesion.app.run.Request`), once
+    request: object = field(default=None, repr=False, compare=False)
 
     @property
     def label(self) -> str:
@@ -148,37 +149,41 @@ def assign(todo: list[Case], groups: int) -> list[list[Case]]:
     return out
 
 
-@contextmanager
-def _case(c: Case, study: dict):
-    """The options of case ``c`` as the global database for the block (the study's comes back after)."""
-    with capi.options_of(c.options(study)):
-        yield AppOptions()
+def _case(c: Case, study: dict) -> AppOptions:
+    """The options of case ``c``, read as values (no options database)."""
+    return AppOptions(Given(c.options(study)))
 
 
-def _validate(todo: list[Case], study: dict, argv: list[str]) -> None:
-    """Each case's options checked as a single run's would be, before any work (every rank alike)."""
+def _validate(todo: list[Case], study: dict, argv: list[str], compute: str = "curve", keep: tuple = ()) -> None:
+    """Each case's options checked as a single run's would be and read into the library's objects
+    (``c.request``), before any work (every rank alike); an option of a case that nothing reads is refused
+    here (one a solver leaves unread, when it has read its own)."""
+    kinds, stop = KINDS[compute]
     for c in todo:
         try:
-            with _case(c, study) as opts:
-                read(opts, PETSc.COMM_SELF, argv)
+            opts = _case(c, study)
+            req = read(opts, PETSc.COMM_SELF, argv, kinds, bool(keep))
+            unread = set(opts.db.left())
+            check_unused(lambda name: name in unread, opts.db)
+            if stop and not opts.db.hasName("cont_F_max"):
+                req = replace(req, settings=replace(req.settings, observable_max=0.0))
+            c.request = (req, opts.flag("profiles"))
         except InputError as e:
             c.error = str(e)
 
 
-def _run(c: Case, study: dict, argv: list[str], comm, compute: str, keep: tuple) -> dict:
-    """One case on ``comm``: its summary and result tree on the group's rank 0 (None elsewhere)."""
-    kinds, stop = KINDS[compute]
-    with _case(c, study) as opts:
-        req = read(opts, comm, argv, kinds, bool(keep))
-        settings = replace(req.settings, observable_max=0.0) \
-            if stop and not opts.db.hasName("cont_F_max") else req.settings
-        curve = trace_curve(req.model, req.grid, req.solver, settings, req.curve, comm=comm, started=check_unused)
-        check_unused()
-        if comm.getRank():
-            return None
-        tree = case_tree(curve, keep=None if opts.flag("profiles") else keep)
-        return {"case": c.index, "values": c.values, "summary": curve.summary, "tree": tree,
-                "incomplete": not curve.complete}
+def _run(c: Case, comm, keep: tuple) -> dict:
+    """One case on ``comm``, from the objects its options were read into: its summary and result tree on the
+    group's rank 0 (None elsewhere)."""
+    req, profiles = c.request
+    # the solvers' own options: one they leave unread (a sub-PC's without a block PC) is refused
+    curve = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, comm=comm,
+                        started=lambda: check_unused(is_solvers_own))
+    if comm.getRank():
+        return None
+    tree = case_tree(curve, keep=None if profiles else keep)
+    return {"case": c.index, "values": c.values, "summary": curve.summary, "tree": tree,
+            "incomplete": not curve.complete}
 
 
 def _failure(c: Case, why: str) -> dict:
@@ -267,7 +272,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     todo = cases(axes)
     targets, journal = _files(opts, argv)
     given = opts.given()
-    _validate(todo, given, argv)
+    _validate(todo, given, argv, compute, keep)
     bad = [c for c in todo if c.error]
     if len(bad) == len(todo):
         raise InputError(bad[0].error)
@@ -280,7 +285,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     try:
         with journal.on_interrupt():
             records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
-                             lambda c, comm: _run(c, given, argv, comm, compute, keep), _brief, journal)
+                             lambda c, comm: _run(c, comm, keep), _brief, journal)
             if mpi.Get_rank() == 0:
                 failed = [_failure(c, c.error) for c in bad] + _failures(records)
                 done = [r for r in records if "error" not in r]

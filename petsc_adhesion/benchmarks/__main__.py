@@ -30,8 +30,8 @@ a measurement, not a test.
 
 ``-bench_profile`` profiles one more curve (cProfile, which slows the Python
 side) and prints the ten functions of largest own time; ``-log_view`` gives PETSc's account of all runs.
-The model and grids are fixed; other options reach the solvers (``-snes_*``,
-``-ksp_*``) and the continuation (``-cont_*``).
+The model and grids are fixed; other options reach the fixed-approach solve (``-snes_*``,
+``-ksp_*``, read into its settings) and the continuation (``-cont_*``).
 """
 from __future__ import annotations
 
@@ -48,8 +48,8 @@ petsc4py.init(sys.argv)
 from petsc4py import PETSc
 
 from ..app.options.checks import check_unused
-from ..app.options.reading import AppOptions, read_settings
-from ..core.newton import Newton
+from ..app.options.reading import AppOptions, read_petsc, read_settings
+from ..core.newton import Newton, PetscSettings
 from ..discretization import grid
 from ..discretization.influence import create_influence
 from ..discretization.problem import Problem
@@ -101,9 +101,11 @@ def mu1_problem() -> Problem:
     return discretize(Model(mu=1.0), grid.paper(10.0))
 
 
-def bench_solve(problem: Problem, repeats: int | None = None, lam: float = -2.0) -> dict:
-    """One fixed-lambda Newton solve from the rigid guess (target 20 ms), refactoring each repeat."""
-    newton = Newton(problem)
+def bench_solve(problem: Problem, repeats: int | None = None, lam: float = -2.0,
+                settings: PetscSettings = PetscSettings()) -> dict:
+    """One fixed-lambda Newton solve from the rigid guess (target 20 ms), refactoring each repeat; ``settings``:
+    its PETSc settings."""
+    newton = Newton(problem, settings=settings)
     H = problem.create_vec()
     times = []
     for _ in range(repeats or 7):
@@ -289,7 +291,7 @@ def main() -> int:
     parts = (only,) if only else PARTS[:-2] + (PARTS[-1:] if workprecision else ())
     results = bench_influence(repeats) if "influence" in parts else {}
     if "solve" in parts:
-        results |= bench_solve(mu1_problem(), repeats)
+        results |= bench_solve(mu1_problem(), repeats, settings=read_petsc(AppOptions(), ""))
     if "curve" in parts:
         results |= bench_curve(repeats)
     if "stiff" in parts:

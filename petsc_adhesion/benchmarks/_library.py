@@ -4,6 +4,7 @@ from __future__ import annotations
 from ..model.parameters import Model
 from ..tracing.trace import (
     CurveRequest,
+    PetscSettings,
     GridChoice,
     SolverChoice,
     curve_settings,
@@ -21,9 +22,10 @@ def flat(curve) -> dict:
 
 
 def traced(model: Model, nodes=None, pmat: str = "dense", settings=None, errors: bool = True,
-           target_error: float | None = None) -> dict:
+           target_error: float | None = None, correctors: PetscSettings = PetscSettings()) -> dict:
     """:func:`flat` of the curve of ``model`` on grids that follow the edge, or on the fixed ``nodes`` (r_m their
-    last), with the program's defaults but those given."""
+    last), with the program's defaults but those given (``correctors``: both correctors' PETSc settings)."""
     grid_choice = GridChoice() if nodes is None else GridChoice("given", r=nodes)
-    return flat(trace_curve(model, grid_choice, SolverChoice(pmat=pmat), settings or curve_settings(),
+    solver = SolverChoice(pmat=pmat, natural=correctors, arclength=correctors)
+    return flat(trace_curve(model, grid_choice, solver, settings or curve_settings(),
                             CurveRequest(error_bars=errors, target_error=target_error)))

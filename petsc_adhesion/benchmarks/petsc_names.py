@@ -11,6 +11,7 @@ from petsc4py import PETSc
 
 from ..app.options.checks import _NAMES_FILE
 from ..app.options.table import TABLE
+from ..core.newton import role_of
 
 __all__ = ["write"]
 
@@ -31,7 +32,8 @@ def write() -> None:
     variants += [("-adh_pmat", "band", "-pc_type", "lu", "-pc_factor_mat_solver_type", "mumps")]
     for extra in variants:
         proc = subprocess.run(base + list(extra), capture_output=True, text=True)
-        names |= set(re.findall(r"^\s+-([a-z][a-z0-9_]*)", proc.stdout, re.M))
+        # each solver's options under a prefix of its own (SolverOptions): the names as users give them
+        names |= {role_of(n) for n in re.findall(r"^\s+-([a-z][a-z0-9_]*)", proc.stdout, re.M)}
     names -= set(TABLE)
     names |= {"sub_" + n for n in names if n.startswith(("ksp_", "pc_"))}
     with open(_NAMES_FILE, "w") as f:

@@ -1,4 +1,4 @@
-"""The bordered system of the pseudo-arclength corrector (eq. 24-25) and its SNES, prefix ``arc_``.
+"""The bordered system of the pseudo-arclength corrector (eq. 24-25) and its SNES, role ``arc_``.
 
 Newton on [G(x, p); Q] = 0, Q the hyperplane through the last point normal to its
 tangent, has the Jacobian [[G_x, G_p], [w xdot^T, pdot]]: a PETSc MatNest holding the
@@ -14,22 +14,24 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-from .newton import PC_REUSE_ITS, PCReuse, Tolerances, create_snes, fresh_retry, guard, krylov_retry
+from .newton import PC_REUSE_ITS, PCReuse, PetscSettings, Tolerances, create_snes, fresh_retry, guard, krylov_retry
 
 __all__ = ["ARCLENGTH_PREFIX", "Bordered", "Border"]
 
-#: Options prefix of the arclength corrector and its tangents.
+#: Options prefix of the arclength corrector's role (its own prefix comes before it: SolverOptions).
 ARCLENGTH_PREFIX = "arc_"
 
 
 class Bordered:
-    """The pseudo-arclength system [G(x, p); Q] = 0 and its SNES (eq. 24-25), prefix ``arc_``.
+    """The pseudo-arclength system [G(x, p); Q] = 0 and its SNES (eq. 24-25), role ``arc_``, with the user's
+    PETSc ``settings`` (:class:`~petsc_adhesion.core.newton.PetscSettings`).
 
     X = (x, p) is one PETSc Vec, p its last entry (on the last rank), so the
     MatNest's blocks line up with X without index sets.
     """
 
-    def __init__(self, problem, pc_reuse_its: int = PC_REUSE_ITS, tol: Tolerances = Tolerances()):
+    def __init__(self, problem, pc_reuse_its: int = PC_REUSE_ITS, tol: Tolerances = Tolerances(),
+                 settings: PetscSettings = PetscSettings()):
         pb = self.pb = problem
         comm = self.comm = pb.comm
         self._mpi = comm.tompi4py()
@@ -52,11 +54,12 @@ class Bordered:
         self.K = PETSc.Mat().createNest([[pb.jacobian, self.column], [self.row, self.corner]], comm=comm)
         self.pmat = pb.create_pmat(1)
         self.reuse = PCReuse(pc_reuse_its)
-        self.snes = None
+        self.snes = self.options = None
         try:
-            self.snes = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R, self.form_jacobian,
-                                    self.K, self.pmat or self.K, pb.setup_pc, self.precheck, full_steps=True,
-                                    bordered=True, tol=tol)
+            self.snes, self.options = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R,
+                                                  self.form_jacobian, self.K, self.pmat or self.K, pb.setup_pc,
+                                                  self.precheck, full_steps=True, bordered=True, tol=tol,
+                                                  settings=settings)
         except BaseException:           # a solver option refused: free what is made
             self.destroy()
             raise
@@ -189,7 +192,7 @@ class Bordered:
     def destroy(self) -> None:
         """Free the PETSc objects made here."""
         for obj in (self.snes, self.K, self.pmat, self.column, self.row, self.corner,
-                    self.X, self.rhs, self.z, self.start, self.R, self.r, self.x, self.G):
+                    self.X, self.rhs, self.z, self.start, self.R, self.r, self.x, self.G, self.options):
             if obj is not None:
                 obj.destroy()
 

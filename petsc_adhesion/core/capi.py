@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["options_left", "error_message", "set_linesearch_type", "options_from", "options_of", "python_errors"]
+__all__ = ["options_left", "error_message", "set_linesearch_type", "linesearch_type", "options_from", "options_of", "python_errors"]
 
 
 @contextmanager
@@ -92,6 +92,18 @@ def set_linesearch_type(snes: PETSc.SNES, kind: str) -> None:
     if lib.SNESGetLineSearch(ctypes.c_void_p(snes.handle), ctypes.byref(ls)) or \
             lib.SNESLineSearchSetType(ls, kind.encode()):
         raise RuntimeError(f"cannot set the line search type '{kind}'")
+
+
+def linesearch_type(snes: PETSc.SNES) -> str:
+    """The line search type of ``snes`` as PETSc has it (SNESGetLineSearch, SNESLineSearchGetType)."""
+    lib = _lib()
+    ls, kind = ctypes.c_void_p(), ctypes.c_char_p()
+    lib.SNESGetLineSearch.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_void_p)]
+    lib.SNESLineSearchGetType.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_char_p)]
+    if lib.SNESGetLineSearch(ctypes.c_void_p(snes.handle), ctypes.byref(ls)) or \
+            lib.SNESLineSearchGetType(ls, ctypes.byref(kind)):
+        raise RuntimeError("cannot get the line search type")
+    return (kind.value or b"").decode()
 
 
 @contextmanager

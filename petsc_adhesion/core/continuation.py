@@ -20,8 +20,10 @@ outside the domain, a turn of the tangent, a corrector far from its predictor
 (curvature), or a large change of the watched observable; grow on fast Newton
 and a nearly straight curve.
 
-Solvers and their options prefixes: the natural corrector ``nat_`` (also the
-first point), the arclength corrector ``arc_`` (also every tangent along it).
+Solvers and their roles' options prefixes: the natural corrector ``nat_`` (also the
+first point), the arclength corrector ``arc_`` (also every tangent along it); each
+takes its :class:`~petsc_adhesion.core.newton.PetscSettings` under a prefix of its own
+before the role's (:class:`~petsc_adhesion.core.newton.SolverOptions`).
 """
 from __future__ import annotations
 
@@ -33,7 +35,7 @@ from petsc4py import PETSc
 
 from ..errors import tell
 from .bordered import Bordered
-from .newton import Tolerances, PC_REUSE_ITS, Newton, krylov_retry
+from .newton import Tolerances, PC_REUSE_ITS, Newton, PetscSettings, krylov_retry
 from .protocol import POINT_FIELDS, Point, check_point
 
 __all__ = ["Settings", "Continuation", "Correction", "NATURAL_PREFIX", "CORRECTORS"]
@@ -138,16 +140,19 @@ class Continuation:
     ``index0`` numbers the monitor's lines after those of earlier segments.
     """
 
-    def __init__(self, problem, settings: Settings | None = None, index0: int = 0):
+    def __init__(self, problem, settings: Settings | None = None, index0: int = 0,
+                 natural: PetscSettings = PetscSettings(), arclength: PetscSettings = PetscSettings()):
+        """``natural``, ``arclength``: the user's PETSc settings of the two correctors' solvers."""
         self.pb, self.set, self.index0 = problem, settings or Settings(), index0
         # the residual's rounding floor grows faster than the size of x and p (a soft sphere's deformation
         # and approach grow like mu, the coupling c like mu^1.5): measured 1e-5 to 6e-5 at mu = 1000 in the
         # frame of the edge (-nat_snes_monitor), where an absolute tolerance of 1e-10 is out of reach from a
         # first iterate already near the curve and Newton stalls for its 50 iterations: unit^2 times it
         tol = Tolerances(snes_atol=Tolerances.snes_atol * self.set.unit**2)
-        self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its, tol=tol)
+        self.newton = Newton(problem, NATURAL_PREFIX, full_steps=True, pc_reuse_its=self.set.pc_reuse_its, tol=tol,
+                             settings=natural)
         try:
-            self.bordered = Bordered(problem, self.set.pc_reuse_its, tol)
+            self.bordered = Bordered(problem, self.set.pc_reuse_its, tol, arclength)
         except BaseException:           # a solver option refused: free the Newton solver made
             self.newton.destroy()
             raise

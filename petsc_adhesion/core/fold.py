@@ -28,7 +28,8 @@ second parameter is set through the base problem (``set_parameter``), never by
 writing its fields.
 
 Unknowns are laid out as u's, then p as the last entry on the last rank.  The
-bordered solves of g have their own KSP, prefix ``fold_`` (-fold_ksp_type, ...).
+bordered solves of g have their own KSP, role ``fold_``, with the
+:class:`~petsc_adhesion.core.newton.PetscSettings` the fold system is given.
 """
 from __future__ import annotations
 
@@ -41,7 +42,7 @@ from petsc4py import PETSc
 
 from .bordered import Border
 from .capi import python_errors
-from .newton import TRUE_RESIDUAL, PCReuse, Tolerances
+from .newton import TRUE_RESIDUAL, PCReuse, PetscSettings, SolverOptions, Tolerances
 
 __all__ = ["FoldSystem", "FOLD_PREFIX"]
 
@@ -61,8 +62,11 @@ class FoldSystem:
         The second parameter s, as the base problem knows it ("sigma", "mu").
     """
 
-    def __init__(self, base, name: str):
+    def __init__(self, base, name: str, settings: PetscSettings = PetscSettings()):
+        if settings.snes_given:
+            raise ValueError(f"{settings.snes_given[0]}: the fold system's bordered solves have a KSP, no SNES")
         self.base, self.parameter = base, name
+        self.options = None
         self.comm = base.comm
         self._mpi = self.comm.tompi4py()
         self._h, self._G, self._u, self._y = (base.create_vec() for _ in range(4))
@@ -87,7 +91,8 @@ class FoldSystem:
             if self.last:
                 self.rhs.setValue(N, 1.0)
             self.rhs.assemble()
-            self.ksp = _bordered_ksp(self.comm, self.bordered, self.pmat or self.bordered, base)
+            self.options = SolverOptions(FOLD_PREFIX, settings)
+            self.ksp = _bordered_ksp(self.comm, self.bordered, self.pmat or self.bordered, base, self.options.prefix)
         except BaseException:               # a solver option refused: free what is made
             self.destroy()
             raise
@@ -287,19 +292,19 @@ class FoldSystem:
     def destroy(self) -> None:
         """Free the PETSc objects made here, the base problem's too."""
         for obj in (self.ksp, self.bordered, self.pmat, self.jacobian, self.rhs, self.z, self.work,
-                    self._h, self._G, self._u, self._y):
+                    self._h, self._G, self._u, self._y, self.options):
             if obj is not None:
                 obj.destroy()
         self.base.destroy()
 
 
-def _bordered_ksp(comm, M: PETSc.Mat, P: PETSc.Mat, base) -> PETSc.KSP:
-    """GMRES on the bordered matrix of g with the base problem's PC, prefix FOLD_PREFIX, tight: g is
-    the residual's last entry, so its error is the fold's."""
+def _bordered_ksp(comm, M: PETSc.Mat, P: PETSc.Mat, base, prefix: str) -> PETSc.KSP:
+    """GMRES on the bordered matrix of g with the base problem's PC, tight (g is the residual's last entry, so
+    its error is the fold's), with ``prefix``, its own of the role FOLD_PREFIX (:class:`SolverOptions`)."""
     tol = Tolerances()
     ksp = PETSc.KSP().create(comm)
     try:
-        ksp.setOptionsPrefix(FOLD_PREFIX)
+        ksp.setOptionsPrefix(prefix)
         ksp.setType("gmres")
         ksp.setTolerances(rtol=1e-2 * tol.ksp_rtol, atol=1e-2 * tol.ksp_atol, max_it=tol.ksp_max_it)
         ksp.setOperators(M, P)

@@ -2,17 +2,24 @@
 
 The problem (see :mod:`petsc_adhesion.core.continuation` for the protocol) supplies
 the residual, its linearization as an operator (often a shell), the matrix the
-preconditioner is built from, and the domain guard.  Each SNES gets its own
-options prefix and its defaults before ``setFromOptions()``, so every default
-can be overridden at run time, solver by solver, and nothing is written into
-the options database.
+preconditioner is built from, and the domain guard.  Each solver gets its
+defaults, then the user's :class:`PetscSettings` for its role (natural or
+arclength corrector, fixed-approach solve, fold system), then
+``setFromOptions()``: the values given are honoured exactly, the others keep the
+defaults.  The settings reach PETSc under an options prefix of the solver's own
+(:class:`SolverOptions`), so two solvers, of one curve or of two, never read
+each other's, nor what a caller left in the options database.
 
-    petsc-adhesion -adh_lambda -2 -snes_monitor -ksp_monitor   # the fixed-approach solve
-    petsc-adhesion -nat_snes_monitor -arc_ksp_converged_reason  # the continuation's correctors
+    Newton(problem, settings=PetscSettings(ksp_type="bcgs", snes_monitor=True))
+    petsc-adhesion -adh_lambda -2 -snes_monitor -ksp_monitor   # the command line reads them into these
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import itertools
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 from petsc4py import PETSc
@@ -20,7 +27,7 @@ from petsc4py import PETSc
 from ..core import capi
 from .capi import python_errors
 
-__all__ = ["Tolerances", "create_snes", "PCReuse", "fresh_retry", "krylov_retry", "guard", "Newton", "PC_REUSE_ITS", "TRUE_RESIDUAL"]
+__all__ = ["Tolerances", "PetscSettings", "SolverOptions", "role_of", "is_solvers_own", "create_snes", "PCReuse", "fresh_retry", "krylov_retry", "guard", "Newton", "PC_REUSE_ITS", "TRUE_RESIDUAL"]
 
 #: Keep a preconditioner while GMRES needs at most this many iterations with it.
 PC_REUSE_ITS = 10
@@ -39,10 +46,167 @@ class Tolerances:
     ksp_max_it: int = 400
 
 
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+#: PetscSettings' typed fields and the PETSc options they are (without prefix).
+_OPTION_OF = {"snes_rtol": "snes_rtol", "snes_atol": "snes_atol", "snes_stol": "snes_stol",
+              "snes_max_it": "snes_max_it", "linesearch": "snes_linesearch_type", "ksp_type": "ksp_type",
+              "ksp_rtol": "ksp_rtol", "ksp_atol": "ksp_atol", "ksp_max_it": "ksp_max_it", "pc_type": "pc_type",
+              "snes_monitor": "snes_monitor", "ksp_monitor": "ksp_monitor"}
+#: (lowest, highest, highest open) of the numbers: PETSc takes some out of range without a word.
+_RANGES = {"snes_rtol": (0.0, 1.0, True), "snes_atol": (0.0, math.inf, False), "snes_stol": (0.0, 1.0, True),
+           "snes_max_it": (1, 10**9, False), "ksp_rtol": (0.0, 1.0, True), "ksp_atol": (0.0, math.inf, False),
+           "ksp_max_it": (1, 10**9, False)}
+
+
+class _Options(Mapping):
+    """PetscSettings' further options: a mapping that cannot change (a value, hashed and pickled as one)."""
+
+    def __init__(self, items: Mapping):
+        self._items = dict(items)
+
+    def __getitem__(self, key):
+        return self._items[key]
+
+    def __iter__(self):
+        return iter(self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __hash__(self) -> int:
+        return hash(tuple(sorted(self._items.items(), key=lambda kv: kv[0])))
+
+    def __repr__(self) -> str:
+        return repr(self._items)
+
+
+@dataclass(frozen=True)
+class PetscSettings:
+    """What a user sets of one solver's PETSc objects; None (False for the monitors): the solver's default.
+
+    ``snes_rtol``, ``snes_atol``, ``snes_stol``, ``snes_max_it``: SNES's tolerances; ``linesearch``: its line
+    search type (``bt``, ``basic``, ...); ``ksp_type``, ``ksp_rtol``, ``ksp_atol``, ``ksp_max_it``: the
+    Krylov solver; ``pc_type``: the preconditioner; ``snes_monitor``, ``ksp_monitor``: PETSc's monitors;
+    ``options``: further PETSc options of this solver, by name without dash and prefix
+    (``{"ksp_gmres_restart": "60", "ksp_converged_reason": None}``, None a bare flag).  ValueError
+    for a value out of its range, one line naming it.
+
+    >>> PetscSettings(ksp_type="bcgs", ksp_rtol=1e-12).entries()
+    {'ksp_type': 'bcgs', 'ksp_rtol': '1e-12'}
+    """
+
+    snes_rtol: float | None = None
+    snes_atol: float | None = None
+    snes_stol: float | None = None
+    snes_max_it: int | None = None
+    linesearch: str | None = None
+    ksp_type: str | None = None
+    ksp_rtol: float | None = None
+    ksp_atol: float | None = None
+    ksp_max_it: int | None = None
+    pc_type: str | None = None
+    snes_monitor: bool = False
+    ksp_monitor: bool = False
+    options: Mapping[str, str | None] = field(default_factory=dict)
+
+    def __post_init__(self):
+        for name, (lo, hi, hi_open) in _RANGES.items():
+            v = getattr(self, name)
+            if v is None:
+                continue
+            integer = name.endswith("max_it")
+            kinds = (int, np.integer) if integer else (int, float, np.integer, np.floating)
+            if isinstance(v, bool) or not isinstance(v, kinds) or not (lo <= v < hi if hi_open else lo <= v <= hi) \
+                    or not math.isfinite(v):
+                what = f"an integer in [{lo}, {hi:g}]" if integer else \
+                    f"a real in [{lo:g}, {hi:g}{')' if hi_open else ']'}"
+                raise ValueError(f"{name}: expected {what}, got {v!r}")
+            object.__setattr__(self, name, int(v) if integer else float(v))
+        for name in ("linesearch", "ksp_type", "pc_type"):
+            v = getattr(self, name)
+            if v is not None and not (isinstance(v, str) and _NAME.fullmatch(v)):
+                raise ValueError(f"{name}: expected the name of a PETSc type, got {v!r}")
+        for name in ("snes_monitor", "ksp_monitor"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name}: expected True or False, got {getattr(self, name)!r}")
+        if not isinstance(self.options, Mapping):
+            raise ValueError(f"options: expected a mapping of PETSc option names to strings, got {self.options!r}")
+        for k, v in self.options.items():
+            if not (isinstance(k, str) and _NAME.fullmatch(k)):
+                raise ValueError(f"options: {k!r} is not a PETSc option name (give it without dash or prefix)")
+            field_name = next((f for f, o in _OPTION_OF.items() if o == k), None)
+            if field_name is not None and getattr(self, field_name) not in (None, False):
+                raise ValueError(f"options: {k} is given as the field {field_name} too; give it once")
+            if v is not None and not isinstance(v, str):
+                raise ValueError(f"options: {k} = {v!r}; expected a string, or None for a bare flag")
+        object.__setattr__(self, "options", _Options(self.options))
+
+    def entries(self) -> dict:
+        """The PETSc options these settings give (name without dash and prefix -> value, None a bare flag)."""
+        out = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "options" or v is None or v is False:
+                continue
+            out[_OPTION_OF[f.name]] = None if v is True else (v if isinstance(v, str) else repr(v))
+        return out | dict(self.options)
+
+    @property
+    def snes_given(self) -> list[str]:
+        """The options given that only a SNES reads."""
+        return [k for k in self.entries() if k.startswith("snes_")]
+
+
+class SolverOptions:
+    """One solver's settings in PETSc's options database under a prefix of its own, for the solver's lifetime.
+
+    ``prefix``: the role's (``nat_``, ``arc_``, ``fold_``, none) after ``pa<n>_``, n counting the solvers made
+    in the process: two solvers never read each other's options, nor the role's own options a caller may have
+    left in the database (the command line reads those into :class:`PetscSettings`).  The values stay in
+    the database while the solver lives and go in :meth:`destroy`: PETSc reads some of them only at the
+    first solve (``ksp_converged_reason``, ``snes_view``, a block preconditioner's ``sub_`` options, a
+    factorization's), after ``setFromOptions()``.
+    """
+
+    _made = itertools.count(1)
+
+    def __init__(self, role: str, settings: PetscSettings):
+        self.prefix = f"pa{next(SolverOptions._made)}_{role}"
+        self.names: list[str] = []
+        db = PETSc.Options()
+        for name, value in settings.entries().items():
+            db.setValue(self.prefix + name, value)
+            self.names.append(self.prefix + name)
+
+    def destroy(self) -> None:
+        """Take the values out of the options database again."""
+        db = PETSc.Options()
+        for name in self.names:
+            db.delValue(name)
+        self.names = []
+
+
+def is_solvers_own(name: str) -> bool:
+    """Whether an option of the database is one a solver put there under its own prefix (:class:`SolverOptions`)."""
+    return re.fullmatch(r"pa\d+_.*", name) is not None
+
+
+def role_of(name: str) -> str:
+    """An option name as the user gave it: without the solver's own ``pa<n>_`` (see :class:`SolverOptions`).
+
+    >>> role_of("pa12_arc_ksp_type"), role_of("pa3_snes_rtol"), role_of("nat_snes_rtol")
+    ('arc_ksp_type', 'snes_rtol', 'nat_snes_rtol')
+    """
+    m = re.fullmatch(r"pa\d+_(.*)", name)
+    return m.group(1) if m else name
+
+
 def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, jacobian,
                 J: PETSc.Mat, P: PETSc.Mat, setup_pc, precheck, full_steps: bool = False,
-                bordered: bool = False, tol: Tolerances = Tolerances()) -> PETSc.SNES:
-    """A Newton-Krylov SNES with prefix ``prefix``, configured, then ``setFromOptions()``.
+                bordered: bool = False, tol: Tolerances = Tolerances(),
+                settings: PetscSettings = PetscSettings()) -> tuple[PETSc.SNES, SolverOptions]:
+    """A Newton-Krylov SNES for the role ``prefix``, configured with its defaults, then ``settings``
+    (:class:`SolverOptions`), then ``setFromOptions()``; the SNES and its options (freed after it).
 
     Parameters
     ----------
@@ -61,9 +225,10 @@ def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, ja
     bordered
         Whether J is the bordered matrix of the arclength corrector (for ``setup_pc``).
     """
-    snes = PETSc.SNES().create(comm)
+    snes, options = PETSc.SNES().create(comm), None
     try:            # an option refused (a type name PETSc does not know): the SNES would outlive the call
-        snes.setOptionsPrefix(prefix)
+        options = SolverOptions(prefix, settings)
+        snes.setOptionsPrefix(options.prefix)
         snes.setFunction(function, residual)
         snes.setJacobian(jacobian, J, P)
         snes.setType("newtonls")
@@ -78,8 +243,10 @@ def create_snes(comm: PETSc.Comm, prefix: str, function, residual: PETSc.Vec, ja
         snes.setFromOptions()
     except BaseException:
         snes.destroy()
+        if options is not None:
+            options.destroy()
         raise
-    return snes
+    return snes, options
 
 
 class PCReuse:
@@ -200,24 +367,26 @@ class Newton:
     problem
         Implements the protocol of :mod:`petsc_adhesion.core.continuation`.
     prefix
-        Options prefix of the SNES ("" for the fixed-approach solve, "nat_" for
-        the natural corrector of the continuation).
+        The role's options prefix ("" for the fixed-approach solve, "nat_" for the natural
+        corrector of the continuation); the SNES's own comes before it (:class:`SolverOptions`).
     full_steps
         See :func:`create_snes`.
     pc_reuse_its
         See :class:`PCReuse`.
+    settings
+        The user's PETSc settings of this solver (:class:`PetscSettings`).
     """
 
     def __init__(self, problem, prefix: str = "", full_steps: bool = False, pc_reuse_its: int = PC_REUSE_ITS,
-                 tol: Tolerances = Tolerances()):
-        self.pb, self.p, self.snes = problem, 0.0, None
+                 tol: Tolerances = Tolerances(), settings: PetscSettings = PetscSettings()):
+        self.pb, self.p, self.snes, self.options = problem, 0.0, None, None
         self.pmat = problem.create_pmat(0)
         self.reuse = PCReuse(pc_reuse_its)
         self.work, residual = problem.create_vec(), problem.create_vec()
         try:
-            self.snes = create_snes(problem.comm, prefix, self._function, residual, self._jacobian,
-                                    problem.jacobian, self.pmat or problem.jacobian, problem.setup_pc,
-                                    self._precheck, full_steps, tol=tol)
+            self.snes, self.options = create_snes(problem.comm, prefix, self._function, residual, self._jacobian,
+                                                  problem.jacobian, self.pmat or problem.jacobian, problem.setup_pc,
+                                                  self._precheck, full_steps, tol=tol, settings=settings)
         except BaseException:           # a solver option refused: free what is made
             self.destroy()
             raise
@@ -284,6 +453,6 @@ class Newton:
 
     def destroy(self) -> None:
         """Free the PETSc objects made here."""
-        for obj in (self.snes, self.pmat, self.work):
+        for obj in (self.snes, self.pmat, self.work, self.options):
             if obj is not None:
                 obj.destroy()

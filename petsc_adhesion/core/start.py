@@ -14,6 +14,7 @@ import atexit
 import importlib
 import signal
 import sys
+import threading
 
 __all__ = ["start_petsc", "KEPT_SIGNALS"]
 
@@ -46,9 +47,12 @@ def start_petsc(argv: list[str] | None = None) -> bool:
         PETSc.Options().delValue("no_signal_handler")
     if helping:
         PETSc.Options().setValue("help", value)
-    for s, handler in kept.items():
-        if handler is not None:
-            signal.signal(s, handler)
+    # Python sets handlers from the main thread only (ValueError elsewhere); from another thread (a web
+    # server's, a notebook executor's) PETSc, started without its own, changed none to put back
+    if threading.current_thread() is threading.main_thread():
+        for s, handler in kept.items():
+            if handler is not None:
+                signal.signal(s, handler)
     atexit.register(_quiet_finalize, not any(a.lstrip("-") == "options_left" for a in argv))
     return True
 

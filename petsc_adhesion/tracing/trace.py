@@ -8,13 +8,18 @@
 Each takes plain typed objects: the :class:`~petsc_adhesion.model.parameters.Model`
 (mu, sigma, roughness, r_m, the far field, the physical inputs), a
 :class:`GridChoice`, a :class:`SolverChoice` (the matrix handed to the
-preconditioner), the continuation's :class:`~petsc_adhesion.core.continuation.Settings`
-(step control and stops; :func:`curve_settings` gives a curve's) and a
-:class:`CurveRequest` (what the curve reports).  PETSc's own options reach each
-solver through its prefix (``nat_``, ``arc_``, none for the fixed-approach
-solve) from the options database, as PETSc's objects read them; the command
-line and the Python API (:mod:`petsc_adhesion.app`) are thin layers that read
-their options into these objects and call these two functions.
+preconditioner, and each solver's PETSc settings, a
+:class:`~petsc_adhesion.core.newton.PetscSettings` by role), the continuation's
+:class:`~petsc_adhesion.core.continuation.Settings` (step control and stops;
+:func:`curve_settings` gives a curve's) and a :class:`CurveRequest` (what the
+curve reports).  They read nothing from PETSc's options database: each solver
+takes its settings under a prefix of its own
+(:class:`~petsc_adhesion.core.newton.SolverOptions`).  The command line and the
+Python API (:mod:`petsc_adhesion.app`) are thin layers that read their options
+into these objects and call these two functions.
+
+    fast = SolverChoice(arclength=PetscSettings(ksp_type="bcgs", ksp_rtol=1e-11))
+    c = trace_curve(Model(mu=1.0), solver=fast)
 
 Collective: under MPI every rank calls them with the same arguments and gets
 the same result.
@@ -31,7 +36,7 @@ from .. import brent
 from ..core.continuation import Continuation, Settings
 from ..core.start import start_petsc
 from ..core.events import EVENT_TOL, jumps
-from ..core.newton import PC_REUSE_ITS, Newton
+from ..core.newton import PC_REUSE_ITS, Newton, PetscSettings
 from ..discretization import grid, preconditioning, resolution
 from ..discretization.influence import create_influence
 from ..discretization.problem import Problem, far_approach, step_scale
@@ -41,7 +46,7 @@ from .curve import Curve, Solution, model_record, program_record
 from .edge_grids import MU_TRUNCATED, RMAX, grid_for
 from .tracer import Tracer
 
-__all__ = ["GridChoice", "SolverChoice", "CurveRequest", "curve_settings", "trace_curve", "solve_at", "rigid_edge",
+__all__ = ["GridChoice", "SolverChoice", "PetscSettings", "check_inputs", "CurveRequest", "curve_settings", "trace_curve", "solve_at", "rigid_edge",
            "discretize", "configure_solvers", "expected_end", "F_MAX", "GRID_KINDS", "spring_start",
            "step_scale"]
 
@@ -100,12 +105,33 @@ class GridChoice:
 @dataclass(frozen=True)
 class SolverChoice:
     """What the preconditioner of every solver is built from (``pmat``: dense, band or shell,
-    :mod:`~petsc_adhesion.discretization.preconditioning`; ``band``: the half bandwidth of band) and how long a
-    preconditioner is kept (``pc_reuse_its``: while Krylov needs at most that many iterations)."""
+    :mod:`~petsc_adhesion.discretization.preconditioning`; ``band``: the half bandwidth of band), how long a
+    preconditioner is kept (``pc_reuse_its``: while Krylov needs at most that many iterations), and the PETSc
+    settings of each solver by its role (:class:`~petsc_adhesion.core.newton.PetscSettings`): ``natural``
+    (the natural corrector and the first point, the command line's ``-nat_``), ``arclength`` (the arclength
+    corrector and its tangents, ``-arc_``), ``fixed`` (the solve at one approach, no prefix), ``fold`` (the
+    fold system's bordered solves, ``-fold_``; :class:`~petsc_adhesion.core.fold.FoldSystem` takes them, the
+    critical-roughness calls do not yet).  Settings not given keep each solver's defaults; settings of a
+    solver the call does not make are refused (ValueError)."""
 
     pmat: str = "dense"
     band: int = preconditioning.BAND
     pc_reuse_its: int = PC_REUSE_ITS
+    natural: PetscSettings = PetscSettings()
+    arclength: PetscSettings = PetscSettings()
+    fixed: PetscSettings = PetscSettings()
+    fold: PetscSettings = PetscSettings()
+
+    def __post_init__(self):
+        if self.pmat not in preconditioning.KINDS:
+            raise ValueError(f"pmat '{self.pmat}': expected one of {', '.join(preconditioning.KINDS)}")
+        for name in ("band", "pc_reuse_its"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+                raise ValueError(f"{name}: expected an integer >= 0, got {v!r}")
+        for role in ("natural", "arclength", "fixed", "fold"):
+            if not isinstance(getattr(self, role), PetscSettings):
+                raise ValueError(f"{role}: expected a PetscSettings, got {getattr(self, role)!r}")
 
     def strategy(self):
         """A fresh preconditioning strategy of this kind."""
@@ -168,6 +194,55 @@ def _init() -> None:
     start_petsc()
 
 
+#: The physical inputs that must be finite and positive, and what each is.
+_POSITIVE = (("radius", "the sphere's radius (m)"), ("young1", "Young's modulus (Pa)"),
+             ("epsilon", "the equilibrium spacing epsilon (m)"))
+
+
+def check_inputs(model, grid_choice: GridChoice = GridChoice(), solver: SolverChoice = SolverChoice(),
+                 lam: float | None = None) -> None:
+    """ValueError, one line naming the parameter and what it accepts, for arguments the library cannot
+    compute with: mu or sigma not finite or negative, physical inputs that are not finite and positive, an
+    approach that is not a finite real, objects of another type; before any work (the command line refuses
+    the same in its options)."""
+    from ..model.parameters import Model
+
+    if not isinstance(model, Model):
+        raise ValueError(f"model: expected a Model, got {type(model).__name__}")
+    if not isinstance(grid_choice, GridChoice):
+        raise ValueError(f"grid_choice: expected a GridChoice, got {type(grid_choice).__name__}")
+    if not isinstance(solver, SolverChoice):
+        raise ValueError(f"solver: expected a SolverChoice, got {type(solver).__name__}")
+    for name in ("mu", "sigma"):
+        v = getattr(model, name)
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v) \
+                or v < 0:
+            raise ValueError(f"{name}: expected a finite real >= 0, got {v!r}")
+    if model.rmax is not None and not (math.isfinite(model.rmax) and model.rmax > 0):
+        raise ValueError(f"rmax: expected a finite real > 0 (the end of the domain), got {model.rmax!r}")
+    bodies = model.bodies
+    if bodies is not None:
+        given = [(f, what) for f, what in _POSITIVE] + \
+            [(f, what) for f, what in (("gamma", "the work of adhesion (J/m^2)"), ("hamaker", "the Hamaker constant (J)"),
+                                      ("radius2", "the second radius (m)"), ("young2", "the second modulus (Pa)"),
+                                      ("rms", "the rms roughness (m)")) if getattr(bodies, f) is not None]
+        for f, what in given:
+            v = getattr(bodies, f)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or \
+                    not math.isfinite(v) or v < 0 or (v == 0 and f != "rms"):
+                raise ValueError(f"{f}: expected {what}, a finite real {'>= 0' if f == 'rms' else '> 0'}, got {v!r}")
+    if lam is not None and (isinstance(lam, bool) or not isinstance(lam, (int, float, np.integer, np.floating))
+                            or not math.isfinite(lam)):
+        raise ValueError(f"lam: expected the approach, a finite real, got {lam!r}")
+    # settings of a solver the call does not make: refused, as the command line refuses its options
+    used = ("fixed",) if lam is not None else ("natural", "arclength")
+    for role in ("natural", "arclength", "fixed", "fold"):
+        if role not in used and getattr(solver, role) != PetscSettings():
+            call = "solve_at" if lam is not None else "trace_curve"
+            raise ValueError(f"solver.{role}: settings of a solver {call} does not make (it makes "
+                             f"{' and '.join(used)}); leave them out")
+
+
 def _domain(model, grid_choice: GridChoice):
     """``model`` with its r_m: its own, or the grid's default."""
     return model if model.rmax is not None else replace(model, rmax=grid_choice.default_rmax)
@@ -177,6 +252,7 @@ def configure_solvers(model, grid_choice: GridChoice = GridChoice(), solver: Sol
                       settings: Settings | None = None, lam: float | None = None, comm=None) -> None:
     """Make the solvers of a curve (or, at a fixed approach ``lam``, of the solve) and free them again: each
     reads its options, and with -help prints those it reads."""
+    check_inputs(model, grid_choice, solver, lam)
     _init()
     from petsc4py import PETSc
 
@@ -187,9 +263,10 @@ def configure_solvers(model, grid_choice: GridChoice = GridChoice(), solver: Sol
     problem = discretize(model, r, solver.strategy(), comm or PETSc.COMM_WORLD)
     try:
         if lam is None:
-            Continuation(problem, settings or curve_settings(step_scale(model))).destroy()
+            Continuation(problem, settings or curve_settings(step_scale(model)), natural=solver.natural,
+                         arclength=solver.arclength).destroy()
         else:
-            Newton(problem, "", pc_reuse_its=solver.pc_reuse_its).destroy()
+            Newton(problem, "", pc_reuse_its=solver.pc_reuse_its, settings=solver.fixed).destroy()
     finally:
         problem.destroy()
 
@@ -231,6 +308,9 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
     Raises RuntimeError when the curve cannot start; a curve that ends early is returned with its warnings
     (``complete`` False).
     """
+    check_inputs(model, grid_choice, solver)
+    if not isinstance(request, CurveRequest):
+        raise ValueError(f"request: expected a CurveRequest, got {type(request).__name__}")
     _init()
     from petsc4py import PETSc
 
@@ -246,7 +326,8 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
     nodes = grid_choice.nodes(model.rmax)
     t0 = t1 = time.perf_counter()
     tracer = Tracer(model, settings, results.curve_events(request.at_lambda, request.spring), request.event_tol, nodes=nodes,
-                    pmat=solver.strategy(), rmax=model.rmax, comm=comm)
+                    pmat=solver.strategy(), rmax=model.rmax, comm=comm, natural=solver.natural,
+                    arclength=solver.arclength)
     kinds = request.kinds
     kept = (lambda label: True) if kinds is None else (lambda label: label in kinds or label == "lambda")
     try:
@@ -312,13 +393,14 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
 
 def solve_at(lam: float, model, grid_choice: GridChoice = GridChoice(), solver: SolverChoice = SolverChoice(),
              guess: tuple | None = None, comm=None, started=None) -> Solution:
-    """The state at the one approach ``lam`` (eq. 12 by Newton, the solver without options prefix; collective).
+    """The state at the one approach ``lam`` (eq. 12 by Newton, its PETSc settings ``solver.fixed``; collective).
 
     The grid that follows the contact edge is centred on the rigid sphere's edge at ``lam``.  ``guess``:
     (r, H) of an earlier state, interpolated as the initial guess (its deformation H - r^2/2 linearly); the
     rigid state of eq. (27) by default.  ``started``: called once the solver has read its options.
     RuntimeError when Newton does not converge.
     """
+    check_inputs(model, grid_choice, solver, lam)
     _init()
     from petsc4py import PETSc
 
@@ -328,7 +410,7 @@ def solve_at(lam: float, model, grid_choice: GridChoice = GridChoice(), solver: 
     r = grid_for(model, rigid_edge(lam), rmax=model.rmax).nodes() if r is None else r
     problem, newton, H = discretize(model, r, solver.strategy(), comm), None, None
     try:                    # on failure too: the shell's context holds a cycle that gc cannot free
-        newton = Newton(problem, "", pc_reuse_its=solver.pc_reuse_its)
+        newton = Newton(problem, "", pc_reuse_its=solver.pc_reuse_its, settings=solver.fixed)
         H = problem.rigid(lam, problem.create_vec())
         if guess is not None:
             r0, h0 = guess

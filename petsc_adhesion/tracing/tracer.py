@@ -33,6 +33,7 @@ import numpy as np
 from mpi4py import MPI
 
 from ..core.continuation import Continuation, Settings
+from ..core.newton import PetscSettings
 from ..core.events import EVENT_TOL, EventFinder
 from ..discretization import grid
 from ..discretization.contact import contact_radius, crossing
@@ -165,11 +166,14 @@ class Tracer:
     """Trace a curve in segments: on a fixed grid (one segment), or on grids that follow the edge."""
 
     def __init__(self, model, settings: Settings, events, tol=None, nodes=None, pmat=None, level: int = 0,
-                 rmax: float = RMAX, comm=None):
+                 rmax: float = RMAX, comm=None, natural: PetscSettings = PetscSettings(),
+                 arclength: PetscSettings = PetscSettings()):
         """``nodes``: a fixed grid, or None for grids following the edge at refinement ``level`` out to
         ``rmax``; ``pmat``: the preconditioning strategy of every segment's problem; ``comm``: the
-        communicator of every segment (PETSc.COMM_WORLD by default)."""
+        communicator of every segment (PETSc.COMM_WORLD by default); ``natural``, ``arclength``: the
+        PETSc settings of every segment's correctors."""
         self.model, self.set, self.events, self.tol, self.comm = model, settings, list(events), tol, comm
+        self.natural, self.arclength = natural, arclength
         self.nodes, self.pmat, self.level, self.rmax = nodes, pmat, level, rmax
         self.segments: list[Segment] = []
         self.sharp = None
@@ -204,7 +208,8 @@ class Tracer:
             s = replace(s, ds=before.cont.ds, max_steps=max(1, s.max_steps - steps),
                         max_folds=s.max_folds - folds)
         try:                    # a solver option refused: the problem's shell holds a cycle that gc cannot free
-            cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments) if before else 0)
+            cont = Continuation(problem, s, index0=sum(len(g.cont.points) for g in self.segments) if before else 0,
+                                natural=self.natural, arclength=self.arclength)
         except BaseException:
             problem.destroy()
             raise

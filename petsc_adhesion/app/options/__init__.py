@@ -2,10 +2,12 @@
 
 The defaults belong to the objects the options configure (``Model``, the grid,
 the continuation ``Settings``, the solvers), and the table reads them from
-there: the library never imports the command line.  PETSc's own options
-(``-snes_*``, ``-ksp_*``, ``-pc_*``, ``-log_view`` ...) are left to PETSc,
-solver by solver through their prefixes; any option that nobody used by the
-end of a run is reported as unknown (:func:`~.checks.check_unused`).
+there: the library never imports the command line.  The solvers' PETSc options
+(``-snes_*``, ``-ksp_*``, ``-pc_*`` under ``nat_``, ``arc_`` or no prefix) are read
+here into each solver's :class:`~petsc_adhesion.core.newton.PetscSettings`
+(:func:`~.reading.read_petsc`); PETSc's others (``-log_view`` ...) are left to
+PETSc; any option that nobody used by the end of a run is reported as unknown
+(:func:`~.checks.check_unused`), a solver's by the name the user gave it.
 
 =============  ================================================================
 module         what

@@ -11,6 +11,7 @@ from petsc4py import PETSc
 
 from ... import brent
 from ...core import capi
+from ...core.newton import role_of
 from ...discretization.preconditioning import BASE_BYTES, memory_available, memory_needed
 from ...errors import InputError
 from ...io.inputs import size_words
@@ -200,7 +201,7 @@ _INPUT_CODES = (56, 62, 63, 86, 92)
 _GENERIC = {"type", "snes", "ksp", "view", "monitor", "options", "file", "grid", "cont", "adh"}
 
 
-def petsc_error(err: PETSc.Error) -> InputError | str:
+def petsc_error(err: PETSc.Error, opts: AppOptions | None = None) -> InputError | str:
     """What a PETSc error means for the user: the option behind it (an InputError), or one line.
 
     PETSc keeps the specific message of its last error (PetscErrorMessage); the
@@ -209,7 +210,7 @@ def petsc_error(err: PETSc.Error) -> InputError | str:
     """
     detail = capi.error_message(err.ierr) or f"PETSc error {err.ierr}"
     # the application's options are checked before PETSc sees them; a number quoted is no one's name
-    given = {k: v for k, v in AppOptions().given().items() if k not in TABLE}
+    given = {k: v for k, v in (opts or AppOptions()).given().items() if k not in TABLE}
     words = set(detail.lower().replace("'", " ").replace('"', " ").replace(",", " ").replace(":", " ").split())
     by_value = [k for k, v in given.items() if v and v.lower() in words and not _NUMBER.fullmatch(v.strip())]
     by_name = [k for k in given if any(len(w) >= 3 and w not in _GENERIC and w in words for w in k.lower().split("_"))]
@@ -251,14 +252,18 @@ def _prefixes() -> tuple:
     return tuple(p for p, _ in SOLVER_PREFIXES)
 
 
-def check_unused(judged=lambda name: True) -> None:
+def check_unused(judged=lambda name: True, db=None) -> None:
     """Raise :class:`InputError` for an option that nobody read.
 
     ``judged`` picks the options to judge: the application's own, which are
     all read up front, before any work; or all of them once the solvers are
-    set up, when PETSc has read its own.
+    set up, when PETSc has read its own.  ``db``: the run's options when they
+    are not PETSc's database (a :class:`~.reading.Given`, the Python API's), judged
+    beside the solvers' own in PETSc's.
     """
-    left = [n for n in capi.options_left() if judged(n) and n not in PETSC_GLOBAL]
+    names = (db.left() if hasattr(db, "left") else []) + capi.options_left()
+    # a solver's options are in the database under its own prefix (SolverOptions): named as the user gave them
+    left = [role_of(n) for n in names if judged(n) and n not in PETSC_GLOBAL]
     if not left:
         return
     name = left[0]

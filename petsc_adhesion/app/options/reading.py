@@ -15,11 +15,16 @@ from ...model.parameters import Model
 from ...model.parameters import tabor
 from ...model.physical import Bodies
 from ...model.roughness import Measured
+from ...core.bordered import ARCLENGTH_PREFIX
+from ...core.continuation import NATURAL_PREFIX
+from ...core.fold import FOLD_PREFIX
+from ...core.newton import PetscSettings
 from ...tracing.model_spread import Rule, default_rules, parse_rules
 from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, step_scale
 from .table import TABLE, Option
 
-__all__ = ["AppOptions", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
+__all__ = ["AppOptions", "Given", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
+           "read_petsc", "ROLE_PREFIXES", "SOLVER_OPTIONS",
            "read_request", "read_settings", "read_spring", "read_model_spread"]
 
 
@@ -33,10 +38,37 @@ MAX_VALUE = 1023
 MAX_SWEEP = 10_000
 
 
-class AppOptions:
-    """Typed, checked reads of :data:`TABLE` options from the PETSc database."""
+class Given:
+    """Options given as values (name without dash -> value string, None for a bare flag), read as PETSc's
+    options database is read, without one: the Python API's keywords.  ``left()``: those not read."""
 
-    def __init__(self, db: PETSc.Options | None = None):
+    def __init__(self, values: dict):
+        self._values = {k.lower(): v for k, v in values.items()}     # PETSc's names ignore case
+        self._read: set[str] = set()
+
+    def hasName(self, name: str) -> bool:
+        return name.lower() in self._values
+
+    def getString(self, name: str, default: str = "") -> str:
+        name = name.lower()
+        if name not in self._values:
+            return default
+        self._read.add(name)
+        v = self._values[name]
+        return "" if v is None else v
+
+    def getAll(self) -> dict:
+        return dict(self._values)
+
+    def left(self) -> list[str]:
+        """The names not read (as PetscOptionsLeftGet of a database)."""
+        return [k for k in self._values if k not in self._read]
+
+
+class AppOptions:
+    """Typed, checked reads of :data:`TABLE` options from the PETSc database (or a :class:`Given`)."""
+
+    def __init__(self, db: PETSc.Options | Given | None = None):
         self.db = db or PETSc.Options()
 
     def _raw(self, name: str) -> str | None:
@@ -335,10 +367,61 @@ def read_grid(opts: AppOptions, model: Model) -> GridChoice:
     return choice
 
 
+#: The prefixes of the solvers' roles, as the command line gives their options (SolverChoice's fields).
+ROLE_PREFIXES = {"natural": NATURAL_PREFIX, "arclength": ARCLENGTH_PREFIX, "fixed": "", "fold": FOLD_PREFIX}
+#: The beginnings of the options of a solver's PETSc objects (its SNES, KSP, PC, a block PC's, matrices).
+SOLVER_OPTIONS = ("snes_", "ksp_", "pc_", "sub_", "mat_")
+#: PetscSettings' fields read from their options (without prefix), with how each value is read.
+_TYPED = {"snes_rtol": "real", "snes_atol": "real", "snes_stol": "real", "snes_max_it": "int",
+          "snes_linesearch_type": "name", "ksp_type": "name", "ksp_rtol": "real", "ksp_atol": "real",
+          "ksp_max_it": "int", "pc_type": "name", "snes_monitor": "flag", "ksp_monitor": "flag"}
+_FIELD = {"snes_linesearch_type": "linesearch"}
+
+
+def read_petsc(opts: AppOptions, prefix: str) -> PetscSettings:
+    """The :class:`~petsc_adhesion.core.newton.PetscSettings` of the solver whose options begin with ``prefix``
+    (``nat_``, ``arc_``, ``fold_``, none for the fixed-approach solve): its SNES, KSP, PC and matrix options in
+    the database, each marked read here.  An option no solver reads (misspelt, or for a PC not chosen) reaches
+    the solver all the same and is left unread there (:func:`~.checks.check_unused` names it)."""
+    others = tuple(p for p in ROLE_PREFIXES.values() if p and p != prefix)
+    kw, extra = {}, {}
+    for name in opts.db.getAll():
+        bare = name[len(prefix):]
+        if not name.startswith(prefix) or name in TABLE or (not prefix and name.startswith(others)) \
+                or not bare.startswith(SOLVER_OPTIONS):
+            continue
+        raw = opts.db.getString(name, "")
+        kind = _TYPED.get(bare)
+        field_name = _FIELD.get(bare, bare)
+        try:
+            if kind == "real":
+                kw[field_name] = _strict_float(raw)
+            elif kind == "int":
+                kw[field_name] = _strict_int(raw)
+            elif kind == "name":
+                kw[field_name] = raw
+            elif kind == "flag" and raw == "":
+                kw[field_name] = True
+            else:                                   # a monitor's viewer, and every other option
+                extra[bare] = raw if raw != "" else None
+        except ValueError:
+            raise InputError(f"-{name}: expected a {'real' if kind == 'real' else 'integer'}, got '{raw}'") from None
+    try:
+        return PetscSettings(**kw, options=extra)
+    except ValueError as e:
+        field_name = str(e).split(":", 1)[0]
+        option = next((k for k in _TYPED if _FIELD.get(k, k) == field_name), field_name)
+        raise InputError(f"-{prefix}{option}: {str(e).split(': ', 1)[1]}") from None
+
+
 def read_solver(opts: AppOptions) -> SolverChoice:
-    """What every solver's preconditioner is built from (-adh_pmat, -adh_pmat_band) and how long it is kept."""
+    """What every solver's preconditioner is built from (-adh_pmat, -adh_pmat_band), how long it is kept, and
+    the PETSc settings of the solvers this run makes (:func:`read_petsc`): a curve's correctors (-nat_, -arc_),
+    or the fixed-approach solve (no prefix) with -adh_lambda."""
+    roles = ("natural", "arclength") if opts.real("adh_lambda") is None else ("fixed",)
     return SolverChoice(pmat=opts.choice("adh_pmat"), band=opts.int("adh_pmat_band"),
-                        pc_reuse_its=opts.int("adh_pc_reuse_its"))
+                        pc_reuse_its=opts.int("adh_pc_reuse_its"),
+                        **{role: read_petsc(opts, ROLE_PREFIXES[role]) for role in roles})
 
 
 def read_spring(opts: AppOptions, bodies: Bodies | None) -> float | None:

@@ -24,6 +24,7 @@ from ...discretization.problem import far_approach
 from ...model.parameters import Model
 from ...tracing.edge_grids import RMAX
 from .. import paths
+from ...core.newton import PetscSettings
 from .._library import traced
 
 __all__ = ["CASES", "QUANTITIES", "quantities", "numpy_curve", "contactmechanics_points", "observed_orders", "measure", "FIGURES", "PERFORMANCE", "PEER", "COMMAND", "TRUTH_TOL", "TARGETS", "UNIFORM", "UNIFORM_TOP", "REPEATS", "SLOW", "PMATS", "PREFIXES", "SCALE_N", "SCALE_STEPS", "ENV", "timed", "errors", "domain_part"]
@@ -231,20 +232,6 @@ def contactmechanics_points(path: str = PEER, mu: float = 1.0) -> list[dict]:
 
 
 # -- measuring ------------------------------------------------------------------------------------------
-def _set_options(opts: dict) -> None:
-    db = PETSc.Options()
-    for prefix in PREFIXES:
-        for k, v in opts.items():
-            db.setValue(f"{prefix}{k}", v)
-
-
-def _clear_options(opts: dict) -> None:
-    db = PETSc.Options()
-    for prefix in PREFIXES:
-        for k in opts:
-            db.delValue(f"{prefix}{k}")
-
-
 def timed(fn, repeats: int = REPEATS):
     """(times, last result) of calling ``fn`` ``repeats`` times; once when the first call exceeds SLOW s."""
     times, res = [], None
@@ -258,12 +245,9 @@ def timed(fn, repeats: int = REPEATS):
 
 
 def _trace(model, r, kind="dense", errors=False, target_error=None, options=None):
-    opts = options or {}
-    _set_options(opts)
-    try:
-        return traced(model, r, kind, read_settings(AppOptions()), errors, target_error)
-    finally:
-        _clear_options(opts)
+    # the options of both correctors (PREFIXES), as their settings
+    return traced(model, r, kind, read_settings(AppOptions()), errors, target_error,
+                  PetscSettings(options=options or {}))
 
 
 def _record(method: str, times: list, values: dict, param=None, n=None, **extra) -> dict:
