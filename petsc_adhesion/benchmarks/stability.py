@@ -3,6 +3,7 @@
     ./run stability            # all cells, two at a time, into docs/stability.md (about 6 minutes)
     ./run stability 20 2       # one cell (mu, sigma), printed
     ./run stability truncated  # the truncated model's rows only, into their table of docs/stability.md
+    python -m petsc_adhesion.benchmarks.stability refinement 10 -7   # its events on levels -2 .. 2 (mu, lambda_max)
 
 Each cell traces the curve from far apart to F >= 2 with the program's
 defaults and -cont_error_estimate, as a user would, and records whether it
@@ -17,6 +18,7 @@ MU_TRUNCATED), traced in the physical frame throughout.
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -27,7 +29,8 @@ from concurrent.futures import ThreadPoolExecutor
 from . import paths
 
 __all__ = ["MUS", "SIGMAS", "EXTRA", "TRUNCATED", "TRUNCATED_OPTIONS", "cell", "main", "OUT", "TIMEOUT", "HEAD",
-           "STABILITY_DOC", "TRUNCATED_MARK"]
+           "STABILITY_DOC", "TRUNCATED_MARK", "LEVELS",
+           "refinement", "refinement_table"]
 
 MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 4.5, 7.0, 10.0, 20.0, 50.0, 100.0, 300.0, 1000.0)
 SIGMAS = (0.0, 0.1, 0.2, 0.4, 1.0, 2.0)
@@ -81,6 +84,63 @@ HEAD = ("| mu | sigma | completed | turning points | pull-off F (error bar) | sm
         "guard | Newton (most) | Krylov (most) | nodes | regrids | wall gap | wall (s) | warnings |\n" + "|---" * 15 + "|")
 
 
+#: The refinement levels of :func:`refinement`: the default grid's error-bar levels and two finer.
+LEVELS = (-2, -1, 0, 1, 2)
+
+
+def refinement(mu: float, lam_max: float = math.inf, sigma: float = 0.0) -> list:
+    """The truncated model's events (r_m = 10, no far field) on the default grids, traced to ``lam_max``, each
+    located again on the nested levels LEVELS of its grid (twice and four times as fine among them): per event
+    (label, lambda or F, {level: value}, default best value, its bar).  The differences of successive
+    levels fall by 4 where the error is h^2 (error_bars.extrapolate), and the default value, made from
+    levels -2, -1, 0, must lie within its bar of the finest levels' Richardson value."""
+    from dataclasses import replace
+
+    from ..discretization import preconditioning
+    from ..discretization.problem import far_approach
+    from ..model.parameters import Model
+    from ..tracing import results
+    from ..tracing.error_bars import event_errors, relocate
+    from ..tracing.trace import curve_settings, step_scale
+    from ..tracing.tracer import Tracer
+
+    model = Model(mu=mu, sigma=sigma, rmax=10.0, farfield=False)
+    settings = replace(curve_settings(step_scale(model)), p_max=lam_max)
+    tracer = Tracer(model, settings, results.curve_events(()), None, None, preconditioning.Dense(), rmax=10.0)
+    out = []
+    try:
+        for seg in tracer.run(far_approach(model)):
+            for found in seg.finder.found:
+                est = event_errors(tracer, seg, found)
+                values = {0: found.point}
+                for level in LEVELS:
+                    if level != 0:
+                        values[level] = relocate(tracer, seg, found, level)
+                for key in ("lambda", "F"):
+                    got = {k: (p.p if key == "lambda" else p.values["F"]) for k, p in values.items() if p is not None}
+                    out.append((found.label, key, got, est.get(key), est.get(f"{key}_err")))
+    finally:
+        tracer.destroy()
+    return out
+
+
+def refinement_table(rows) -> str:
+    """:func:`refinement`'s rows as a markdown table: the values, the ratios of successive differences, and
+    the default value's distance from the Richardson value of levels 1 and 2 in units of its bar."""
+    lines = ["| event | of | level -2 | level -1 | level 0 | level 1 | level 2 | ratio 0/1 | ratio 1/2 | "
+             "default (levels -2..0) | bar | distance from levels 1-2 / bar |", "|---" * 12 + "|"]
+    for label, key, got, best, bar in rows:
+        cells = [f"{got[k]:.8f}" if k in got else "-" for k in LEVELS]
+        d = {k: got[k] - got[k - 1] for k in LEVELS if k in got and k - 1 in got}
+        ratio = [f"{d[k] / d[k + 1]:.2f}" if k in d and k + 1 in d and d[k + 1] else "-" for k in (0, 1)]
+        rich = got[2] + (got[2] - got[1]) / 3 if 1 in got and 2 in got else None
+        dist = f"{abs(best - rich) / bar:.2f}" if rich is not None and best is not None and bar else "-"
+        lines.append(f"| {label} | {key} | {' | '.join(cells)} | {' | '.join(ratio)} | "
+                     f"{best:.8f} | {bar:.1e} | {dist} |" if best is not None else
+                     f"| {label} | {key} | {' | '.join(cells)} | {' | '.join(ratio)} | - | - | - |")
+    return "\n".join(lines)
+
+
 def _done(c: dict) -> bool:
     return c["status"] == 0 and bool(c["summary"]) and c["summary"]["complete"]
 
@@ -106,6 +166,10 @@ def main(argv: list[str]) -> int:
     """All cells into docs/stability.md; ``truncated``: the truncated model's table alone rewritten; or the one
     cell given as mu sigma, printed."""
     truncated = [(m, s, TRUNCATED_OPTIONS, "truncated") for m, s in TRUNCATED]
+    if argv[:1] == ["refinement"]:
+        mu, lam_max = float(argv[1]), float(argv[2]) if len(argv) > 2 else math.inf
+        print(refinement_table(refinement(mu, lam_max)))
+        return 0
     if argv == ["truncated"]:
         cells = _run(truncated)
         with open(OUT) as f:
