@@ -3,7 +3,7 @@
     ./run stability            # all cells, two at a time, into docs/stability.md (about 6 minutes)
     ./run stability 20 2       # one cell (mu, sigma), printed
     ./run stability truncated  # the truncated model's rows only, into their table of docs/stability.md
-    python -m petsc_adhesion.benchmarks.stability refinement 10 -7   # its events on levels -2 .. 2 (mu, lambda_max)
+    python -m petsc_adhesion.benchmarks.stability refinement 10 -6 [STEPS]  # its events on levels -2 .. 2
 
 Each cell traces the curve from far apart to F >= 2 with the program's
 defaults and -cont_error_estimate, as a user would, and records whether it
@@ -88,8 +88,9 @@ HEAD = ("| mu | sigma | completed | turning points | pull-off F (error bar) | sm
 LEVELS = (-2, -1, 0, 1, 2)
 
 
-def refinement(mu: float, lam_max: float = math.inf, sigma: float = 0.0) -> list:
-    """The truncated model's events (r_m = 10, no far field) on the default grids, traced to ``lam_max``, each
+def refinement(mu: float, lam_max: float = math.inf, steps: int | None = None, sigma: float = 0.0) -> list:
+    """The truncated model's events (r_m = 10, no far field) on the default grids, traced to ``lam_max`` (or for
+    ``steps`` steps at most), each
     located again on the nested levels LEVELS of its grid (twice and four times as fine among them): per event
     (label, lambda or F, {level: value}, default best value, its bar).  The differences of successive
     levels fall by 4 where the error is h^2 (error_bars.extrapolate), and the default value, made from
@@ -106,6 +107,8 @@ def refinement(mu: float, lam_max: float = math.inf, sigma: float = 0.0) -> list
 
     model = Model(mu=mu, sigma=sigma, rmax=10.0, farfield=False)
     settings = replace(curve_settings(step_scale(model)), p_max=lam_max)
+    if steps is not None:
+        settings = replace(settings, max_steps=steps)
     tracer = Tracer(model, settings, results.curve_events(()), None, None, preconditioning.Dense(), rmax=10.0)
     out = []
     try:
@@ -168,7 +171,7 @@ def main(argv: list[str]) -> int:
     truncated = [(m, s, TRUNCATED_OPTIONS, "truncated") for m, s in TRUNCATED]
     if argv[:1] == ["refinement"]:
         mu, lam_max = float(argv[1]), float(argv[2]) if len(argv) > 2 else math.inf
-        print(refinement_table(refinement(mu, lam_max)))
+        print(refinement_table(refinement(mu, lam_max, int(argv[3]) if len(argv) > 3 else None)))
         return 0
     if argv == ["truncated"]:
         cells = _run(truncated)
