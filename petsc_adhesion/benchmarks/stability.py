@@ -69,7 +69,8 @@ def cell(mu: float, sigma: float, extra=()) -> dict:
 def _row(c: dict, what: str = "") -> str:
     s = c["summary"]
     if s is None:
-        return f"| {c['mu']:g} | {c['sigma']:g}{(' ' + what) if what else ''} | no: {c['error'] or c['status']} |" + " |" * 12
+        label = f"{c['sigma']:g}{(' ' + what) if what else ''}"
+        return f"| {c['mu']:g} | {label} | no: {c['error'] or c['status']} |" + " |" * 12
     po = s["pull_off"] or {}
     err = f" +- {po['F_err']:.1e}" if "F_err" in po else " (no bar)"
     done = "yes" if c["status"] == 0 and s["complete"] else f"no (exit {c['status']})"
