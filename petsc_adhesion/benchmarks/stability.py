@@ -240,7 +240,11 @@ frame throughout (a grid in r / a could not keep its end at r_m), on grids grade
 edge and regridded as it moves; a sharp edge (mu > 3.3) gets COARSE_MARGIN = 4 times the nodes a
 zone of NODES_PER_ZONE (tracing/edge_grids.py `margined`), so that the edge crossing the nodes
 makes no spurious turning points.  Every step there moves the edge by about a tenth of its zone:
-the steps grow about as mu^2, and mu = 10 is the most it is traced to (MU_TRUNCATED).
+the steps grow about as mu^2 (mu = 10: 3977 steps), and mu = 10 is the most it is traced to
+(MU_TRUNCATED).  A domain of r_m = 10 is small for a soft sphere: at mu = 10 the smooth contact
+reaches it before F = 2 (its edge at r = 9.75, the gap at r_m below 13 epsilon, |P(r_m)| above 1e-3 of the peak
+attraction), and the run says so with exit 3, the model's limit and not the grid's (its curve and
+events are whole; tests/test_truncated.py traces it to F = 0.5 with exit 0).
 {done} of {total} cells completed.
 
 {head}
