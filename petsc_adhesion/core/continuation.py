@@ -73,7 +73,7 @@ class Settings:
     observable_max: float = math.inf  # stop when the observable reaches this
     p_max: float = math.inf         # stop when the parameter reaches this
     p_min: float = -math.inf        # or falls to this
-    max_steps: int = 2000
+    max_steps: int = 5000           # the truncated model at mu = 10 takes about 3950 (edge_grids.MU_TRUNCATED)
     max_folds: int = 12             # stop after more than this many turning points
     pc_reuse_its: int = PC_REUSE_ITS
     monitor: bool = False           # one line a step

@@ -16,7 +16,7 @@ from ..model.pressure import pressure_law
 
 __all__ = ["BAND", "BAND_ZONES", "CONTACT_SPACING", "REACH", "RMAX", "A_SWITCH", "A_SWITCH_ZONES", "GROW", "band",
            "a_switch", "grid_for", "scaled_grid_for", "scaled_band", "sharp",
-           "frame_of_edge", "MU_TRUNCATED", "soft"]
+           "frame_of_edge", "MU_TRUNCATED", "soft", "margined"]
 
 
 #: Half-width of the fine band about the edge in the physical frame ...
@@ -63,10 +63,20 @@ def _zone(model, given: float | None = None) -> float:
 
 def _fine(model, zone: float | None = None) -> float:
     """The spacing about the edge: the zone (default the model's, :func:`_zone`) over NODES_PER_ZONE,
-    COARSE_MARGIN times finer for a sharp edge (so that its two coarser levels still resolve the zone and
-    give the error bars), at most CONTACT_SPACING."""
+    COARSE_MARGIN times finer where :func:`margined` (so that its two coarser levels still resolve the zone
+    and give the error bars), at most CONTACT_SPACING."""
     zone = _zone(model, zone)
-    return min(zone / NODES_PER_ZONE / (COARSE_MARGIN if soft(model) else 1), CONTACT_SPACING)
+    return min(zone / NODES_PER_ZONE / (COARSE_MARGIN if margined(model) else 1), CONTACT_SPACING)
+
+
+def margined(model) -> bool:
+    """Whether the grids about the edge are COARSE_MARGIN times finer than NODES_PER_ZONE asks: a soft
+    sphere's, and the truncated model's sharp edge (:func:`frame_of_edge` False), which crosses the nodes of
+    the physical frame all along its curve.  There, at NODES_PER_ZONE a zone, the edge's lattice trapping is
+    small but shows wherever dlambda/da vanishes: at mu = 10 nine spurious fold pairs within 3e-3 in lambda of
+    the contact's snap-off (-16.199), the curve stopped by -cont_max_folds; COARSE_MARGIN times finer, none
+    (and its levels -1 and -2 still resolve the zone: the error bars come from coarser grids)."""
+    return soft(model) or (not model.farfield and sharp(model))
 
 
 def soft(model) -> bool:
@@ -138,7 +148,9 @@ def sharp(model) -> bool:
 
 
 #: The truncated model (-adh_farfield false) on grids that follow the edge, traced in the physical frame
-#: throughout (:func:`frame_of_edge`), up to this mu: its steps there grow like mu^1.5 (mu = 7: 1690 steps).
+#: throughout (:func:`frame_of_edge`, on :func:`margined` grids), up to this mu: there every step moves the
+#: edge by about a tenth of its zone, so the steps grow like the edge's travel over the zone, about mu^2
+#: (mu = 5: 755, mu = 7: 1704, mu = 10: about 3950 steps to F = 2, within -cont_max_steps' default).
 MU_TRUNCATED = 10.0
 
 
