@@ -157,6 +157,10 @@ class PetscSettings:
         return [k for k in self.entries() if k.startswith("snes_")]
 
 
+#: The solvers made in this process, for their prefixes (:class:`SolverOptions`).
+_SOLVERS_MADE = itertools.count(1)
+
+
 class SolverOptions:
     """One solver's settings in PETSc's options database under a prefix of its own, for the solver's lifetime.
 
@@ -168,10 +172,8 @@ class SolverOptions:
     factorization's), after ``setFromOptions()``.
     """
 
-    _made = itertools.count(1)
-
     def __init__(self, role: str, settings: PetscSettings):
-        self.prefix = f"pa{next(SolverOptions._made)}_{role}"
+        self.prefix = f"pa{next(_SOLVERS_MADE)}_{role}"
         self.names: list[str] = []
         db = PETSc.Options()
         for name, value in settings.entries().items():
