@@ -42,9 +42,11 @@ from petsc4py import PETSc
 from ..core import capi
 from ..errors import InputError, Interrupted, collective, say
 from ..io.layout import case_tree
+from ..io.summary import summary_of
 from ..io.resultset import check_targets, mark_done, written
 from ..io.write import write_critical, write_study
-from ..tracing.curve import program_record
+from ..io.summary import program_record
+from ..tracing.curve import Program
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
 from .options.checks import check_unused
@@ -177,7 +179,7 @@ def _run(c: Case, study: dict, argv: list[str], comm, compute: str, keep: tuple)
         if comm.getRank():
             return None
         tree = case_tree(curve, keep=None if opts.flag("profiles") else keep)
-        return {"case": c.index, "values": c.values, "summary": curve.summary, "tree": tree,
+        return {"case": c.index, "values": c.values, "summary": summary_of(curve), "tree": tree,
                 "incomplete": not curve.complete}
 
 
@@ -291,7 +293,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
                     status = None
                 else:
                     with written(targets, journal.paths()) as files:
-                        write_study({**program_record(world), "options": opts.given()}, study, done,
+                        write_study({**program_record(Program.of(world)), "options": opts.given()}, study, done,
                                     sorted(failed, key=lambda r: r["case"]), files)
         status = mpi.bcast(status, root=0)
         if status is None:
@@ -394,7 +396,7 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
                     status = None
                 else:
                     with written(targets, journal.paths()) as files:
-                        write_critical({**program_record(world), "options": opts.given()}, study, done, failed,
+                        write_critical({**program_record(Program.of(world)), "options": opts.given()}, study, done, failed,
                                        files)
         check_unused()
         status = mpi.bcast(status, root=0)
