@@ -45,7 +45,7 @@ from ..io.layout import case_tree
 from ..io.summary import summary_of
 from ..io.resultset import check_targets, mark_done, written
 from ..io.write import write_critical, write_study
-from ..io.summary import program_record
+from ..io.summary import critical_record, program_record
 from ..tracing.curve import Program
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
@@ -417,7 +417,7 @@ def _cusp(c: Case, model, comm) -> dict | None:
         out = sigma_c(model, value, comm=comm) if name == "adh_mu" else mu_c(model, value, comm=comm)
     except ValueError as e:                        # no cusp in the range searched
         raise RuntimeError(str(e)) from None
-    return {"case": c.index, "values": c.values, "kind": "sigma_c" if name == "adh_mu" else "mu_c", **out} \
+    return {"case": c.index, "values": c.values, "kind": out.kind, **critical_record(out)} \
         if comm.getRank() == 0 else None
 
 

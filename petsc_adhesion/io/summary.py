@@ -13,6 +13,7 @@ reaches the JSON and HDF5 files with no change here; the CSV names its columns
 from __future__ import annotations
 
 from dataclasses import fields, is_dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,8 +22,11 @@ from ..model.pressure import pressure_law
 from ..tracing.curve import Curve, Cycle, Profile, Program, Solution
 from ..tracing.measured import Measured, Missing
 
+if TYPE_CHECKING:                    # tracing.critical loads PETSc, which a file reader need not
+    from ..tracing.critical import Critical
+
 __all__ = ["event_record", "branch_record", "program_record", "model_record", "head_of", "summary_of",
-           "solve_summary", "cycle_summary", "KEYS"]
+           "solve_summary", "cycle_summary", "critical_record", "KEYS"]
 
 #: A field's name -> the key the files have always used for it.
 KEYS = {"lam": "lambda", "note": "error_note"}
@@ -163,3 +167,20 @@ def solve_summary(solution: Solution) -> dict:
         summ["physical"] = {**d, "lambda_nm": res["lambda"] * d["approach_nm"], "F_nN": res["F"] * d["force_nN"],
                             "H0_nm": res["H0"] * d["approach_nm"]}
     return _plain(summ)
+
+
+def critical_record(c: Critical) -> dict:
+    """A critical study's case (:class:`~petsc_adhesion.tracing.critical.Critical`) as the files hold it:
+    ``sigma_c`` (or ``mu_c``) and lambda_c, F_c with their bars, the values on each level (``*_grid``), the
+    levels and their nodes, the domain's share, the bracket, the edge and contact radius at the cusp, its
+    roughness law, r_m, the wall time and any warning."""
+    k = c.kind
+    out = {c.fixed_name: c.fixed, k: c.value.value, f"{k}_err": c.value.err, "lambda_c": c.lam.value,
+           "lambda_c_err": c.lam.err, "F_c": c.F.value, "F_c_err": c.F.err, f"{k}_domain": c.domain,
+           "levels": list(c.levels), "n_nodes": list(c.n_nodes), f"{k}_grid": list(c.value_grid),
+           "lambda_c_grid": list(c.lam_grid), "F_c_grid": list(c.F_grid), "bracket": list(c.bracket),
+           "edge": c.edge, "contact_radius": c.contact_radius, "roughness": pressure_law(c.model).describe(),
+           "rmax": c.model.rmax, "wall_time_s": c.wall_time_s}
+    if c.warning is not None:
+        out["warning"] = c.warning
+    return out
