@@ -446,7 +446,7 @@ def test_energy_quadrature_converges(uniform_cycles):
         print(f"\n{key}: E* = {exact:.12f}; |E - E*| = {errs[0.5]:.2e} (ds_max 0.5), {errs[0.02]:.2e} (0.02); "
               f"change {change:.2e}; bar {bar:.2e}")
     # the tight value is the brief's measured 0.0399529326 (both step sizes)
-    assert tight["rigid"]["energy"] == pytest.approx(0.0399529326, abs=2e-10)
+    assert tight["rigid"].energy == pytest.approx(0.0399529326, abs=2e-10)
 
 
 # ----------------------------------------------------------------------------------------------------

@@ -1,6 +1,6 @@
-"""The results are values (issue 32): a field added to an event reaches the JSON and HDF5 files through the
+"""The results are values: a field added to an event reaches the JSON and HDF5 files through the
 serializers that read fields generically, with no change to them; and the energy of a cycle that was not
-closed is missing with its reason (issue 33), in the files and on the console, never 0."""
+closed is missing with its reason, in the files and on the console, never 0."""
 import dataclasses
 import json
 

@@ -42,10 +42,9 @@ from petsc4py import PETSc
 from ..core import capi
 from ..errors import InputError, Interrupted, collective, say
 from ..io.layout import case_tree
-from ..io.summary import summary_of
 from ..io.resultset import check_targets, mark_done, written
+from ..io.summary import critical_record, program_record, summary_of
 from ..io.write import write_critical, write_study
-from ..io.summary import critical_record, program_record
 from ..tracing.curve import Program
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
