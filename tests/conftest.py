@@ -17,6 +17,8 @@ os.environ.setdefault("PETSC_ADHESION_CHECKOUT", ROOT)
 def _env():
     # PETSC_DIR is the environment's business (./run and the venv set it for Debian's PETSc)
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    # this checkout's package, also for a script run from another folder (not the one the venv installed)
+    env["PYTHONPATH"] = os.pathsep.join([ROOT, *filter(None, [os.environ.get("PYTHONPATH")])])
     if os.geteuid() == 0:
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     env.setdefault("OMPI_MCA_btl_vader_single_copy_mechanism", "none")

@@ -112,7 +112,7 @@ def test_the_stiffness_table_is_what_the_library_gives_now():
     head = _row("afm_stiffness", ["K"])
     c = trace_curve(Model(mu=1.0), request=CurveRequest(spring=0.1, kinds=afm.JUMP_KINDS))
     jin, joff = afm.primary(c)
-    got = {"jump-in distance -Z": -jin.Z, "jump-off F": joff.F, "energy": c.spring["energy"]}
+    got = {"jump-in distance -Z": -jin.Z.value, "jump-off F": joff.F.value, "energy": c.spring.cycle.energy.value}
     for name, now in got.items():
         value, bar = _value(cells[head.index(f"mu = 1: {name}")])
         assert abs(value - now) <= max(2 * bar, 1e-4 * abs(now)), (name, value, now)
@@ -126,9 +126,9 @@ def test_the_example_table_is_what_the_library_gives_now():
     c = afm.cantilever(b, 1.0)
     jin, joff = afm.primary(c)
     cells = _row("afm_example", ["glass", f"{b.mu:.4f}", "1"])
-    assert _value(cells[4])[0] == pytest.approx(jin.Z * d["approach_nm"], abs=1e-4)
-    assert _value(cells[8])[0] == pytest.approx(joff.F * d["force_nN"], abs=1e-4)
-    assert _value(cells[9])[0] == pytest.approx(c.spring["energy"] * d["work_aJ"], abs=1e-3)
+    assert _value(cells[4])[0] == pytest.approx(jin.Z.value * d["approach_nm"], abs=1e-4)
+    assert _value(cells[8])[0] == pytest.approx(joff.F.value * d["force_nN"], abs=1e-4)
+    assert _value(cells[9])[0] == pytest.approx(c.spring.cycle.energy.value * d["work_aJ"], abs=1e-3)
 
 
 def test_the_closed_forms_of_the_figures():
@@ -164,7 +164,7 @@ def test_afm_md_names_its_figures_and_commands():
         assert f"made by: ./run figures {png} (python -m petsc_adhesion.benchmarks.afm {what})" in table
         assert f"python -m petsc_adhesion.benchmarks.afm {what}" in text or \
             "python -m petsc_adhesion.benchmarks.afm`" in text
-    for needle in ("options/afm_map.opts", "CurveRequest(spring=", "curve.spring", "curve.energy",
+    for needle in ("options/afm_map.opts", "CurveRequest(spring=", "curve.spring", "curve.rigid.energy",
                    "curve.contact_radius", "-afm_spring", "-phys_spring"):
         assert needle in text, needle
 
@@ -196,8 +196,8 @@ def test_the_python_example_of_afm_md_runs():
     K = tip.spring_stiffness(1.0)
     assert K == pytest.approx(0.04775, abs=1e-5)
     curve = trace_curve(Model(mu=tip.mu, bodies=tip), request=CurveRequest(spring=K, kinds=("jump_in", "jump_off")))
-    assert [j["kind"] for j in curve.spring["jumps"]] == ["jump_in", "jump_off"]
-    assert curve.energy[0] == 0.0 and curve.spring["energy"] > 0
+    assert [j.kind for j in curve.spring.jumps] == ["jump_in", "jump_off"]
+    assert curve.rigid.energy.value == 0.0 and curve.spring.cycle.energy.value > 0
     assert curve.Z.shape == curve.F.shape == curve.contact_radius.shape
     jump_in = curve.events_of("jump_in")[0]
-    assert jump_in.landing.Z == jump_in.Z and jump_in.Z_err > 0
+    assert jump_in.landing.Z.value == jump_in.Z.value and jump_in.Z.err > 0

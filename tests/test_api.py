@@ -21,6 +21,7 @@ import pytest
 import conftest
 import petsc_adhesion as pa
 from conftest import ROOT, run_cli
+from petsc_adhesion.io.summary import solve_summary, summary_of
 from petsc_adhesion.model.reference.rigid import DMT_PULL_OFF, rigid_load
 
 h5py = pytest.importorskip("h5py")
@@ -81,13 +82,14 @@ def cli_runs(tmp_path_factory):
 
 def test_curve_is_the_command_lines(cli_runs):
     c = pa.curve(**CURVE)
-    same(json.loads((cli_runs / "c.json").read_text()), c.summary)
+    files = json.loads((cli_runs / "c.json").read_text())
+    same(files, summary_of(c))
     with h5py.File(cli_runs / "c.h5") as f:
         for name, ours in (("lambda", c.lam), ("F", c.F), ("H0", c.H0)):
             np.testing.assert_allclose(ours, f[f"curve/{name}"][()], rtol=1e-12, atol=1e-12)
         np.testing.assert_array_equal(c.stable, f["curve/stable"][()])
-    po = c.summary["pull_off"]
-    assert (c.pull_off.kind, c.pull_off.lam, c.pull_off.F, c.pull_off.F_err) == \
+    po = files["pull_off"]
+    assert (c.pull_off.kind, c.pull_off.lam.value, c.pull_off.F.value, c.pull_off.F.err) == \
         ("F_min", po["lambda"], po["F"], po["F_err"])
     assert [e.kind for e in c.events] == ["snap_on", "snap_off", "F_min", "equilibrium"]
     assert c.complete and c.warnings == []
@@ -95,12 +97,13 @@ def test_curve_is_the_command_lines(cli_runs):
 
 def test_solve_is_the_command_lines(cli_runs):
     s = pa.solve(**SOLVE)
-    same(json.loads((cli_runs / "s.json").read_text()), s.summary)
+    files = json.loads((cli_runs / "s.json").read_text())
+    same(files, solve_summary(s))
     with h5py.File(cli_runs / "s.h5") as f:
         for name, ours in (("r", s.r), ("H", s.H), ("P", s.P)):
             np.testing.assert_allclose(ours, f["grid/r" if name == "r" else f"solution/{name}"][()], rtol=1e-12,
                                        atol=1e-12)
-    assert (s.lam, s.F) == (SOLVE["lam"], s.summary["F"])
+    assert (s.lam, s.F) == (SOLVE["lam"], files["F"])
 
 
 # each: API keywords, and where the command line's message must start
@@ -156,13 +159,13 @@ def test_petsc_options_reach_the_solver_and_stay_in_their_run():
     with pytest.raises(RuntimeError, match="Newton did not converge"):
         pa.solve(**SOLVE, snes_max_it=1)
     loose, tight = pa.solve(**SOLVE, snes_rtol=1e-2), pa.solve(**SOLVE, snes_rtol=1e-12)
-    assert loose.summary["snes_iterations"] < tight.summary["snes_iterations"]
-    assert pa.solve(**SOLVE).summary["snes_iterations"] > loose.summary["snes_iterations"]
+    assert loose.snes_iterations < tight.snes_iterations
+    assert pa.solve(**SOLVE).snes_iterations > loose.snes_iterations
 
 
 def test_files_are_the_summary(tmp_path):
     s = pa.solve(**SOLVE, summary=str(tmp_path / "s.json"), out=str(tmp_path / "s.h5"))
-    assert json.loads((tmp_path / "s.json").read_text()) == s.summary
+    assert json.loads((tmp_path / "s.json").read_text()) == solve_summary(s)
     with h5py.File(tmp_path / "s.h5") as f:
         np.testing.assert_array_equal(f["solution/H"][()], s.H)
     assert sorted(os.listdir(tmp_path)) == ["s.h5", "s.json"]
@@ -194,7 +197,7 @@ out = {"before": live(), "curves": [], "solves": [], "after": []}
 for i in range(2):
     c = pa.curve(mu=1.0, grid_type="uniform", grid_n=101, cont_F_max=0, profiles=True)
     on = c.events_of("snap_on")[0]
-    out["curves"].append([c.lam.tolist(), c.F.tolist(), c.H0.tolist(), on.H.tolist(), c.pull_off.F])
+    out["curves"].append([c.lam.tolist(), c.F.tolist(), c.H0.tolist(), on.profile.H.tolist(), c.pull_off.F.value])
     s = pa.solve(-2.0, mu=1.0, grid_type="uniform", grid_n=101)
     out["solves"].append([s.H.tolist(), s.P.tolist(), s.F])
     out["after"].append(live())
@@ -251,7 +254,7 @@ def test_every_rank_gets_the_result(tmp_path):
             "c = pa.curve(mu=1.0, grid_type='uniform', grid_n=101, cont_F_max=0, profiles=True); "
             "e = c.events_of('snap_on')[0]; "
             "open(f'rank{MPI.COMM_WORLD.rank}.json', 'w').write(json.dumps([MPI.COMM_WORLD.rank, "
-            "c.summary['mpi_ranks'], c.pull_off.F, c.H0.tolist(), e.H.tolist()]))")
+            "c.program.mpi_ranks, c.pull_off.F.value, c.H0.tolist(), e.profile.H.tolist()]))")
     mpiexec = shutil.which("mpiexec")
     if mpiexec is None:
         pytest.skip("mpiexec not found")
@@ -263,9 +266,9 @@ def test_every_rank_gets_the_result(tmp_path):
     assert [r[:2] for r in rows] == [[0, 2], [1, 2]]
     assert rows[0][2:] == rows[1][2:]
     serial = pa.curve(mu=1.0, grid_type="uniform", grid_n=101, cont_F_max=0, profiles=True)
-    assert abs(rows[0][2] - serial.pull_off.F) < 1e-10
+    assert abs(rows[0][2] - serial.pull_off.F.value) < 1e-10
     np.testing.assert_allclose(rows[0][3], serial.H0, atol=1e-10)
-    np.testing.assert_allclose(rows[0][4], serial.events_of("snap_on")[0].H, atol=1e-10)
+    np.testing.assert_allclose(rows[0][4], serial.events_of("snap_on")[0].profile.H, atol=1e-10)
 
 
 # -- docs/python.md --------------------------------------------------------------------------------
@@ -283,7 +286,7 @@ def test_python_md_runs_and_prints_what_it_shows(tmp_path, monkeypatch):
             exec(compile(block, "docs/python.md", "exec"), ns)
     number = r"-?\d+\.\d{6,}"
     assert re.findall(number, printed.getvalue()) == re.findall(number, shown) != []
-    assert abs(ns["d"].pull_off.F - DMT_PULL_OFF) < 2e-3                    # mu = 0.01: DMT
+    assert abs(ns["d"].pull_off.F.value - DMT_PULL_OFF) < 2e-3                    # mu = 0.01: DMT
     np.testing.assert_allclose(ns["s"].H, ns["s"].r ** 2 / 2 - 0.5, atol=1e-12)   # mu = 0: rigid, eq. (27)
-    assert json.loads((tmp_path / "mu2.json").read_text()) == ns["f"].summary
+    assert json.loads((tmp_path / "mu2.json").read_text()) == summary_of(ns["f"])
     assert {"mu1.png", "mu2.png", "mu2.json"} <= set(os.listdir(tmp_path))

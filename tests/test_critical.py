@@ -64,9 +64,10 @@ def test_sigma_c_grid_converged(study):
     assert c["sigma_c_err"] < 1e-6 and c["sigma_c_domain"] < c["sigma_c_err"]
     assert abs(c["sigma_c"] - SIGMA_AT_2) < 1e-7       # the value the figure reports
     finer = critical.sigma_c(Model(rmax=c["rmax"]), 2.0, grid_refinements=(1, 2, 3))
-    assert finer["n_nodes"][-1] > 3.8 * c["n_nodes"][-2]
-    for k in ("sigma_c", "lambda_c", "F_c"):
-        assert abs(finer[k] - c[k]) <= c[k + "_err"], (k, finer[k], c[k], c[k + "_err"])
+    assert finer.kind == "sigma_c" and finer.fixed == 2.0 and finer.levels == (1, 2, 3)
+    assert finer.n_nodes[-1] > 3.8 * c["n_nodes"][-2]
+    for k, m in (("sigma_c", finer.value), ("lambda_c", finer.lam), ("F_c", finer.F)):
+        assert abs(m.value - c[k]) <= c[k + "_err"], (k, m.value, c[k], c[k + "_err"])
 
 
 def test_fold_continued_in_mu_meets_fold_continued_in_sigma(study):
@@ -105,8 +106,8 @@ def test_ordinary_curves_either_side_of_the_cusp(study, mu, sigma, pair):
     on, off = c.events_of("snap_on"), c.events_of("snap_off")
     assert (len(on), len(off)) == ((1, 1) if pair else (0, 0)), c.events
     if pair:
-        assert off[0].lam < on[0].lam
-        assert abs(on[0].lam - cusp["lambda_c"]) < 0.05 and abs(off[0].lam - cusp["lambda_c"]) < 0.05
+        assert off[0].lam.value < on[0].lam.value
+        assert abs(on[0].lam.value - cusp["lambda_c"]) < 0.05 and abs(off[0].lam.value - cusp["lambda_c"]) < 0.05
 
 
 @pytest.mark.parametrize("args, line", [

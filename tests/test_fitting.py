@@ -112,7 +112,7 @@ def test_pull_off_of_an_independent_curve_gives_its_gamma_back():
 
     b = _bodies(1.0)
     c = trace_curve(Model(mu=1.0))
-    P = abs(c.pull_off.F) * 2 * math.pi * b.R * 0.05
+    P = abs(c.pull_off.F.value) * 2 * math.pi * b.R * 0.05
     f = fit_pull_off(P, b, P_err=0.01 * P)
     assert abs(f.gamma - 0.05) < 1.96 * f.gamma_err
     # a 1% force gives w to about 1 / (1 + (2/3) dln|F|/dlnmu) %: the bar says so

@@ -863,7 +863,7 @@ import petsc_adhesion as pa
 
 KW = dict(grid_type="uniform", grid_n=101, cont_F_max=0, cont_error_estimate=False)
 MUS = (0.5, 0.3)
-serial = {mu: pa.curve(mu=mu, **KW).pull_off.F for mu in MUS}
+serial = {mu: pa.curve(mu=mu, **KW).pull_off.F.value for mu in MUS}
 trials = []
 for _ in range(6):
     got, errors = {}, []
@@ -874,7 +874,7 @@ for _ in range(6):
                 pa.curve(mu=mu, **KW, **bad)
                 errors.append(f"mu = {mu}: {bad} was not refused")
             else:
-                got[str(mu)] = pa.curve(mu=mu, **KW).pull_off.F
+                got[str(mu)] = pa.curve(mu=mu, **KW).pull_off.F.value
         except pa.InputError as e:
             if not bad:
                 errors.append(f"mu = {mu}: InputError {e}")

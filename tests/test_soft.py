@@ -68,14 +68,14 @@ def _jkr_distances(mu: float) -> dict:
     """The distances of a default curve's values (no error bars) from the JKR limits at ``mu``."""
     curve = trace_curve(Model(mu=mu), request=CurveRequest(error_bars=False))
     assert curve.complete, curve.warnings
-    pull = min((e for e in curve.events_of("F_min")), key=lambda e: e.F)
-    snap = min(curve.events_of("snap_off"), key=lambda e: e.lam)       # the last: the contact lets go
+    pull = min((e for e in curve.events_of("F_min")), key=lambda e: e.F.value)
+    snap = min(curve.events_of("snap_off"), key=lambda e: e.lam.value)       # the last: the contact lets go
     zero = curve.events_of("equilibrium")[-1]
     A0, lam0 = jkr_zero_load(mu)
     lam_s, F_s = jkr_fixed_grip_pull_off(mu)
-    return {"pull_off": abs(pull.F / JKR_PULL_OFF - 1), "snap_off_F": abs(snap.F / F_s - 1),
-            "snap_off_lambda": abs(snap.lam / lam_s - 1), "zero_load_lambda": abs(zero.lam / lam0 - 1),
-            "zero_load_radius": abs(zero.contact_radius / A0 - 1)}
+    return {"pull_off": abs(pull.F.value / JKR_PULL_OFF - 1), "snap_off_F": abs(snap.F.value / F_s - 1),
+            "snap_off_lambda": abs(snap.lam.value / lam_s - 1), "zero_load_lambda": abs(zero.lam.value / lam0 - 1),
+            "zero_load_radius": abs(zero.contact_radius.value / A0 - 1)}
 
 
 def test_the_jkr_limit_is_approached():

@@ -2,7 +2,7 @@
 
     import petsc_adhesion as pa
     c = pa.curve(mu=1.0, grid_type="uniform", grid_n=201)
-    print(c.pull_off.F, "+-", c.pull_off.F_err)
+    print(c.pull_off.F.value, "+-", c.pull_off.F.err)
     s = pa.solve(-2.0, mu=1.0, snes_rtol=1e-12)                   # H(r), P(r), F at lambda = -2
 
 Each call is one run (:func:`petsc_adhesion.app.run.execute`) of the options
@@ -162,6 +162,6 @@ def _run(given: dict):
         failed.__context__ = failed.__cause__ = None
         raise failed.with_traceback(None)
     if PETSc.COMM_WORLD.getRank() == 0:
-        for w in result.summary.get("warnings", []):
+        for w in getattr(result, "warnings", ()):
             warnings.warn(f"petsc-adhesion: {w}", RuntimeWarning, stacklevel=3)
     return result

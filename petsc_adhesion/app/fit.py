@@ -24,10 +24,11 @@ from ..fitting.pull_off import PullOffFitError, fit_pull_off
 from ..io.fit import fit_summary, fit_tree, report_fit
 from ..io.inputs import check_input
 from ..io.resultset import PLOT_FORMATS, check_targets, written
+from ..io.summary import model_record, program_record
 from ..io.write import write_fit
 from ..model.parameters import Model
 from ..model.physical import Bodies
-from ..tracing.curve import model_record, program_record
+from ..tracing.curve import Program
 from ..tracing.trace import GridChoice
 from .options.checks import check_petsc_values, check_unused
 from .options.reading import AppOptions, read_grid, read_solver
@@ -249,7 +250,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     if req.kind == "curve":
         summary["given"] = {**summary["given"], "file": req.data.path, "format": req.data.source,
                             "spring_from": req.spring_source}
-    head = program_record(comm)
+    head = program_record(Program.of(comm))
     head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted
     given = opts.given()
     data = model = None

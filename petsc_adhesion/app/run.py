@@ -141,10 +141,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
             with ck.on_interrupt() if ck else nullcontext(), written(req.targets, ck.paths() if ck else ()) as files:
                 (write_curve if req.lam is None else write_solve)(result, given, files, commit=False)
                 if report:       # before the files go in place: a report that cannot be written fails the run
-                    if req.lam is None:
-                        report_curve(result.summary)
-                    else:
-                        report_solve(result.summary, result.summary.get("physical"))
+                    (report_curve if req.lam is None else report_solve)(result)
                 files.commit()
         PETSc.garbage_cleanup()
     except Interrupted as e:

@@ -42,8 +42,9 @@ from ..core.newton import is_solvers_own
 from ..errors import InputError, Interrupted, collective, say
 from ..io.layout import case_tree
 from ..io.resultset import check_targets, mark_done, written
+from ..io.summary import critical_record, program_record, summary_of
 from ..io.write import write_critical, write_study
-from ..tracing.curve import program_record
+from ..tracing.curve import Program
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
 from .options.checks import check_unused
@@ -182,7 +183,7 @@ def _run(c: Case, comm, keep: tuple) -> dict:
     if comm.getRank():
         return None
     tree = case_tree(curve, keep=None if profiles else keep)
-    return {"case": c.index, "values": c.values, "summary": curve.summary, "tree": tree,
+    return {"case": c.index, "values": c.values, "summary": summary_of(curve), "tree": tree,
             "incomplete": not curve.complete}
 
 
@@ -296,7 +297,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
                     status = None
                 else:
                     with written(targets, journal.paths()) as files:
-                        write_study({**program_record(world), "options": opts.given()}, study, done,
+                        write_study({**program_record(Program.of(world)), "options": opts.given()}, study, done,
                                     sorted(failed, key=lambda r: r["case"]), files)
         status = mpi.bcast(status, root=0)
         if status is None:
@@ -399,7 +400,7 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
                     status = None
                 else:
                     with written(targets, journal.paths()) as files:
-                        write_critical({**program_record(world), "options": opts.given()}, study, done, failed,
+                        write_critical({**program_record(Program.of(world)), "options": opts.given()}, study, done, failed,
                                        files)
         check_unused()
         status = mpi.bcast(status, root=0)
@@ -420,7 +421,7 @@ def _cusp(c: Case, model, comm) -> dict | None:
         out = sigma_c(model, value, comm=comm) if name == "adh_mu" else mu_c(model, value, comm=comm)
     except ValueError as e:                        # no cusp in the range searched
         raise RuntimeError(str(e)) from None
-    return {"case": c.index, "values": c.values, "kind": "sigma_c" if name == "adh_mu" else "mu_c", **out} \
+    return {"case": c.index, "values": c.values, "kind": out.kind, **critical_record(out)} \
         if comm.getRank() == 0 else None
 
 

@@ -1,6 +1,8 @@
 """The library's curve as the benchmarks read it: one flat record of a :class:`~petsc_adhesion.tracing.curve.Curve`."""
 from __future__ import annotations
 
+from ..io.layout import curve_tree
+from ..io.summary import event_record, summary_of
 from ..model.parameters import Model
 from ..tracing.trace import (
     CurveRequest,
@@ -17,8 +19,9 @@ __all__ = ["flat", "traced"]
 def flat(curve) -> dict:
     """The summary's keys, with the events as their records (``events``), the pull-off's record
     (``pull_off``) and the grids of the segments (``grids``)."""
-    pull = next((rec for ev, rec in zip(curve.events, curve.records) if ev is curve.pull_off), None)
-    return {**curve.summary, "events": curve.records, "pull_off": pull, "grids": curve.head["grid"]}
+    records = [event_record(e) for e in curve.events]
+    pull = next((rec for ev, rec in zip(curve.events, records) if ev is curve.pull_off), None)
+    return {**summary_of(curve), "events": records, "pull_off": pull, "grids": curve_tree(curve, {})["grid"]}
 
 
 def traced(model: Model, nodes=None, pmat: str = "dense", settings=None, errors: bool = True,

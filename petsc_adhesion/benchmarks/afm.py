@@ -30,11 +30,13 @@ import numpy as np
 from .. import brent
 from ..io.plot.curve import contact_load, force_distance
 from ..io.plot.read import figure
+from ..io.summary import branch_record, event_record
 from ..model.parameters import Model
 from ..model.physical import Bodies
 from ..model.reference.jkr import jkr_load, jkr_zero_load
 from ..model.reference.maugis_dugdale import maugis_dugdale_curve, maugis_parameter
 from ..model.reference.rigid import rigid_load
+from ..tracing.measured import Measured
 from ..tracing.trace import CurveRequest, trace_curve
 from . import paths
 
@@ -75,7 +77,7 @@ def primary(curve, kinds: tuple = JUMP_KINDS) -> tuple:
     approach (largest Z) and the jump-off reached last on retraction (smallest Z); with ``RIGID`` kinds
     (snap_on, snap_off), the same in lambda.  None where there is none."""
     on, off = kinds
-    value = (lambda e: e.Z) if on == "jump_in" else (lambda e: e.lam)
+    value = (lambda e: e.Z.value) if on == "jump_in" else (lambda e: e.lam.value)
     ins, offs = curve.events_of(on), curve.events_of(off)
     return max(ins, key=value, default=None), min(offs, key=value, default=None)
 
@@ -123,8 +125,13 @@ def md_radius(mu: float) -> dict:
 
 def _res(curve) -> dict:
     """A curve as the plots read it."""
-    return {"curve": curve.branch, "events": curve.records, "mu": curve.summary["mu"],
-            "sigma": curve.summary["sigma"]}
+    return {"curve": branch_record(curve), "events": [event_record(e) for e in curve.events],
+            "mu": curve.model.mu, "sigma": curve.model.sigma}
+
+
+def _energy(cycle) -> tuple:
+    """(energy, bar) of a cycle; (None, None) where it is missing."""
+    return (cycle.energy.value, cycle.energy.err) if isinstance(cycle.energy, Measured) else (None, None)
 
 
 def _pm(x, err, scale: float = 1.0, digits: int = 4) -> str:
@@ -163,10 +170,10 @@ def example() -> None:
             jin, joff = primary(c)
             force_distance(ax, _res(c), label=f"k = {k:g} N/m (K = {b.spring_stiffness(k):.3g})",
                            scale=(nm, nN))
-            F_po = c.pull_off.F
+            F_po = c.pull_off.F.value
             # from below the jump-off's landing to where the contact pushes back as hard as the pull-off pulled
             Z, F = c.Z * nm, c.F * nN
-            lo = min(e.landing.Z for e in c.events if e.kind in JUMP_KINDS and e.landing) * nm
+            lo = min(e.landing.Z.value for e in c.events if e.kind in JUMP_KINDS and e.landing) * nm
             past = np.nonzero((F > -F_po * nN) & (Z > 0))[0]
             hi = Z[past[0]] if past.size else Z.max()
             ax.set_xlim(lo - 0.1 * (hi - lo), hi)
@@ -177,19 +184,19 @@ def example() -> None:
             ax.legend(fontsize=7, loc="lower right")
             sp = c.spring
             rows.append([flat, f"{b.mu:.4f}", f"{k:g}", f"{b.spring_stiffness(k):.5f}",
-                         _pm(jin.Z, jin.Z_err, nm) if jin else "no jump",
-                         _pm(jin.F, jin.F_err, nN) if jin else "-",
-                         _pm(jin.landing.F, jin.landing.F_err, nN) if jin else "-",
-                         _pm(joff.Z, joff.Z_err, nm) if joff else "no jump",
-                         _pm(joff.F, joff.F_err, nN) if joff else "-",
-                         _pm(sp["energy"], sp["energy_err"], aJ, 3)])
+                         _pm(jin.Z.value, jin.Z.err, nm) if jin else "no jump",
+                         _pm(jin.F.value, jin.F.err, nN) if jin else "-",
+                         _pm(jin.landing.F.value, jin.landing.F.err, nN) if jin else "-",
+                         _pm(joff.Z.value, joff.Z.err, nm) if joff else "no jump",
+                         _pm(joff.F.value, joff.F.err, nN) if joff else "-",
+                         _pm(*_energy(sp.cycle), aJ, 3)])
         snap_on, snap_off = primary(c, ("snap_on", "snap_off"))
         rows.append([flat, f"{b.mu:.4f}", "limits", "",
-                     "k -> infinity: " + (_pm(snap_on.lam, snap_on.lam_err, nm) + " (snap-on)" if snap_on else "none"),
-                     "", "", "k -> infinity: " + (_pm(snap_off.lam, snap_off.lam_err, nm) + " (snap-off)"
+                     "k -> infinity: " + (_pm(snap_on.lam.value, snap_on.lam.err, nm) + " (snap-on)" if snap_on else "none"),
+                     "", "", "k -> infinity: " + (_pm(snap_off.lam.value, snap_off.lam.err, nm) + " (snap-off)"
                                                   if snap_off else "none"),
-                     "k -> 0: " + _pm(c.pull_off.F, c.pull_off.F_err, nN) + " (load control)",
-                     "k -> infinity: " + _pm(c.energy[0], c.energy[1], aJ, 3) + " (rigid machine)"])
+                     "k -> 0: " + _pm(c.pull_off.F.value, c.pull_off.F.err, nN) + " (load control)",
+                     "k -> infinity: " + _pm(*_energy(c.rigid), aJ, 3) + " (rigid machine)"])
     table = _table(["flat", "mu", "k (N/m)", "K", "jump-in Z (nm)", "jump-in F (nN)", "lands at F (nN)",
                     "jump-off Z (nm)", "pull-off F (nN)", "energy of a cycle (aJ)"], rows)
     b = bodies("glass")
@@ -221,33 +228,33 @@ def stiffness() -> None:
             c = trace_curve(Model(mu=mu), request=CurveRequest(spring=float(K), kinds=JUMP_KINDS))
             jin, joff = primary(c)
             if len(c.events_of("jump_in")) > 1:
-                rest = [e.Z for e in c.events if e.kind in JUMP_KINDS and e is not jin and e is not joff]
+                rest = [e.Z.value for e in c.events if e.kind in JUMP_KINDS and e is not jin and e is not joff]
                 pairs.append((mu, K, max(rest) - min(rest)))
-            bare = [e for e in c.events if e.kind in JUMP_KINDS and e.Z_err is None]
+            bare = [e for e in c.events if e.kind in JUMP_KINDS and e.Z.err is None]
             if bare:
                 notes.append(f"mu = {mu:g}, K = {K:.4g}: no error bar on the "
-                             + ", ".join(f"{e.kind} at Z = {e.Z:.5f}" for e in bare) + f" ({bare[0].note})")
-            got.append((jin, joff, c.spring["energy"], c.spring["energy_err"]))
+                             + ", ".join(f"{e.kind} at Z = {e.Z.value:.5f}" for e in bare) + f" ({bare[0].note})")
+            got.append((jin, joff, *_energy(c.spring.cycle)))
         cols[mu] = got
         have = [(K, g[0]) for K, g in zip(Ks, got) if g[0] is not None]
-        ax_in.errorbar([K for K, _ in have], [-e.Z for _, e in have], yerr=[e.Z_err or 0 for _, e in have],
+        ax_in.errorbar([K for K, _ in have], [-e.Z.value for _, e in have], yerr=[e.Z.err or 0 for _, e in have],
                        fmt="o-", ms=3, color=color, label=f"mu = {mu:g}")
         if snap_on:
-            ax_in.axhline(-snap_on.lam, ls="--", color=color, lw=0.9)
+            ax_in.axhline(-snap_on.lam.value, ls="--", color=color, lw=0.9)
         E = [(K, g[2], g[3]) for K, g in zip(Ks, got) if g[2]]
         ax_e.errorbar([x[0] for x in E], [x[1] for x in E], yerr=[x[2] or 0 for x in E], fmt="o-", ms=3,
                       color=color, label=f"mu = {mu:g}")
-        if rigid.energy[0]:
-            ax_e.axhline(rigid.energy[0], ls="--", color=color, lw=0.9)
+        if _energy(rigid.rigid)[0]:
+            ax_e.axhline(_energy(rigid.rigid)[0], ls="--", color=color, lw=0.9)
         soft = Ks[Ks <= 0.3]
-        ax_e.loglog(soft, po.F**2 / (2 * soft), ":", color=color, lw=0.9)
+        ax_e.loglog(soft, po.F.value**2 / (2 * soft), ":", color=color, lw=0.9)
         off = [(K, g[1]) for K, g in zip(Ks, got) if g[1] is not None]
-        ax_off.errorbar([K for K, _ in off], [-e.F for _, e in off], yerr=[e.F_err or 0 for _, e in off],
+        ax_off.errorbar([K for K, _ in off], [-e.F.value for _, e in off], yerr=[e.F.err or 0 for _, e in off],
                         fmt="o-", ms=3, color=color, label=f"mu = {mu:g}")
-        ax_off.axhline(-po.F, ls=":", color=color, lw=0.9)
+        ax_off.axhline(-po.F.value, ls=":", color=color, lw=0.9)
         if snap_off:
-            ax_off.axhline(-snap_off.F, ls="--", color=color, lw=0.9)
-        lims.append((mu, snap_on, snap_off, po, rigid.energy))
+            ax_off.axhline(-snap_off.F.value, ls="--", color=color, lw=0.9)
+        lims.append((mu, snap_on, snap_off, po, _energy(rigid.rigid)))
     zr = [(K, rigid_sphere_jump_in(K)) for K in np.logspace(-3.0, math.log10(1.02), 60)]
     ax_in.plot([K for K, z in zr], [-z for K, z in zr], "k:", lw=1.0, label="rigid sphere (mu = 0)")
     ax_in.plot([], [], "k--", lw=0.9, label="rigid machine: -lambda of snap-on")
@@ -268,15 +275,15 @@ def stiffness() -> None:
         row = [f"{K:.4g}"]
         for mu in MUS:
             jin, joff, E, Eerr = cols[mu][i]
-            row += [_pm(-jin.Z, jin.Z_err) if jin else "no jump", _pm(joff.F, joff.F_err) if joff else "no jump",
+            row += [_pm(-jin.Z.value, jin.Z.err) if jin else "no jump", _pm(joff.F.value, joff.F.err) if joff else "no jump",
                     _pm(E, Eerr, digits=5)]
         rows.append(row)
     row_inf, row_0 = ["infinity (rigid machine)"], ["0 (load control)"]
     for mu, snap_on, snap_off, po, energy in lims:
-        row_inf += [_pm(-snap_on.lam, snap_on.lam_err) + " (-lambda of snap-on)" if snap_on else "no jump",
-                    _pm(snap_off.F, snap_off.F_err) + " (snap-off)" if snap_off else "no jump",
+        row_inf += [_pm(-snap_on.lam.value, snap_on.lam.err) + " (-lambda of snap-on)" if snap_on else "no jump",
+                    _pm(snap_off.F.value, snap_off.F.err) + " (snap-off)" if snap_off else "no jump",
                     _pm(energy[0], energy[1], digits=5)]
-        row_0 += ["see the rigid sphere", _pm(po.F, po.F_err) + " (pull-off)", "F_pull-off^2 / (2K)"]
+        row_0 += ["see the rigid sphere", _pm(po.F.value, po.F.err) + " (pull-off)", "F_pull-off^2 / (2K)"]
     rows += [row_inf, row_0]
     head = ["K"] + [f"mu = {mu:g}: {q}" for mu in MUS for q in ("jump-in distance -Z", "jump-off F", "energy")]
     table = _table(head, rows)
@@ -323,10 +330,10 @@ def radius() -> None:
         ax.legend(fontsize=7, loc="lower right")
         po = c.pull_off
         eq = c.events_of("equilibrium")[0]
-        rows.append([f"{mu:g}", "pull-off (load control)", _pm(po.F, po.F_err), _pm(po.contact_radius,
-                     po.contact_radius_err), f"{(9 * math.pi / 8) ** (1 / 3) * math.sqrt(mu):.4f}",
+        rows.append([f"{mu:g}", "pull-off (load control)", _pm(po.F.value, po.F.err), _pm(po.contact_radius.value,
+                     po.contact_radius.err), f"{(9 * math.pi / 8) ** (1 / 3) * math.sqrt(mu):.4f}",
                      f"{md['pull_off']:.4f}", "0"])
-        rows.append([f"{mu:g}", "zero load", "0", _pm(eq.contact_radius, eq.contact_radius_err),
+        rows.append([f"{mu:g}", "zero load", "0", _pm(eq.contact_radius.value, eq.contact_radius.err),
                      f"{jkr_zero_load(mu)[0]:.4f}", f"{md['zero']:.4f}", f"{float(dmt_radius(0.0, mu)):.4f}"])
     table = _table(["mu", "state", "F", "contact radius (this model)", "JKR", "Maugis-Dugdale", "DMT"], rows)
     table += ("\n\nContact radii in sqrt(epsilon R), loads in 2 pi R gamma.  This model's contact radius is where "

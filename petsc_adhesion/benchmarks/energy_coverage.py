@@ -57,16 +57,19 @@ DOC = os.path.join(paths.DOCS, "coverage.md")
 HEADING = "## The energy of a cycle"
 
 
-def _jump_record(rec: dict, key: str) -> dict:
-    """A jump of the program's cycle: its c (best, grid, bar) and the heights of the jump in F."""
-    land = rec.get("landing") or {}
-    return {"kind": rec["kind"], "c": rec[key], "c_grid": rec.get(f"{key}_grid", rec[key]), "c_err": rec.get(f"{key}_err"),
-            "F": rec["F"], "landing_F": land.get("F"), "error_note": rec.get("error_note")}
+def _jump_record(ev, key: str) -> dict:
+    """A jump of the program's cycle (an :class:`~petsc_adhesion.tracing.curve.Event`; ``key``: lam or Z, its
+    c): its c (best, grid, bar) and the heights of the jump in F."""
+    c = getattr(ev, key)
+    return {"kind": ev.kind, "c": c.value, "c_grid": c.value if c.grid is None else c.grid, "c_err": c.err,
+            "F": ev.F.value, "landing_F": None if ev.landing is None else ev.landing.F.value,
+            "error_note": ev.note}
 
 
 def _program(model, K) -> dict:
     """The program's energy and bar (trace_curve, defaults), the bar's terms and the times."""
     from ..tracing import energy
+    from ..tracing.measured import Measured
     from ..tracing.trace import CurveRequest, trace_curve
 
     seen, cycle_s = {}, {}
@@ -74,11 +77,11 @@ def _program(model, K) -> dict:
 
     def bar(result, fold, record_of):
         total = real_bar(result, fold, record_of)
-        key = "Z" if fold.weight else "lambda"
-        jumps = [_jump_record(record_of(f), key) for f in result.get("jumps", [])]
+        key = "Z" if fold.weight else "lam"
+        jumps = [_jump_record(record_of(f), key) for f in result.jumps]
         term = sum(abs(j["landing_F"] - j["F"]) * (abs(j["c_grid"] - j["c"]) + j["c_err"])
                    for j in jumps if j["landing_F"] is not None and j["c_err"] is not None)
-        quad = result.get("quadrature_err", 0.0) if result.get("pieces") else 0.0
+        quad = result.quadrature_err if result.pieces else 0.0
         seen["spring" if fold.weight else "rigid"] = {
             "jumps": jumps, "terms": None if total is None else
             {"jumps": term, "stretches": total - term - quad, "quadrature": quad}}
@@ -98,8 +101,10 @@ def _program(model, K) -> dict:
     finally:
         energy.energy_bar, energy.cycle = real_bar, real_cycle
     machine = "rigid" if K is None else "spring"
-    s = c.summary if K is None else c.summary["spring"]
-    return {"value": s["energy"], "bar": s["energy_err"], "loops": s["loops"], "note": s.get("energy_note"),
+    cyc = c.rigid if K is None else c.spring.cycle
+    got = isinstance(cyc.energy, Measured)
+    return {"value": cyc.energy.value if got else None, "bar": cyc.energy.err if got else None,
+            "loops": cyc.loops if got else 0, "note": None if got else cyc.energy.reason,
             "bar_terms": seen[machine]["terms"], "jumps": seen[machine]["jumps"],
             "time": {"curve_s": wall, "cycle_s": cycle_s[machine]}}
 
@@ -133,7 +138,7 @@ def _level(model, K, level: int) -> dict:
                "steps": sum(len(seg.cont.points) - 1 for seg in segments), "trace_s": traced}
         if level == 0:
             cyc = energy.cycle(segments, fold)
-            out["energy_default"] = cyc["energy"]
+            out["energy_default"] = cyc.energy
         tol, halvings = energy.QUADRATURE_TOL, energy.MAX_HALVINGS
         energy.QUADRATURE_TOL, energy.MAX_HALVINGS = TRUTH_TOL, TRUTH_HALVINGS
         try:
@@ -142,11 +147,11 @@ def _level(model, K, level: int) -> dict:
             out["cycle_s"] = time.perf_counter() - t
         finally:
             energy.QUADRATURE_TOL, energy.MAX_HALVINGS = tol, halvings
-        out |= {"energy": cyc["energy"], "loops": cyc.get("loops", 0), "quadrature_err": cyc.get("quadrature_err"),
-                "note": cyc.get("note"),
+        out |= {"energy": cyc.energy, "loops": cyc.loops,
+                "quadrature_err": cyc.quadrature_err if cyc.energy is not None else None, "note": cyc.note,
                 "jumps": [{"kind": f.label, "c": fold.value(f.point), "F": f.point.values["F"],
                            "landing_F": None if f.landing is None else f.landing.values["F"]}
-                          for f in cyc.get("jumps", [])]}
+                          for f in cyc.jumps]}
     finally:
         tracer.destroy()
     return out

@@ -105,18 +105,18 @@ def ours(curve, mu: float) -> dict:
     out = {}
     po = curve.pull_off
     if po is not None:
-        out["pull_off_F"] = (po.F, bar(po.F_err))
+        out["pull_off_F"] = (po.F.value, bar(po.F.err))
     offs = curve.events_of("snap_off")
     if offs:
-        so = min(offs, key=lambda e: e.lam)
-        out["snap_off_F"] = (so.F, bar(so.F_err))
-        out["snap_off_lam"] = (so.lam / mu, bar(so.lam_err) / mu)
+        so = min(offs, key=lambda e: e.lam.value)
+        out["snap_off_F"] = (so.F.value, bar(so.F.err))
+        out["snap_off_lam"] = (so.lam.value / mu, bar(so.lam.err) / mu)
     eqs = curve.events_of("equilibrium")
     if eqs:
-        eq = max(eqs, key=lambda e: e.lam)
-        out["zero_lam"] = (eq.lam / mu, bar(eq.lam_err) / mu)
+        eq = max(eqs, key=lambda e: e.lam.value)
+        out["zero_lam"] = (eq.lam.value / mu, bar(eq.lam.err) / mu)
         if eq.contact_radius is not None:
-            out["zero_a"] = (eq.contact_radius / math.sqrt(mu), bar(eq.contact_radius_err) / math.sqrt(mu))
+            out["zero_a"] = (eq.contact_radius.value / math.sqrt(mu), bar(eq.contact_radius.err) / math.sqrt(mu))
     return out
 
 
@@ -144,8 +144,8 @@ def maugis_dugdale_values(mu: float) -> dict:
 def _marks(curve, mu: float) -> list[tuple]:
     """The pull-off and the primary snap-off of a curve as (lambda / mu, F, their bars) for the figure."""
     offs = curve.events_of("snap_off")
-    events = [curve.pull_off, min(offs, key=lambda e: e.lam) if offs else None]
-    return [(e.lam / mu, e.F, (e.lam_err or 0.0) / mu, e.F_err or 0.0) for e in events if e is not None]
+    events = [curve.pull_off, min(offs, key=lambda e: e.lam.value) if offs else None]
+    return [(e.lam.value / mu, e.F.value, (e.lam.err or 0.0) / mu, e.F.err or 0.0) for e in events if e is not None]
 
 
 def run_child(cmd: list[str], cwd: str, timeout: float, limit_bytes: int = 0) -> dict:
@@ -183,13 +183,14 @@ def measure(mu: float, processes: bool = True, limit_bytes: int = 0) -> dict:
     c0, t0 = time.process_time(), time.perf_counter()
     curve = trace_curve(Model(mu=mu))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    s = curve.summary
-    rec = {"mu": mu, "load_before": load, "wall_s": wall, "cpu_s": cpu, "trace_s": s["wall_time_s"],
+    d = curve.diagnostics
+    folds = [e for e in curve.events if e.kind in ("snap_on", "snap_off")]
+    rec = {"mu": mu, "load_before": load, "wall_s": wall, "cpu_s": cpu, "trace_s": d.wall_time_s,
            "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-           "errors_s": s.get("error_estimate", {}).get("wall_time_s", float("nan")),
-           "steps": s["steps"], "rejected": s["rejected_steps"], "regrids": s["regrids"], "nodes": s["n_nodes"],
-           "grids": len(curve.head["grid"].get("n_nodes", [0])), "turning_points": len(s["folds"]),
-           "folds": sorted(((f["kind"], f["lambda"], f["F"]) for f in s["folds"]), key=lambda f: -f[1]),
+           "errors_s": float("nan") if d.error_estimate is None else d.error_estimate.wall_time_s,
+           "steps": d.steps, "rejected": d.rejected_steps, "regrids": d.regrids, "nodes": curve.grid.largest,
+           "grids": 0 if curve.grid.n_nodes is None else len(curve.grid.n_nodes), "turning_points": len(folds),
+           "folds": sorted(((f.kind, f.lam.value, f.F.value) for f in folds), key=lambda f: -f[1]),
            "complete": curve.complete, "warnings": curve.warnings, "values": ours(curve, mu),
            "jkr": jkr_limits(mu), "md": maugis_dugdale_values(mu),
            "branch": (curve.lam / mu, curve.F.copy(), curve.stable.copy()), "marks": _marks(curve, mu)}

@@ -242,7 +242,7 @@ class _Problem:
             self.traces += 1
             if not c.complete:
                 self.notes.append(f"the curve at mu = {p['mu']:.4g}, K = {p['K']:.4g} ended early "
-                                  f"({c.summary['stop_reason']}); continued linearly")
+                                  f"({c.diagnostics.stop_reason}); continued linearly")
             if len(self.cache) > 64:
                 self.cache.pop(next(iter(self.cache)))
             self.cache[key] = ForwardCurve(c, p["K"])

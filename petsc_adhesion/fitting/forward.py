@@ -91,8 +91,8 @@ def _value(e, key: str, K: float | None = None) -> float:
     """An event's value on its grid (its best value when it has none): lam, F, or Z = lam + F / K."""
     if key == "Z":
         return _value(e, "lam") + _value(e, "F") / K
-    grid = getattr(e, f"{key}_grid", None)
-    return float(grid if grid is not None else getattr(e, key))
+    m = getattr(e, key)                 # a Measured
+    return float(m.grid if m.grid is not None else m.value)
 
 
 class ForwardCurve:
@@ -106,8 +106,8 @@ class ForwardCurve:
 
     def __init__(self, curve, K: float):
         b = curve.branch
-        lam, Z, F = (np.asarray(b[k], dtype=float) for k in ("lambda", "Z", "F"))
-        stable = np.asarray(b["stable_spring"], dtype=bool)
+        lam, Z, F = (np.asarray(v, dtype=float) for v in (b.lam, b.Z, b.F))
+        stable = np.asarray(b.stable_spring, dtype=bool)
         self.K = float(K)
         self.notes: list[str] = []
         events = {k: [e for e in curve.events if e.kind == k] for k in ("jump_in", "jump_off")}

@@ -89,7 +89,7 @@ def model_pull_off(model: Model, grid=None, solver=None, error_bars: bool = Fals
         c = trace_curve(model, grid or GridChoice(), solver or SolverChoice(), curve_settings(observable_max=0.0),
                         CurveRequest(error_bars=error_bars, kinds=("F_min",)), comm=comm)
     if c.pull_off is None:
-        raise RuntimeError(f"the curve at mu = {model.mu:.6g} has no pull-off ({c.summary['stop_reason']})")
+        raise RuntimeError(f"the curve at mu = {model.mu:.6g} has no pull-off ({c.diagnostics.stop_reason})")
     return c.pull_off
 
 
@@ -176,8 +176,8 @@ def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = Non
         if lnw not in cache:
             w = math.exp(lnw)
             e = model_pull_off(model_at(w), grid, solver, comm=comm)
-            cache[lnw] = abs(e.F)
-            history.append((w, mu_of(w), e.F))
+            cache[lnw] = abs(e.F.value)
+            history.append((w, mu_of(w), e.F.value))
         return cache[lnw]
 
     def g(lnw: float) -> float:
@@ -192,7 +192,7 @@ def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = Non
     w = math.exp(lnw)
     # the best pull-off at the root (extrapolated over nested grids), its bar, and the slope of |F_p| in mu
     best = model_pull_off(model_at(w), grid, solver, error_bars=True, comm=comm)
-    Fg = best.F_grid if best.F_grid is not None else best.F
+    Fg = best.F.grid if best.F.grid is not None else best.F.value
     up = min(lnw + _DLOGW, math.log(hi_w))
     down = max(lnw - _DLOGW, math.log(lo_w))
     slope_w = 1.0 + (math.log(pull(up)) - math.log(pull(down))) / (up - down)     # d ln(w |F_p|) / d ln w
@@ -200,11 +200,11 @@ def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = Non
     if slope_w <= 0:
         raise PullOffFitError(f"P = {P:.4g} N: the model's pull-off falls faster than 1/w about w = {w:.4g} J/m^2 "
                               f"(mu = {mu_of(w):.3g}): the pull-off does not determine w there")
-    lnw -= math.log(abs(best.F) / abs(Fg)) / slope_w       # one Newton step onto the best pull-off
+    lnw -= math.log(abs(best.F.value) / abs(Fg)) / slope_w       # one Newton step onto the best pull-off
     w = math.exp(lnw)
-    F_err = best.F_err or 0.0
-    rel = math.hypot(F_err / abs(best.F), P_err / P) / slope_w
-    return PullOffFit(P=P, P_err=P_err, gamma=w, gamma_err=w * rel, mu=mu_of(w), sigma=sigma, F=best.F, F_err=F_err,
+    F_err = best.F.err or 0.0
+    rel = math.hypot(F_err / abs(best.F.value), P_err / P) / slope_w
+    return PullOffFit(P=P, P_err=P_err, gamma=w, gamma_err=w * rel, mu=mu_of(w), sigma=sigma, F=best.F.value, F_err=F_err,
                       F_grid=Fg, dlnF_dlnmu=dlnF_dlnmu, closed_forms=closed_forms(P, bodies), curves=len(cache) + 1,
                       wall_time_s=time.perf_counter() - t0, bodies=replace(bodies, gamma=w, hamaker=None),
                       history=history)

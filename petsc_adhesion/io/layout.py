@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .summary import branch_record, event_record, head_of, solve_record, summary_of
+
 __all__ = ["DESCRIBE", "curve_tree", "study_table", "CRITICAL_KEYS", "critical_table", "with_options", "case_tree", "solve_tree"]
 
 # Units of the dimensionless results (docs/model.md)
@@ -96,34 +98,39 @@ def with_options(head: dict, options: dict) -> dict:
     return {**program, "options": options, **{k: head[k] for k in ("model", "grid", "physical") if k in head}}
 
 
+def _h5_summary(summary: dict) -> dict:
+    """The summary as the HDF5 group holds it: an energy that is missing is absent (its note says why),
+    not an empty value."""
+    def cycle(c: dict) -> dict:
+        if c.get("energy") is None and "energy_note" in c:
+            return {k: v for k, v in c.items() if k not in ("energy", "energy_err", "loops")}
+        return c
+    out = cycle(summary)
+    if out.get("spring"):
+        out = {**out, "spring": cycle(out["spring"])}
+    return out
+
+
 def curve_tree(curve, options: dict) -> dict:
     """The HDF5 tree of a :class:`~petsc_adhesion.tracing.curve.Curve`: its head, the options of its run, the
     points, the events and the summary."""
-    return {**with_options(curve.head, options), "kind": "curve", "curve": curve.branch, "events": curve.records,
-            "summary": curve.summary}
+    return {**with_options(head_of(curve), options), "kind": "curve", "curve": branch_record(curve),
+            "events": [event_record(e) for e in curve.events], "summary": _h5_summary(summary_of(curve))}
 
 
 def case_tree(curve, keep: tuple | None = None) -> dict:
     """A study's case: a curve's tree without the program's keys; the profiles only of the event kinds in
     ``keep`` (None: all that were computed)."""
-    events = curve.records
-    if keep is not None:
-        events = [_without_profiles(e) if e["kind"] not in keep else e for e in events]
-    tree = {**curve.head, "curve": curve.branch, "events": events, "summary": curve.summary}
+    events = [event_record(e, keep is None or e.kind in keep) for e in curve.events]
+    tree = {**head_of(curve), "curve": branch_record(curve), "events": events,
+            "summary": _h5_summary(summary_of(curve))}
     return {k: v for k, v in tree.items() if k in ("model", "grid", "curve", "events", "summary", "physical")}
-
-
-def _without_profiles(e: dict) -> dict:
-    out = {k: v for k, v in e.items() if k not in ("r", "H", "P")}
-    if "landing" in e:
-        out["landing"] = {k: v for k, v in e["landing"].items() if k not in ("r", "H", "P")}
-    return out
 
 
 def solve_tree(solution, options: dict) -> dict:
     """The HDF5 tree of a :class:`~petsc_adhesion.tracing.curve.Solution`."""
-    return {**with_options(solution.head, options), "kind": "solve",
-            "solution": {"H": solution.H, "P": solution.P, **solution.record}}
+    return {**with_options(head_of(solution), options), "kind": "solve",
+            "solution": {"H": solution.H, "P": solution.P, **solve_record(solution)}}
 
 
 def study_table(done: list[dict], axes: list[str]) -> dict:

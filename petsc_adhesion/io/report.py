@@ -2,58 +2,61 @@
 from __future__ import annotations
 
 from ..errors import tell
+from ..tracing.curve import Curve, Cycle, Event, Solution
+from ..tracing.measured import Measured, Missing
+from .summary import summary_of
 
 __all__ = ["report_curve", "report_solve"]
 
 
-def _pm(e: dict, key: str, digits: int = 8) -> str:
-    """``key = value`` with its bar when it has one."""
-    bar = e.get(f"{key}_err")
-    return f"{key} = {e[key]:.{digits}f}" + ("" if bar is None or bar == 0 else f" +- {bar:.1e}")
+def _pm(name: str, m: Measured, digits: int = 8) -> str:
+    """``name = value`` with its bar when it has one."""
+    return f"{name} = {m.value:.{digits}f}" + ("" if m.err is None or m.err == 0 else f" +- {m.err:.1e}")
 
 
-def _note(e: dict) -> str:
+def _note(e: Event) -> str:
     """Why an event has no bar, when it has none."""
-    return "  (no error bar: not found again on the nested levels)" if e.get("error_note") else ""
+    return "  (no error bar: not found again on the nested levels)" if e.note else ""
 
 
-def _energy(s: dict) -> str:
+def _energy(c: Cycle) -> str:
     """The energy of a cycle with its bar and the number of loops, or why there is none."""
-    if s["energy"] is None:
-        return f"none: {s.get('energy_note', 'no cycle')}"
-    loops = f"{s['loops']} hysteresis loop{'s' * (s['loops'] != 1)}"
-    return f"{_pm(s, 'energy', 8)}  ({loops})"
+    if isinstance(c.energy, Missing):
+        return f"none: {c.energy.reason}"
+    loops = f"{c.loops} hysteresis loop{'s' * (c.loops != 1)}"
+    return f"{_pm('energy', c.energy, 8)}  ({loops})"
 
 
-def report_curve(s: dict) -> None:
-    """The console lines of a curve's summary (rank 0)."""
+def report_curve(curve: Curve) -> None:
+    """The console lines of a curve (rank 0)."""
     out = []
-    po = s["pull_off"]
-    extra = f" + {s['error_estimate']['wall_time_s']:.3g} s for the error bars" if "error_estimate" in s else ""
-    out.append(f"mu = {s['mu']:g}  sigma = {s['sigma']:g}  N = {s['n_nodes']}  steps {s['steps']} "
-               f"(rejected {s['rejected_steps']})  {s['wall_time_s']:.3g} s{extra}; stopped: {s['stop_reason']}")
+    d, po = curve.diagnostics, curve.pull_off
+    extra = f" + {d.error_estimate.wall_time_s:.3g} s for the error bars" if d.error_estimate is not None else ""
+    out.append(f"mu = {curve.model.mu:g}  sigma = {curve.model.sigma:g}  N = {curve.grid.largest}  steps {d.steps} "
+               f"(rejected {d.rejected_steps})  {d.wall_time_s:.3g} s{extra}; stopped: {d.stop_reason}")
     if po:
-        out.append(f"  pull-off (load control)  {_pm(po, 'lambda')}  {_pm(po, 'F')}{_note(po)}")
-    for f in s["folds"]:
-        land = f.get("landing")
-        to = f"  -> lands at {_pm(land, 'F')}" if land else ""
-        out.append(f"  {f['kind']:<23}  {_pm(f, 'lambda')}  {_pm(f, 'F')}{to}{_note(f)}")
-    for e in s["equilibria"]:
-        out.append(f"  equilibrium F = 0       {_pm(e, 'lambda')}{_note(e)}")
-    for e in s["at_lambda"]:
-        out.append(f"  at lambda               {_pm(e, 'lambda')}  {_pm(e, 'F')}{_note(e)}")
-    out.append(f"  energy of a cycle       {_energy(s)}  (rigid machine)")
-    sp = s.get("spring")
-    if sp:
-        for f in sp["jumps"]:
-            land = f.get("landing")
-            to = f"  -> lands at {_pm(land, 'lambda')}  {_pm(land, 'F')}" if land else ""
-            out.append(f"  {f['kind']:<8} (K = {sp['K']:.4g})  {_pm(f, 'Z')}  {_pm(f, 'lambda')}  {_pm(f, 'F')}{to}"
+        out.append(f"  pull-off (load control)  {_pm('lambda', po.lam)}  {_pm('F', po.F)}{_note(po)}")
+    for f in curve.events:
+        if f.kind not in ("snap_on", "snap_off"):
+            continue
+        to = f"  -> lands at {_pm('F', f.landing.F)}" if f.landing else ""
+        out.append(f"  {f.kind:<23}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}{_note(f)}")
+    for e in curve.events_of("equilibrium"):
+        out.append(f"  equilibrium F = 0       {_pm('lambda', e.lam)}{_note(e)}")
+    for e in curve.events_of("lambda"):
+        out.append(f"  at lambda               {_pm('lambda', e.lam)}  {_pm('F', e.F)}{_note(e)}")
+    out.append(f"  energy of a cycle       {_energy(curve.rigid)}  (rigid machine)")
+    sp = curve.spring
+    if sp is not None:
+        for f in sp.jumps:
+            land = f.landing
+            to = f"  -> lands at {_pm('lambda', land.lam)}  {_pm('F', land.F)}" if land else ""
+            out.append(f"  {f.kind:<8} (K = {sp.K:.4g})  {_pm('Z', f.Z)}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}"
                        f"{_note(f)}")
-        out.append(f"  energy of a cycle       {_energy(sp)}  (spring K = {sp['K']:.4g})")
-    if "physical" in s:
-        out += _physical_lines(s["physical"])
-    for w in s["warnings"]:
+        out.append(f"  energy of a cycle       {_energy(sp.cycle)}  (spring K = {sp.K:.4g})")
+    if curve.model.bodies is not None:
+        out += _physical_lines(summary_of(curve)["physical"])
+    for w in curve.warnings:
         out.append(f"  WARNING: {w}")
     tell("\n".join(out))
 
@@ -85,12 +88,14 @@ def _physical_lines(p: dict) -> list[str]:
     return out
 
 
-def report_solve(res: dict, physical: dict | None = None) -> None:
-    """The console line of a fixed-approach solve (rank 0), and its physical values (``physical`` of the
-    summary)."""
-    line = (f"lambda = {res['lambda']:.10g}  F = {res['F']:.10g}  H0 = {res['H0']:.10g}  "
-            f"Newton {res['snes_iterations']}  KSP {res['ksp_iterations']}  {res['wall_time_s']:.3g} s")
-    if physical:
+def report_solve(s: Solution) -> None:
+    """The console line of a fixed-approach solve (rank 0), and its physical values."""
+    line = (f"lambda = {s.lam:.10g}  F = {s.F:.10g}  H0 = {s.H0:.10g}  "
+            f"Newton {s.snes_iterations}  KSP {s.ksp_iterations}  {s.wall_time_s:.3g} s")
+    if s.model.bodies is not None:
+        d = s.model.bodies.describe()
+        physical = {"mu": d["mu"], "lambda_nm": s.lam * d["approach_nm"], "F_nN": s.F * d["force_nN"],
+                    "H0_nm": s.H0 * d["approach_nm"]}
         line += (f"\n  in physical units (mu = {physical['mu']:.4g}): lambda = {physical['lambda_nm']:.5g} nm  "
                  f"F = {physical['F_nN']:.5g} nN  H0 = {physical['H0_nm']:.5g} nm")
     tell(line)

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from .layout import _EPS, _LOAD, _RAD
+from .summary import branch_record, event_record
 
 __all__ = ["CURVE_COLUMNS", "EVENT_COLUMNS", "curve_csv_columns", "event_csv_columns", "table_csv_columns",
            "write_csv", "write_curve_csv", "write_events_csv", "write_table_csv"]
@@ -21,7 +22,7 @@ __all__ = ["CURVE_COLUMNS", "EVENT_COLUMNS", "curve_csv_columns", "event_csv_col
 #: unit of a dimensionless column -> (the suffix of its physical twin, its unit, the scale in the physical group)
 _PHYSICAL = {_EPS: ("nm", "nm", "approach_nm"), _LOAD: ("nN", "nN", "force_nN"), _RAD: ("nm", "nm", "radius_nm")}
 
-#: The curve's columns: (key of Curve.branch, unit or None); Z and stable_spring only behind a spring.
+#: The curve's columns: (key of the HDF5 group curve, unit or None); Z and stable_spring only behind a spring.
 CURVE_COLUMNS = (("lambda", _EPS), ("F", _LOAD), ("Z", _EPS), ("contact_radius", _RAD), ("stable", None),
                  ("stable_spring", None))
 
@@ -77,8 +78,8 @@ def _with_physical(columns: list, physical: dict | None) -> list:
 
 
 def curve_csv_columns(branch: dict, physical: dict | None = None) -> list:
-    """The columns of the curve's CSV (header name, unit, values), from
-    :attr:`~petsc_adhesion.tracing.curve.Curve.branch` and the scales of ``physical`` (or None)."""
+    """The columns of the curve's CSV (header name, unit, values), from the HDF5 group ``curve``
+    (:func:`~petsc_adhesion.io.summary.branch_record`) and the scales of ``physical`` (or None)."""
     cols = [(k, unit, list(branch[k])) for k, unit in CURVE_COLUMNS if k in branch]
     return _with_physical(cols, physical)
 
@@ -91,7 +92,7 @@ def _event_value(e: dict, name: str):
 
 def event_csv_columns(records: list[dict], physical: dict | None = None) -> list:
     """The columns of the events' CSV (header name, unit, values), one row per record of
-    :func:`~petsc_adhesion.tracing.results.event_record` (None where an event has no such value)."""
+    :func:`~petsc_adhesion.io.summary.event_record` (None where an event has no such value)."""
     cols = [(name, unit, [_event_value(e, name) for e in records]) for name, unit in EVENT_COLUMNS]
     return _with_physical(cols, physical)
 
@@ -111,14 +112,18 @@ def write_csv(path: str, columns: list) -> None:
             out.writerow([_cell(values[i]) for _, _, values in columns])
 
 
+def _physical(curve) -> dict | None:
+    return None if curve.model.bodies is None else curve.model.bodies.describe()
+
+
 def write_curve_csv(path: str, curve) -> None:
     """The points of a :class:`~petsc_adhesion.tracing.curve.Curve` as CSV, in traced order."""
-    write_csv(path, curve_csv_columns(curve.branch, curve.head.get("physical")))
+    write_csv(path, curve_csv_columns(branch_record(curve), _physical(curve)))
 
 
 def write_events_csv(path: str, curve) -> None:
     """The events of a :class:`~petsc_adhesion.tracing.curve.Curve` as CSV, in the order found."""
-    write_csv(path, event_csv_columns(curve.records, curve.head.get("physical")))
+    write_csv(path, event_csv_columns([event_record(e, profiles=False) for e in curve.events], _physical(curve)))
 
 
 def write_table_csv(path: str, table: dict) -> None:

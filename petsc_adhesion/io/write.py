@@ -1,7 +1,7 @@
 """Result files: their layout (docs/output.md) and their writing, by rank 0.
 
-The layout of a curve or a solve is built here from the result dicts of
-:mod:`petsc_adhesion.tracing.results`, once for the JSON summary and the HDF5 tree;
+The layout of a curve or a solve is built from the library's result values
+(:mod:`petsc_adhesion.io.summary`, :mod:`petsc_adhesion.io.layout`), once for the JSON summary and the HDF5 tree;
 the files of one run are written into the temporaries of a
 :class:`~petsc_adhesion.io.resultset.ResultSet` and committed together.
 """
@@ -22,6 +22,7 @@ from .layout import (
 )
 from .fit import DESCRIBE_FIT, write_fit_csv
 from .resultset import ResultSet, plot_format
+from .summary import solve_summary, summary_of
 from .text import write_curve_csv, write_events_csv, write_table_csv
 
 __all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study", "write_critical", "write_fit"]
@@ -105,7 +106,7 @@ def write_curve(curve, options: dict, files: ResultSet, commit: bool = True) -> 
         fmt = plot_format(files.targets["plot"])
         curve_figure(tree, files.temp("plot"), fmt)
     if "summary" in files.targets:
-        write_json(files.temp("summary"), curve.summary)
+        write_json(files.temp("summary"), summary_of(curve))
     if "csv" in files.targets:
         write_curve_csv(files.temp("csv"), curve)
     if "csv_events" in files.targets:
@@ -135,7 +136,7 @@ def write_solve(solution, options: dict, files: ResultSet, commit: bool = True) 
     if "out" in files.targets:
         write_h5(files.temp("out"), solve_tree(solution, options))
     if "summary" in files.targets:
-        write_json(files.temp("summary"), solution.summary)
+        write_json(files.temp("summary"), solve_summary(solution))
     if commit:
         files.commit()
 

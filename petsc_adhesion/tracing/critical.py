@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from petsc4py import PETSc
@@ -65,9 +65,10 @@ from ..model.pressure import pressure_law
 from ..tracing import results
 from .edge_grids import BAND, grid_for
 from .error_bars import extrapolate
+from .measured import Measured
 from .tracer import Tracer, contact_radius, edge_of
 
-__all__ = ["fold_system", "at_parameter", "ordinary_folds", "bracket", "trace_cusp", "sigma_c", "mu_c", "Cusp", "BRACKET",
+__all__ = ["Critical", "fold_system", "at_parameter", "ordinary_folds", "bracket", "trace_cusp", "sigma_c", "mu_c", "Cusp", "BRACKET",
            "LEVELS", "SIGMA_START", "SIGMA_RANGE", "MU_START", "MU_RANGE", "FOLD_SETTINGS"]
 
 #: The bracket of stage 1 ends when its two values are within this ratio: the fold curve then travels
@@ -313,7 +314,46 @@ def _relocate(cusp: Cusp, model, name: str, nodes: np.ndarray, direction: int, c
     return None
 
 
-def _critical(model, name: str, levels, comm) -> dict:
+@dataclass(frozen=True)
+class Critical:
+    """The cusp of the fold curve: the critical value of ``name`` (sigma: sigma_c at the fixed mu; mu: mu_c
+    at the fixed sigma) and the lambda and F there, each a :class:`~.measured.Measured` (its best value
+    from the levels, its bar with the domain's share); ``domain``: the change of the critical value on the
+    finest level from r_m to 2 r_m; per level (``levels``, ``n_nodes``) the values on it (``value_grid``,
+    ``lam_grid``, ``F_grid``); the ``bracket`` of ordinary curves (with folds, without); the cusp's radius
+    of peak attraction ``edge`` and ``contact_radius``; the ``model`` at the cusp (its roughness law, its
+    r_m); the wall time; ``warning`` when the cusp lies outside the bracket (else None)."""
+
+    name: str
+    fixed: float
+    value: Measured
+    lam: Measured
+    F: Measured
+    domain: float
+    levels: tuple
+    n_nodes: tuple
+    value_grid: tuple
+    lam_grid: tuple
+    F_grid: tuple
+    bracket: tuple
+    edge: float
+    contact_radius: float
+    model: object = field(repr=False)
+    wall_time_s: float = 0.0
+    warning: str | None = None
+
+    @property
+    def kind(self) -> str:
+        """sigma_c or mu_c."""
+        return f"{self.name}_c"
+
+    @property
+    def fixed_name(self) -> str:
+        """The parameter held: mu for sigma_c, sigma for mu_c."""
+        return "mu" if self.name == "sigma" else "sigma"
+
+
+def _critical(model, name: str, levels, comm) -> Critical:
     """The cusp in ``name`` (sigma: hysteresis below it; mu: above it) of ``model``: stages 1-3."""
     t0 = time.perf_counter()
     direction = 1 if name == "sigma" else -1
@@ -348,24 +388,22 @@ def _critical(model, name: str, levels, comm) -> dict:
     domain = [abs(longer[i] - at[max(levels)][i]) for i in range(3)]
     best = {k: extrapolate({level: v[i] for level, v in at.items()}) for i, k in enumerate(("s", "lambda", "F"))}
     s, s_err = best["s"]
-    fixed = ("mu", model.mu) if name == "sigma" else \
-        ("sigma", pressure_law(model).sigma if model.roughness == "measured" else model.sigma)
-    out = {fixed[0]: fixed[1], f"{name}_c": s, f"{name}_c_err": s_err + domain[0],
-           "lambda_c": best["lambda"][0], "lambda_c_err": best["lambda"][1] + domain[1],
-           "F_c": best["F"][0], "F_c_err": best["F"][1] + domain[2], f"{name}_c_domain": domain[0],
-           "levels": sorted(at), "n_nodes": [at[k][3] for k in sorted(at)],
-           f"{name}_c_grid": [at[k][0] for k in sorted(at)], "lambda_c_grid": [at[k][1] for k in sorted(at)],
-           "F_c_grid": [at[k][2] for k in sorted(at)], "bracket": [yes, no], "edge": peak, "contact_radius": contact,
-           "roughness": pressure_law(at_parameter(model, name, s)).describe(), "rmax": model.rmax,
-           "wall_time_s": time.perf_counter() - t0}
+    fixed = model.mu if name == "sigma" else \
+        (pressure_law(model).sigma if model.roughness == "measured" else model.sigma)
     lo, hi = sorted((yes, no))
-    if not lo <= s <= hi:
-        out["warning"] = (f"the cusp at {name} = {s:.6g} lies outside the bracket [{lo:.6g}, {hi:.6g}] of the "
-                          f"traced curves")
-    return out
+    keys = sorted(at)
+    return Critical(name=name, fixed=fixed, value=Measured(s, s_err + domain[0]),
+                    lam=Measured(best["lambda"][0], best["lambda"][1] + domain[1]),
+                    F=Measured(best["F"][0], best["F"][1] + domain[2]), domain=domain[0], levels=tuple(keys),
+                    n_nodes=tuple(at[k][3] for k in keys), value_grid=tuple(at[k][0] for k in keys),
+                    lam_grid=tuple(at[k][1] for k in keys), F_grid=tuple(at[k][2] for k in keys),
+                    bracket=(yes, no), edge=peak, contact_radius=contact, model=at_parameter(model, name, s),
+                    wall_time_s=time.perf_counter() - t0,
+                    warning=None if lo <= s <= hi else (f"the cusp at {name} = {s:.6g} lies outside the bracket "
+                                                        f"[{lo:.6g}, {hi:.6g}] of the traced curves"))
 
 
-def sigma_c(model, mu: float, grid_refinements=LEVELS, comm=None) -> dict:
+def sigma_c(model, mu: float, grid_refinements=LEVELS, comm=None) -> Critical:
     """The critical roughness at Tabor parameter ``mu``: the largest sigma with hysteresis, the cusp of the
     fold curve in (sigma, lambda), with its error bar.
 
@@ -383,23 +421,23 @@ def sigma_c(model, mu: float, grid_refinements=LEVELS, comm=None) -> dict:
 
     Returns
     -------
-    dict
-        mu, sigma_c, sigma_c_err, lambda_c(_err), F_c(_err) at the cusp (best values and bars from
-        the levels), the values on each level (``*_grid``), ``levels``, ``n_nodes``, the change on
-        the finest level from r_m to 2 r_m (``sigma_c_domain``, part of the bars), the ``bracket``
-        of ordinary curves (with folds, without), the cusp's radius of peak attraction ``edge`` and
-        ``contact_radius``, the roughness law, ``wall_time_s``; ``warning`` when the cusp lies outside
-        the bracket.  ValueError when there is no hysteresis even at sigma = SIGMA_RANGE[0].
+    Critical
+        sigma_c, lambda_c and F_c at the cusp (best values and bars from the levels), the values on
+        each level, the levels and their nodes, the change on the finest level from r_m to 2 r_m
+        (``domain``, part of the bars), the ``bracket`` of ordinary curves (with folds, without), the
+        cusp's radius of peak attraction ``edge`` and ``contact_radius``, the model at the cusp,
+        ``wall_time_s``; ``warning`` when the cusp lies outside the bracket.  ValueError when there is
+        no hysteresis even at sigma = SIGMA_RANGE[0].
     """
     return _critical(replace(model, mu=mu), "sigma", grid_refinements, comm or PETSc.COMM_WORLD)
 
 
-def mu_c(model, sigma: float, grid_refinements=LEVELS, comm=None) -> dict:
+def mu_c(model, sigma: float, grid_refinements=LEVELS, comm=None) -> Critical:
     """The critical Tabor parameter at roughness ``sigma``: the smallest mu with hysteresis, the cusp of the
     fold curve in (mu, lambda), with its error bar; at sigma = 0 the onset of hysteresis of a smooth
     sphere.
 
-    Parameters and result as :func:`sigma_c`, with mu and sigma exchanged (``mu_c``, ``mu_c_err``, ...).
+    Parameters and result as :func:`sigma_c`, with mu and sigma exchanged.
     ValueError when there is no hysteresis up to mu = MU_RANGE[1].
     """
     return _critical(at_parameter(model, "sigma", sigma), "mu", grid_refinements, comm or PETSc.COMM_WORLD)

@@ -1,16 +1,20 @@
-"""The results of the library: a load-approach curve, its events, a fixed-approach solution, and their summaries.
+"""The results of the library as values: a load-approach curve, its events, its cycles, a fixed-approach solution.
 
 :func:`~petsc_adhesion.tracing.trace.trace_curve` returns a :class:`Curve`,
-:func:`~petsc_adhesion.tracing.trace.solve_at` a :class:`Solution`: plain
-objects, the same on every rank, holding what was computed (the points, the
-events with their best values, error bars and landings, the profiles when
-asked for) and the summary dict a ``-summary`` file holds (docs/output.md).
-The result files are made from them (:mod:`petsc_adhesion.io.write`).
+:func:`~petsc_adhesion.tracing.trace.solve_at` a :class:`Solution`: plain frozen
+objects, the same on every rank, holding what was computed.  Learnt from
+BifurcationKit's ``ContResult`` (a branch and its special points) and
+``SpecialPoint`` (a value with its precision and status): every quantity with an
+error bar is a :class:`~.measured.Measured`, what a run did not compute a
+:class:`~.measured.Missing` (or None where it does not exist, e.g. Z without a
+spring); no dict.  The result files are made from these objects by
+:mod:`petsc_adhesion.io` alone (one serializer per format), which also names
+their keys.  A new quantity of an event is one field here and, where it is not
+read generically, one line in a serializer (docs/architecture.md).
 
 Units (docs/model.md): lambda and H in epsilon, F in 2 pi R gamma (eq. 26,
 negative when tensile), r and contact radii in sqrt(epsilon R), P in
-8 gamma / (3 epsilon); with physical inputs (``Model.bodies``) the summary
-holds every event in nm and nN too.
+8 gamma / (3 epsilon), energies in 2 pi R gamma epsilon.
 """
 from __future__ import annotations
 
@@ -18,38 +22,37 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.physical import in_units
-from ..model.pressure import pressure_law
 from ..version import __version__
+from .measured import Measured, Missing
 
-__all__ = ["Event", "Curve", "Solution", "program_record", "model_record", "curve_summary", "solve_summary",
-           "EVENT_KINDS"]
+__all__ = ["Profile", "Landing", "Event", "Branch", "Cycle", "SpringResult", "ErrorEstimate", "Diagnostics",
+           "Assessment", "Program", "GridRecord", "Curve", "Solution", "EVENT_KINDS"]
 
 #: The kinds of events of a curve (:mod:`~petsc_adhesion.tracing.results` names them).
 EVENT_KINDS = ("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda", "jump_in", "jump_off")
-#: The keys of an event (and of a landing) that a summary keeps.
-_BRIEF = ("kind", "lambda", "F", "Z", "H0", "contact_radius", "stable", "lambda_err", "F_err", "Z_err",
-          "contact_radius_err", "lambda_grid", "F_grid", "Z_grid", "contact_radius_grid", "F_beyond", "levels",
-          "target_met", "error_note", "refinement_note")
-_LANDING = ("lambda", "F", "Z", "H0", "contact_radius", "lambda_err", "F_err", "Z_err", "contact_radius_err",
-            "lambda_grid", "F_grid")
 
 
-def program_record(comm) -> dict:
-    """What every result says about the program that made it: versions and ranks (``comm``: PETSc's)."""
-    import petsc4py
-    from petsc4py import PETSc
+@dataclass(frozen=True)
+class Profile:
+    """The state at an event on the nodes ``r``: the separation ``H`` (eq. 12) and the pressure ``P`` (eq. 14)."""
 
-    return {"program": "petsc-adhesion", "version": __version__,
-            "petsc_version": "%d.%d.%d" % PETSc.Sys.getVersion(),
-            "petsc4py_version": petsc4py.__version__, "mpi_ranks": comm.getSize()}
+    r: np.ndarray = field(repr=False)
+    H: np.ndarray = field(repr=False)
+    P: np.ndarray = field(repr=False)
 
 
-def model_record(model) -> dict:
-    """The model a result was computed for: mu, sigma, r_m, the roughness average and the domain."""
-    return {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **pressure_law(model).describe(),
-            "domain": "half-infinite (the rigid sphere's attraction beyond r_m added)" if model.farfield
-            else "truncated at r_m (the paper's model)"}
+@dataclass(frozen=True)
+class Landing:
+    """Where the jump from a fold lands: the other stable branch at the fold's lambda (behind a spring, at its
+    Z, ``lam`` then moved by the spring's extension).  ``lam`` is the fold's best lambda (with a rigid
+    machine) or its own best value and bar (behind a spring); ``F`` its best load, bar and grid value."""
+
+    lam: Measured
+    F: Measured
+    H0: float
+    Z: Measured | None = None
+    contact_radius: Measured | None = None
+    profile: Profile | None = None
 
 
 @dataclass(frozen=True)
@@ -59,213 +62,251 @@ class Event:
     ``kind``: snap_on, snap_off (the turning points in lambda), F_min, F_max (the
     extrema of the load; the most tensile F_min is the pull-off under load control),
     equilibrium (F = 0), lambda (a state asked for), or behind a spring jump_in and
-    jump_off (the turning points of its base Z = lambda + F / K, ``Z`` and ``Z_err``
-    its value and bar; stable is then None, the state marginal under the spring).  ``lam`` and ``F`` are the best
-    values (Richardson-extrapolated over nested grids), ``lam_err`` and ``F_err`` their
-    error bars, ``lam_grid`` and ``F_grid`` the values on the grid the event was located
-    on (None, like the bars, without an error estimate: ``note`` says why).  ``stable``
-    is None at a fold (marginal).  ``landing``: where the jump from a fold lands (kind
-    ``"landing"``).  ``contact_radius``: where the separation rises through the edge
-    level (docs/numerics.md), its best value with ``contact_radius_err`` its bar.  ``r``, ``H``, ``P``: the profiles of eq. (12) and (14)
-    when asked for, else None.
+    jump_off (the turning points of its base Z = lambda + F / K; ``stable`` is then
+    None, the state marginal under the spring).  ``lam``, ``F``, ``Z`` and
+    ``contact_radius`` are :class:`~.measured.Measured`: the best value
+    (Richardson-extrapolated over nested grids), its bar and the value on the grid
+    the event was located on (no bar and no grid value without an error estimate:
+    ``note`` says why when one was tried).  ``Z`` is None without a spring.
+    ``stable`` is None at a fold (marginal).  ``F_beyond``: the part of F from the
+    rigid sphere's attraction beyond r_m (half-infinite model; None without an
+    error estimate).  ``levels``: the refinement levels it was located on;
+    ``target_met``: whether -target_error was reached (None without one tried);
+    ``refinement_note``: why refinement stopped short.  ``landing``: where the
+    jump from a fold lands.  ``profile``: H and P at the event when asked for.
     """
 
     kind: str
-    lam: float
-    F: float
+    lam: Measured
+    F: Measured
     H0: float
+    Z: Measured | None = None
+    contact_radius: Measured | None = None
     stable: bool | None = None
-    lam_err: float | None = None
-    F_err: float | None = None
-    lam_grid: float | None = None
-    F_grid: float | None = None
     F_beyond: float | None = None
-    contact_radius: float | None = None
-    levels: tuple = ()
+    levels: tuple[int, ...] = ()
     target_met: bool | None = None
     note: str | None = None
-    landing: Event | None = None
-    Z: float | None = None
-    Z_err: float | None = None
-    contact_radius_err: float | None = None
-    r: np.ndarray | None = field(default=None, repr=False)
-    H: np.ndarray | None = field(default=None, repr=False)
-    P: np.ndarray | None = field(default=None, repr=False)
-
-    @classmethod
-    def from_record(cls, e: dict) -> Event:
-        """The event of a record as the result files hold it (:func:`~.results.event_record`)."""
-        def num(key):
-            return None if e.get(key) is None else float(e[key])
-        return cls(kind=e["kind"], lam=float(e["lambda"]), F=float(e["F"]), H0=float(e["H0"]),
-                   stable=None if e.get("stable") is None else bool(e["stable"]), lam_err=num("lambda_err"),
-                   F_err=num("F_err"), lam_grid=num("lambda_grid"), F_grid=num("F_grid"), F_beyond=num("F_beyond"),
-                   contact_radius=num("contact_radius"), contact_radius_err=num("contact_radius_err"),
-                   Z=num("Z"), Z_err=num("Z_err"), levels=tuple(int(k) for k in e.get("levels", ())),
-                   target_met=e.get("target_met"), note=e.get("error_note"),
-                   landing=cls.from_record({"kind": "landing", **e["landing"]}) if e.get("landing") else None,
-                   r=e.get("r"), H=e.get("H"), P=e.get("P"))
-
-
-def _plain(x):
-    """Python numbers, lists and dicts of x (as its JSON file holds it)."""
-    if isinstance(x, dict):
-        return {k: _plain(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_plain(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, np.generic):
-        return x.item()
-    return x
-
-
-def _brief(e: dict) -> dict:
-    out = {k: v for k, v in e.items() if k in _BRIEF}
-    if "landing" in e:
-        out["landing"] = {k: v for k, v in e["landing"].items() if k in _LANDING}
-    return out
-
-
-def _common(head: dict) -> dict:
-    """The keys every summary has: versions, the model and the grid size (the largest grid's)."""
-    flat = {k: v for k, v in head.items() if k not in ("options", "model", "grid")}
-    sizes = head["grid"].get("n_nodes", [head["grid"]["r"].size])
-    return {**flat, **head["model"], "n_nodes": int(max(sizes))}
-
-
-def _cycle(c: dict) -> dict:
-    return {"energy": c["energy"], "energy_err": c["energy_err"], "loops": c["loops"],
-            **({"energy_note": c["energy_note"]} if "energy_note" in c else {})}
-
-
-def curve_summary(res: dict, head: dict) -> dict:
-    """The summary of a traced curve (``res``: :func:`~.trace.trace_curve`'s record; ``head``: the program,
-    model, grid and physical inputs)."""
-    ev, po = res["events"], res["pull_off"]
-    cycles = res["cycles"]
-    s = {**_common(head),
-         "pull_off": _brief(po) if po else None,
-         "folds": [_brief(e) for e in ev if e["kind"] in ("snap_on", "snap_off")],
-         "equilibria": [{k: v for k, v in _brief(e).items() if k not in ("F", "F_err", "F_grid")}
-                        for e in ev if e["kind"] == "equilibrium"],
-         "load_extrema": [_brief(e) for e in ev if e["kind"] in ("F_min", "F_max")],
-         "at_lambda": [_brief(e) for e in ev if e["kind"] == "lambda"],
-         **_cycle(cycles["rigid"]),
-         **({"spring": {"K": cycles["spring"]["K"],
-                        "jumps": [_brief(e) for e in ev if e["kind"] in ("jump_in", "jump_off")],
-                        **_cycle(cycles["spring"])}} if "spring" in cycles else {}),
-         "wall_gap": res["wall_gap"],
-         "steps": res["steps"], "rejected_steps": res["rejected_steps"], "regrids": res["regrids"],
-         **{k: res[k] for k in ("guard_activations", "smallest_step", "most_newton_its", "most_ksp_its")},
-         "stop_reason": res["stop_reason"],
-         "grid_warning": res["grid_warning"], "warnings": res["warnings"], "complete": not res["incomplete"],
-         "lambda_start": res["lambda_start"], "wall_time_s": res["wall_time_s"]}
-    if "error_estimate" in res:
-        s["error_estimate"] = res["error_estimate"]
-    if "physical" in head:
-        s["physical"] = in_units(s, head["physical"])
-    return _plain(s)
-
-
-def solve_summary(res: dict, head: dict) -> dict:
-    """The summary of a fixed-approach solve (``res``: its record without the profiles)."""
-    summ = {**_common(head), **res}
-    if "physical" in head:
-        d = head["physical"]
-        summ["physical"] = {**d, "lambda_nm": res["lambda"] * d["approach_nm"], "F_nN": res["F"] * d["force_nN"],
-                            "H0_nm": res["H0"] * d["approach_nm"]}
-    return _plain(summ)
+    refinement_note: str | None = None
+    landing: Landing | None = None
+    profile: Profile | None = None
 
 
 @dataclass(frozen=True)
-class Curve:
-    """A load-approach curve: its computed points, its events, its pull-off and its summary.
-
-    ``lam``, ``F``, ``H0`` and ``stable`` hold one entry a computed point, in the order
-    traced (lambda = alpha / epsilon, F in 2 pi R gamma by eq. (26), H0 = H(0), stable
-    under displacement control); ``branch`` holds those, the contact radius, behind a
-    spring Z and the stability under it, and the step statistics of every point
-    (docs/output.md, the HDF5 group ``curve``).  ``events`` in the order
-    found; ``pull_off`` the most tensile load minimum (load control).  ``summary`` is
-    the dict a ``-summary`` file holds; ``head`` the program, model, grid and physical
-    inputs it was computed with; ``records`` the events as the result files hold them.
-    """
+class Branch:
+    """The computed points of a curve, one entry each in the order traced: lambda = alpha / epsilon, F (eq.
+    26), H0 = H(0), stability under displacement control (lambdadot > 0), the contact radius (on the grid of
+    the point), the step that reached it (0 at the start), Newton and Krylov iterations, d lambda / ds and
+    the corrector; behind a spring its base Z = lambda + F / K and the stability under it (dZ/ds > 0),
+    None without one."""
 
     lam: np.ndarray = field(repr=False)
     F: np.ndarray = field(repr=False)
     H0: np.ndarray = field(repr=False)
     stable: np.ndarray = field(repr=False)
-    events: tuple
+    contact_radius: np.ndarray = field(repr=False)
+    ds: np.ndarray = field(repr=False)
+    newton_its: np.ndarray = field(repr=False)
+    ksp_its: np.ndarray = field(repr=False)
+    lambdadot: np.ndarray = field(repr=False)
+    corrector: np.ndarray = field(repr=False)
+    Z: np.ndarray | None = field(default=None, repr=False)
+    stable_spring: np.ndarray | None = field(default=None, repr=False)
+
+    @classmethod
+    def from_points(cls, points, radii, K: float | None = None) -> Branch:
+        """The branch of the core's points (:class:`~petsc_adhesion.core.protocol.Point`) and their contact
+        radii; ``K``: the stiffness of the spring the approach is driven through (None: a rigid machine)."""
+        lam = np.array([p.p for p in points])
+        F = np.array([p.values["F"] for p in points])
+        spring = {} if K is None else {             # its base Z = lambda + F / K, stable where dZ/ds > 0
+            "Z": lam + F / K, "stable_spring": np.array([p.pdot + p.rates["F"] / K > 0 for p in points])}
+        return cls(lam=lam, F=F, H0=np.array([p.x[0] for p in points]),
+                   stable=np.array([p.pdot > 0 for p in points]),
+                   contact_radius=np.array(radii, dtype=float), ds=np.array([p.ds for p in points]),
+                   newton_its=np.array([p.newton_its for p in points]),
+                   ksp_its=np.array([p.ksp_its for p in points]),
+                   lambdadot=np.array([p.pdot for p in points]),
+                   corrector=np.array([p.corrector for p in points], dtype="S9"), **spring)
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """One quasi-static approach-retract cycle (:mod:`~petsc_adhesion.tracing.energy`): the energy it
+    dissipates (units 2 pi R gamma epsilon; a true 0 without hysteresis on a curve traced through; Missing
+    with its reason when the cycle was not closed), the number of its hysteresis ``loops`` (None where the
+    energy is missing) and the stiffness ``K`` of the machine's spring (None: the rigid machine)."""
+
+    energy: Measured | Missing
+    loops: int | None
+    K: float | None = None
+
+
+@dataclass(frozen=True)
+class SpringResult:
+    """Behind a spring of stiffness ``K`` (units 2 pi R gamma / epsilon): its jumps (jump_in, jump_off, in the
+    order found) and its cycle."""
+
+    K: float
+    jumps: tuple[Event, ...]
+    cycle: Cycle
+
+
+@dataclass(frozen=True)
+class ErrorEstimate:
+    """What the error bars cost and reached: their wall time, the -target_error asked for (None: none) and
+    the refinement levels the events were located on."""
+
+    wall_time_s: float
+    target_error: float | None
+    levels: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class Diagnostics:
+    """How the curve was traced: steps taken and rejected, regrids, turning points passed, the domain guard's
+    activations, the smallest step, the most iterations of a corrector, why it stopped, the wall time, the
+    start, the least gap to the wall of the roughness rule, and the error bars' cost (None: none made)."""
+
+    steps: int
+    rejected_steps: int
+    regrids: int
+    folds: int
+    guard_activations: int
+    smallest_step: float
+    most_newton_its: int
+    most_ksp_its: int
+    stop_reason: str
+    wall_time_s: float
+    lambda_start: float
+    wall_gap: float
+    error_estimate: ErrorEstimate | None = None
+
+
+@dataclass(frozen=True)
+class Assessment:
+    """What makes a curve untrustworthy, one line each (``warnings``), the subset that makes it not what was
+    asked for (``incomplete``: the command line's exit status 3), among them the resolution check's
+    ``grid_warning`` (None: the grids resolve the cohesive zone)."""
+
+    warnings: tuple[str, ...]
+    incomplete: tuple[str, ...]
+    grid_warning: str | None = None
+
+    @property
+    def complete(self) -> bool:
+        return not self.incomplete
+
+
+@dataclass(frozen=True)
+class Program:
+    """What every result says about the program that made it: versions and ranks."""
+
+    program: str
+    version: str
+    petsc_version: str
+    petsc4py_version: str
+    mpi_ranks: int
+
+    @classmethod
+    def of(cls, comm) -> Program:
+        """This program on ``comm`` (PETSc's)."""
+        import petsc4py
+        from petsc4py import PETSc
+
+        return cls("petsc-adhesion", __version__, "%d.%d.%d" % PETSc.Sys.getVersion(), petsc4py.__version__,
+                   comm.getSize())
+
+
+@dataclass(frozen=True)
+class GridRecord:
+    """The collocation grid: the nodes ``r`` (of the last segment when the grid followed the contact edge)
+    and, for a curve, where each segment starts in lambda, its nodes and the edge its grid is centred on
+    (None on a fixed grid)."""
+
+    r: np.ndarray = field(repr=False)
+    lam: np.ndarray | None = field(default=None, repr=False)
+    n_nodes: np.ndarray | None = field(default=None, repr=False)
+    edge: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def largest(self) -> int:
+        """The nodes of the largest grid."""
+        return int(self.r.size if self.n_nodes is None else max(self.n_nodes))
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A load-approach curve: its branch of computed points, its events, its pull-off, its cycles, how it was
+    traced and what is wrong with it.
+
+    ``model``: the :class:`~petsc_adhesion.model.parameters.Model` it was computed for; ``program`` and
+    ``grid`` records; ``branch``: the points (:class:`Branch`); ``events`` in the order found; ``pull_off``
+    the most tensile load minimum (load control; None without one); ``rigid``: the cycle of a rigid machine;
+    ``spring``: behind a spring, its jumps and cycle (else None); ``diagnostics``; ``assessment``.
+    """
+
+    model: object = field(repr=False)
+    program: Program = field(repr=False)
+    grid: GridRecord = field(repr=False)
+    branch: Branch = field(repr=False)
+    events: tuple[Event, ...]
     pull_off: Event | None
-    summary: dict = field(repr=False)
-    branch: dict = field(repr=False)
-    head: dict = field(repr=False)
-    records: list = field(repr=False)
+    rigid: Cycle
+    spring: SpringResult | None
+    diagnostics: Diagnostics = field(repr=False)
+    assessment: Assessment = field(repr=False)
 
     @property
     def complete(self) -> bool:
         """Whether the curve is what was asked for (the command line's exit status 0, not 3)."""
-        return bool(self.summary["complete"])
+        return self.assessment.complete
 
     @property
     def warnings(self) -> list:
         """What makes the curve untrustworthy, one line each (the command line's WARNING lines)."""
-        return list(self.summary["warnings"])
+        return list(self.assessment.warnings)
 
     def events_of(self, kind: str) -> tuple:
         """The events of one kind: snap_on, snap_off, F_min, F_max, equilibrium, lambda, jump_in or jump_off."""
         return tuple(e for e in self.events if e.kind == kind)
 
     @property
+    def lam(self) -> np.ndarray:
+        """lambda at every computed point."""
+        return self.branch.lam
+
+    @property
+    def F(self) -> np.ndarray:
+        """F at every computed point."""
+        return self.branch.F
+
+    @property
+    def H0(self) -> np.ndarray:
+        """H(0) at every computed point."""
+        return self.branch.H0
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Stability under displacement control at every computed point."""
+        return self.branch.stable
+
+    @property
     def contact_radius(self) -> np.ndarray:
         """The contact radius of every computed point (docs/numerics.md; units sqrt(epsilon R))."""
-        return self.branch["contact_radius"]
+        return self.branch.contact_radius
 
     @property
     def Z(self) -> np.ndarray | None:
         """Behind a spring, its base position Z = lambda + F / K at every computed point (else None)."""
-        return self.branch.get("Z")
-
-    @property
-    def energy(self) -> tuple:
-        """(energy, bar) dissipated in one approach-retract cycle with a rigid machine (units 2 pi R gamma
-        epsilon; 0 without hysteresis; None when the cycle cannot be closed or has no bar)."""
-        return self.summary["energy"], self.summary["energy_err"]
-
-    @property
-    def spring(self) -> dict | None:
-        """Behind a spring: {K, jumps, energy, energy_err, loops} as the summary holds it (else None)."""
-        return self.summary.get("spring")
-
-    @classmethod
-    def from_result(cls, res: dict, head: dict) -> Curve:
-        """The curve of a traced record (rank 0's: the points, the events as records) and its head."""
-        pts = res["points"]
-        branch = {"lambda": np.array([p.p for p in pts]), "F": np.array([p.values["F"] for p in pts]),
-                  "stable": np.array([p.pdot > 0 for p in pts]), "ds": np.array([p.ds for p in pts]),
-                  "newton_its": np.array([p.newton_its for p in pts]), "ksp_its": np.array([p.ksp_its for p in pts]),
-                  "H0": np.array([p.x[0] for p in pts]), "lambdadot": np.array([p.pdot for p in pts]),
-                  "corrector": np.array([p.corrector for p in pts], dtype="S9"),
-                  "contact_radius": np.array(res["contact_radius"], dtype=float)}
-        spring = res["cycles"].get("spring")
-        if spring is not None:            # behind a spring: its base Z = lambda + F / K, stable where dZ/ds > 0
-            K = spring["K"]
-            branch["Z"] = branch["lambda"] + branch["F"] / K
-            branch["stable_spring"] = np.array([p.pdot + p.rates["F"] / K > 0 for p in pts])
-        records = [{k: v for k, v in e.items() if k != "segment"} for e in res["events"]]
-        summary = curve_summary(res, head)
-        events = [Event.from_record(e) for e in records]
-        pull = next((ev for ev, e in zip(events, res["events"]) if e is res["pull_off"]), None)
-        return cls(lam=branch["lambda"], F=branch["F"], H0=branch["H0"], stable=branch["stable"], events=tuple(events),
-                   pull_off=pull, summary=summary, branch=branch, head=head, records=records)
+        return self.branch.Z
 
 
 @dataclass(frozen=True)
 class Solution:
     """The state at one fixed approach ``lam``: H(r) (eq. 12) and P(r) (eq. 14) on the nodes r, the load F
-    (eq. 26; ``F_beyond`` of it from beyond r_m) and the summary a ``-summary`` file holds; ``record``: the
-    scalars of the solve (the solver's iterations and time among them), ``head`` as :class:`Curve`'s."""
+    (eq. 26; ``F_beyond`` of it from beyond r_m), H0 = H(0), the solver's iterations and wall time, and the
+    model, program and grid it was computed with."""
 
     lam: float
     F: float
@@ -274,14 +315,9 @@ class Solution:
     r: np.ndarray = field(repr=False)
     H: np.ndarray = field(repr=False)
     P: np.ndarray = field(repr=False)
-    summary: dict = field(repr=False)
-    head: dict = field(repr=False)
-    record: dict = field(repr=False)
-
-    @classmethod
-    def from_result(cls, res: dict, head: dict) -> Solution:
-        """The solution of a solve's record (``H`` and ``P`` whole) and its head."""
-        brief = {k: v for k, v in res.items() if not isinstance(v, np.ndarray)}
-        return cls(lam=float(res["lambda"]), F=float(res["F"]), H0=float(res["H0"]), F_beyond=float(res["F_beyond"]),
-                   r=np.asarray(head["grid"]["r"]), H=res["H"], P=res["P"], summary=solve_summary(brief, head),
-                   head=head, record=brief)
+    snes_iterations: int
+    ksp_iterations: int
+    wall_time_s: float
+    model: object = field(repr=False)
+    program: Program = field(repr=False)
+    grid: GridRecord = field(repr=False)

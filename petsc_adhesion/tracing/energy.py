@@ -43,7 +43,7 @@ import numpy as np
 
 from ..core.events import Fold
 
-__all__ = ["Node", "cycle", "energy_bar", "hermite_integral"]
+__all__ = ["Node", "Loop", "cycle", "energy_bar", "hermite_integral"]
 
 #: 3-point Gauss-Legendre on [0, 1]: exact for the product of a cubic and a quadratic.
 _GL_T = 0.5 + 0.5 * np.array([-math.sqrt(0.6), 0.0, math.sqrt(0.6)])
@@ -197,23 +197,39 @@ def _walk(nodes: list[Node], forward: bool) -> tuple[list[int], list] | str:
     return pieces, jumped
 
 
-def cycle(segments, fold: Fold) -> dict:
+@dataclass(frozen=True)
+class Loop:
+    """The cycle walked under control of a fold's c (:func:`cycle`): the ``energy`` it dissipates (None when
+    it cannot be walked, ``note`` saying why), the sum of the last changes of the pieces' integrals on
+    halving (``quadrature_err``), the points solved for on the way (``solves``), the hysteresis ``loops``,
+    the folds the approach and then the retraction jump at (``jumps``), the ``pieces`` of the loops'
+    borders as (first node, last node, multiplicity) and the ``nodes`` walked."""
+
+    energy: float | None
+    note: str | None = None
+    quadrature_err: float = 0.0
+    solves: int = 0
+    loops: int = 0
+    jumps: tuple = ()
+    pieces: tuple = ()
+    nodes: tuple = ()
+
+
+def cycle(segments, fold: Fold) -> Loop:
     """The energy one approach-retract cycle dissipates under control of ``fold``'s c (collective).
 
-    Returns {energy, quadrature_err, loops, jumps: [the folds the approach, then the retraction jump at],
-    pieces: [(first node, last node, multiplicity)] of the loops' borders, nodes} or {energy: None, note}
-    when the cycle cannot be walked (a jump lands beyond the traced curve; the curve ends on an unstable
-    branch).  ``quadrature_err``: the sum of the last changes of the pieces' integrals on halving
-    (:class:`_Pieces`; the error of the halved value is smaller by about 16 where the interpolant resolves
-    the border); ``solves``: the points solved for on the way.
+    Returns the :class:`Loop`, its energy None with a note when the cycle cannot be walked (a jump lands
+    beyond the traced curve; the curve ends on an unstable branch).  ``quadrature_err``: the error of the
+    pieces' integrals (:class:`_Pieces`; the error of the halved value is smaller by about 16 where the
+    interpolant resolves the border).
     """
     nodes = _nodes(segments, fold)
     if not fold.stable(nodes[-1].point) or not fold.stable(nodes[0].point):
-        return {"energy": None, "note": "the curve does not end on a stable branch: no cycle to close"}
+        return Loop(None, "the curve does not end on a stable branch: no cycle to close")
     approach, retract = _walk(nodes, True), _walk(nodes, False)
     for walk in (approach, retract):
         if isinstance(walk, str):
-            return {"energy": None, "note": walk}
+            return Loop(None, walk)
     m = np.zeros(len(nodes) - 1, dtype=int)
     np.add.at(m, approach[0], 1)
     np.add.at(m, retract[0], -1)
@@ -235,50 +251,51 @@ def cycle(segments, fold: Fold) -> dict:
             energy += k * value
             quadrature += abs(k) * err
     jumped = approach[1] + retract[1]
-    return {"energy": energy, "quadrature_err": quadrature, "solves": pieces.solves, "loops": len(approach[1]) if runs else 0,
-            "jumps": jumped if runs else [], "pieces": runs, "nodes": nodes}
+    return Loop(energy, None, quadrature, pieces.solves, len(approach[1]) if runs else 0,
+                tuple(jumped) if runs else (), tuple(runs), tuple(nodes))
 
 
-def energy_bar(result: dict, fold: Fold, record_of) -> float:
-    """The error bar of :func:`cycle`'s energy from the events' (``record_of(found)``: the event's record
-    with its best values, bars and grid values; ``_grid`` keys absent without an error estimate: no bar,
-    None).
+def energy_bar(result: Loop, fold: Fold, event_of) -> float | None:
+    """The error bar of ``result``'s energy (:func:`cycle`) under control of ``fold``'s c; ``event_of(found)``:
+    the :class:`~.curve.Event` of a located fold, with its best values, bars and grid values (no bar, no grid
+    value without an error estimate: then no bar here, None).  0 without hysteresis; None without an
+    energy.
 
     Each jump: |F(fold) - F(landing)| times the error of the fold's c; each stretch of a loop's border:
     |c(end) - c(start)| times the larger error of F at its two ends (an end that is no event: the largest
     error of F of the loop's events).  An error: |grid value - best value| + bar.  Plus the quadrature's
     estimate (:func:`cycle`).
     """
-    if result.get("energy") is None or not result["pieces"]:
-        return None if result.get("energy") is None else 0.0
-    key = "Z" if fold.weight else "lambda"
-    recs = {id(n.found): record_of(n.found) for n in result["nodes"] if n.found is not None}
-    if any(recs[id(f)].get(f"{key}_err") is None or recs[id(f)].get("F_err") is None for f in result["jumps"]):
+    if result.energy is None or not result.pieces:
+        return None if result.energy is None else 0.0
+    key = "Z" if fold.weight else "lam"
+    evs = {id(n.found): event_of(n.found) for n in result.nodes if n.found is not None}
+    if any(getattr(evs[id(f)], key) is None or getattr(evs[id(f)], key).err is None or evs[id(f)].F.err is None
+           for f in result.jumps):
         return None
 
-    def err(rec, name):
-        grid = rec.get(f"{name}_grid", rec[name])
-        return abs(grid - rec[name]) + rec[f"{name}_err"]
+    def err(m) -> float:
+        """The grid value's distance from the best value, plus the bar."""
+        return abs((m.value if m.grid is None else m.grid) - m.value) + m.err
 
     def F_error(node) -> float | None:
         if node.found is None:
             return None
-        rec = recs[id(node.found)]
+        ev = evs[id(node.found)]
         if node.landing:
-            land = rec.get("landing", {})
-            return None if land.get("F_err") is None else err(land, "F")
-        return err(rec, "F")
+            return None if ev.landing is None or ev.landing.F.err is None else err(ev.landing.F)
+        return err(ev.F)
 
-    bar = result["quadrature_err"]
-    for f in result["jumps"]:
-        rec = recs[id(f)]
-        if rec.get("landing") is not None:
-            bar += abs(rec["landing"]["F"] - rec["F"]) * err(rec, key)
-    nodes = result["nodes"]
-    jumped = {id(f) for f in result["jumps"]}
+    bar = result.quadrature_err
+    for f in result.jumps:
+        ev = evs[id(f)]
+        if ev.landing is not None:
+            bar += abs(ev.landing.F.value - ev.F.value) * err(getattr(ev, key))
+    nodes = result.nodes
+    jumped = {id(f) for f in result.jumps}
     ends = [e for n in nodes if n.found is not None and id(n.found) in jumped and (e := F_error(n)) is not None]
     worst = max(ends, default=0.0)
-    for i, j, _ in result["pieces"]:
+    for i, j, _ in result.pieces:
         u, v = nodes[i], nodes[j]
         eu, ev = F_error(u), F_error(v)
         e = max(worst if eu is None else eu, worst if ev is None else ev)

@@ -15,16 +15,17 @@ calibrated by the coverage study of docs/coverage.md).
 """
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..core.events import EventFinder, ParameterValue
 from ..discretization.preconditioning import memory_available, memory_needed
 from ..discretization.resolution import NODES_PER_ZONE, cohesive_zone
+from .measured import Measured
 from .tracer import carry, contact_radius
 
-__all__ = ["relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE", "MAX_LEVEL", "too_large"]
+__all__ = ["Estimate", "LandingEstimate", "relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE", "MAX_LEVEL", "too_large"]
 
 #: Steps a local trace may take to pass the event on another level.
 LOCAL_STEPS = 40
@@ -36,6 +37,32 @@ BAR_FACTOR = 2.5
 #: coverage data, 2e-4 starts to miss (4 of 235) and 3e-3 made the snap-on lambda's bars 25 times its
 #: error; 6e-4 covers as 3e-3 did with those bars 5 times the error.
 FLOOR = 6e-4
+
+
+@dataclass(frozen=True)
+class LandingEstimate:
+    """The best values and bars of a fold's landing: its load (with the value on the fold's grid), its
+    contact radius and, behind a spring (where the landing moves in lambda), its lambda (else None)."""
+
+    F: Measured
+    contact_radius: Measured
+    lam: Measured | None = None
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """The best values and bars of an event's lambda, F and contact radius from its levels (no grid values:
+    the event's own point holds them); behind a spring Z (else None); the ``levels`` used; whether
+    -target_error was met; why refinement stopped short (``refinement``, or None); the landing's."""
+
+    lam: Measured
+    F: Measured
+    contact_radius: Measured
+    levels: tuple[int, ...]
+    target_met: bool
+    Z: Measured | None = None
+    refinement: str | None = None
+    landing: LandingEstimate | None = None
 
 
 def relocate(tracer, seg, found, level: int, target=None):
@@ -162,18 +189,16 @@ def too_large(tracer, seg, level: int) -> str | None:
            f"this machine has {have / 2**30:.1f} GiB available"
 
 
-def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
+def event_errors(tracer, seg, found, target_error: float | None = None) -> Estimate | None:
     """Best values and error bars of one event's lambda, F and contact radius (and its landing's) from its
     levels.
 
     Levels 0, -1, -2 by default, as far as they resolve the edge (:func:`coarse_levels`), then finer ones;
     where a coarse level does not yield the event, 0,
     1, 2; with ``target_error``, finer levels up to MAX_LEVEL until every bar of lambda and F is
-    below it (``target_met`` says whether it was).  Returns {lambda, F, contact_radius, their
-    ``_err``, levels, target_met}, for a turning point of a spring's control also {Z, Z_err}, and for
-    a fold with a landing {landing: {F, F_err, F_grid, contact_radius, contact_radius_err}} (behind a
-    spring, whose landing moves in lambda, also {lambda, lambda_err, lambda_grid}); {} when no other
-    level yields the event.
+    below it (``target_met`` says whether it was).  Returns the :class:`Estimate`, for a turning point of a
+    spring's control with Z, and for a fold with a landing the landing's (behind a spring, whose landing
+    moves in lambda, with its lambda); None when no other level yields the event.
     """
     fold = found.event
     spring = bool(getattr(fold, "weight", 0.0))
@@ -200,7 +225,7 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
             break
     while len(points) < 3:
         if not add(max(points) + 1):
-            return {}
+            return None
 
     def series(pts, key):
         return {k: (p.p if key == "lambda" else fold.value(p) if key == "Z" else p.values[key])
@@ -226,16 +251,13 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> dict:
         if stop or not add(max(points) + 1):
             break
         est = bars()
-    out = {k: v for key in ("lambda", "F", "contact_radius", "Z") if key in est
-           for k, v in ((key, est[key][0]), (f"{key}_err", est[key][1]))}
-    out |= {"levels": sorted(points), "target_met": not target_error or largest(est) <= target_error}
-    if stop and not out["target_met"]:
-        out["refinement"] = stop
+    met = not target_error or largest(est) <= target_error
+    landing = None
     if "landing" in est:
         land = est["landing"]
-        out["landing"] = {"F": land["F"][0], "F_err": land["F"][1], "F_grid": found.landing.values["F"],
-                          "contact_radius": land["contact_radius"][0], "contact_radius_err": land["contact_radius"][1]}
-        if spring:
-            out["landing"] |= {"lambda": land["lambda"][0], "lambda_err": land["lambda"][1],
-                               "lambda_grid": found.landing.p}
-    return out
+        landing = LandingEstimate(F=Measured(*land["F"], grid=found.landing.values["F"]),
+                                  contact_radius=Measured(*land["contact_radius"]),
+                                  lam=Measured(*land["lambda"], grid=found.landing.p) if spring else None)
+    return Estimate(lam=Measured(*est["lambda"]), F=Measured(*est["F"]), contact_radius=Measured(*est["contact_radius"]),
+                    levels=tuple(sorted(points)), target_met=met, Z=Measured(*est["Z"]) if "Z" in est else None,
+                    refinement=stop if stop and not met else None, landing=landing)

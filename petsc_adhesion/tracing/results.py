@@ -23,6 +23,7 @@ is stable when dZ/ds > 0, and a jump lands at the same Z.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 from mpi4py import MPI
@@ -31,9 +32,12 @@ from ..core.events import Extremum, Fold, ParameterValue, Zero
 from ..discretization import grid
 from ..model.reference.rigid import far_deflection, load_beyond
 from . import energy
+from .curve import Assessment, Branch, Cycle, Event, Landing, Profile
+from .measured import Measured, Missing
 from .tracer import contact_radius
 
-__all__ = ["curve_events", "spring_fold", "curve", "stop_reason", "assess", "WALL_GAP", "event_record", "QUADRATURE_MARGIN", "quadrature_error", "EDGE_SHARE", "PEAK_ATTRACTION"]
+__all__ = ["curve_events", "spring_fold", "curve", "Traced", "stop_reason", "assess", "WALL_GAP", "event_of",
+           "NO_BAR", "unclosed", "QUADRATURE_MARGIN", "quadrature_error", "EDGE_SHARE", "PEAK_ATTRACTION"]
 
 #: Closer than this to the wall of the roughness rule, a state is set by its smallest weights.
 WALL_GAP = 1e-3
@@ -63,68 +67,80 @@ def _whole(problem, local: np.ndarray):
     return np.concatenate(parts) if parts is not None else None
 
 
-def _state(problem, pt, profiles: bool, spring=None) -> dict:
-    out = {"lambda": pt.p, "F": pt.values["F"], "H0": _H0(problem, pt), "contact_radius": contact_radius(problem, pt.x)}
-    if spring is not None:
-        out["Z"] = spring.value(pt)
+@dataclass(frozen=True)
+class _State:
+    lam: float
+    F: float
+    H0: float
+    contact_radius: float
+    Z: float | None
+    profile: Profile | None
+
+
+def _state(problem, pt, profiles: bool, spring=None) -> _State:
+    """The state of a point on the grid it was located on (collective: H0 and the profiles gather)."""
+    profile = None
     if profiles:
         r = problem.nodes(pt.x)
         H = _whole(problem, problem.separation(pt.x))
         if H is not None:
-            out["r"], out["H"], out["P"] = r, H, problem.law(H)[0]
-    return out
+            profile = Profile(r, H, problem.law(H)[0])
+    return _State(pt.p, pt.values["F"], _H0(problem, pt), contact_radius(problem, pt.x),
+                  None if spring is None else spring.value(pt), profile)
 
 
-def event_record(problem, found, profiles: bool) -> dict:
-    """One event as the result files hold it (collective: H0 and profiles gather).
+#: Why an event has no bar when its error estimate was tried and failed.
+NO_BAR = "no error bar: the event was not found again on the coarser and finer levels"
 
-    With an error estimate, ``lambda`` and ``F`` are the best values, ``*_err``
-    their bars and ``*_grid`` the values on the grid it was located on.  A lambda
-    asked for is exact, so is F = 0 at an equilibrium.  The half-infinite model
-    adds the rigid sphere's attraction beyond r_m to F (``F_beyond``); its
-    remainder, the deflection that attraction causes inside, enters both bars
+
+def event_of(problem, found, estimate, profiles: bool) -> Event:
+    """One event as a value (collective: H0 and profiles gather).
+
+    ``estimate``: its :class:`~.error_bars.Estimate`, a :class:`~.measured.Missing` when one was tried and
+    failed, or None when none was asked for.  With an estimate, lambda and F are the best values with their
+    bars and the values on the grid it was located on.  A lambda asked for is exact, so is F = 0 at an
+    equilibrium.  The half-infinite model adds the rigid sphere's attraction beyond r_m to F
+    (``F_beyond``); its remainder, the deflection that attraction causes inside, enters both bars
     (:func:`~petsc_adhesion.model.reference.far_deflection`).
     """
     spring = found.event if isinstance(found.event, Fold) and found.event.weight else None
-    ev = {"kind": found.label, **_state(problem, found.point, profiles, spring), "segment": found.segment}
-    if not isinstance(found.event, Fold):          # at a fold of its control the state is marginal
-        ev["stable"] = bool(problem.stable(found.point))
+    at = _state(problem, found.point, profiles, spring)
+    stable = None if isinstance(found.event, Fold) else bool(problem.stable(found.point))
+    landing = None                               # at a fold of its control the state is marginal: None
     if found.landing is not None:
-        ev["landing"] = _state(found.landing_by.cont.pb, found.landing, profiles, spring)
-    est = getattr(found, "estimate", None)
-    if est is None:
+        ld = _state(found.landing_by.cont.pb, found.landing, profiles, spring)
+        landing = Landing(lam=Measured(ld.lam), F=Measured(ld.F), H0=ld.H0,
+                          Z=None if spring is None else Measured(ld.Z),
+                          contact_radius=Measured(ld.contact_radius), profile=ld.profile)
+    ev = Event(kind=found.label, lam=Measured(at.lam), F=Measured(at.F), H0=at.H0,
+               Z=None if spring is None else Measured(at.Z), contact_radius=Measured(at.contact_radius),
+               stable=stable, landing=landing, profile=at.profile)
+    if estimate is None:
         return ev
-    if not est:
-        ev["error_note"] = "no error bar: the event was not found again on the coarser and finer levels"
-        return ev
-    model = problem.model
+    if isinstance(estimate, Missing):
+        return replace(ev, note=estimate.reason)
+    est, model = estimate, problem.model
     rm = float(problem.nodes(found.point.x)[-1])
     far = far_deflection(rm, model.coupling) if model.farfield else 0.0
-    ev |= {"lambda_grid": ev["lambda"], "F_grid": ev["F"], "levels": est["levels"], "target_met": est["target_met"],
-           "F_beyond": float(load_beyond(rm, ev["lambda"])) if model.farfield else 0.0,
-           "contact_radius_grid": ev["contact_radius"], "contact_radius": est["contact_radius"],
-           "contact_radius_err": est["contact_radius_err"]}
-    if est.get("refinement"):
-        ev["refinement_note"] = est["refinement"]
     beyond = far + quadrature_error(problem, found.point)
     if found.label == "lambda":
-        ev |= {"F": est["F"], "F_err": est["F_err"] + beyond, "lambda_err": 0.0}
+        lam, F = Measured(at.lam, 0.0, at.lam), Measured(est.F.value, est.F.err + beyond, at.F)
     elif found.label == "equilibrium":
-        ev |= {"lambda": est["lambda"], "lambda_err": est["lambda_err"] + beyond, "F": 0.0, "F_err": 0.0}
+        lam, F = Measured(est.lam.value, est.lam.err + beyond, at.lam), Measured(0.0, 0.0, at.F)
     else:
-        ev |= {"lambda": est["lambda"], "lambda_err": est["lambda_err"] + beyond, "F": est["F"],
-               "F_err": est["F_err"] + beyond}
-    if spring is not None:
-        ev |= {"Z_grid": ev["Z"], "Z": est["Z"], "Z_err": est["Z_err"] + beyond * (1 + spring.weight)}
-    if "landing" in ev and "landing" in est:
-        land = est["landing"]
-        ev["landing"] |= {"lambda": ev["lambda"], "F": land["F"], "F_err": land["F_err"] + beyond,
-                          "F_grid": land["F_grid"], "contact_radius": land["contact_radius"],
-                          "contact_radius_err": land["contact_radius_err"]}
+        lam, F = Measured(est.lam.value, est.lam.err + beyond, at.lam), Measured(est.F.value, est.F.err + beyond, at.F)
+    Z = None if spring is None else Measured(est.Z.value, est.Z.err + beyond * (1 + spring.weight), at.Z)
+    if landing is not None and est.landing is not None:
+        land = est.landing
+        landing = replace(landing, lam=Measured(lam.value), F=Measured(land.F.value, land.F.err + beyond, land.F.grid),
+                          contact_radius=Measured(land.contact_radius.value, land.contact_radius.err))
         if spring is not None:              # the same Z; lambda moves by the spring's extension
-            ev["landing"] |= {"lambda": land["lambda"], "lambda_err": land["lambda_err"] + beyond,
-                              "lambda_grid": land["lambda_grid"], "Z": ev["Z"], "Z_err": ev["Z_err"]}
-    return ev
+            landing = replace(landing, lam=Measured(land.lam.value, land.lam.err + beyond, land.lam.grid),
+                              Z=Measured(Z.value, Z.err))
+    return replace(ev, lam=lam, F=F, Z=Z, landing=landing, levels=tuple(est.levels), target_met=est.target_met,
+                   F_beyond=float(load_beyond(rm, at.lam)) if model.farfield else 0.0,
+                   contact_radius=Measured(est.contact_radius.value, est.contact_radius.err, at.contact_radius),
+                   refinement_note=est.refinement)
 
 
 #: The load of the quadrature error, times this, bounds its effect on results (tests/test_roughness_models.py).
@@ -168,25 +184,87 @@ def _current(segments, seg) -> list:
     return seg.cont.points if seg is segments[-1] else seg.cont.points[:-1]
 
 
-def curve(segments, profiles: bool = False) -> dict:
-    """The traced curve (its segments, in order) with its events as dicts and the pull-off.
+@dataclass(frozen=True)
+class Traced:
+    """What the traced segments hold, as values: the branch, the events (each with the core's ``Found`` it
+    was made from, in the order found), the pull-off, the cycles of a rigid machine and (None without one)
+    of a spring, the statistics of the steps, why it stopped, the least gap to the wall of the roughness
+    rule, the profiles of every point (rank 0, for the resolution check) and the grids of the segments."""
+
+    branch: Branch
+    found: tuple
+    events: tuple[Event, ...]
+    pull_off: Event | None
+    rigid: Cycle
+    spring: Cycle | None
+    wall_gap: float
+    steps: int
+    rejected_steps: int
+    folds: int
+    regrids: int
+    guard_activations: int
+    smallest_step: float
+    most_newton_its: int
+    most_ksp_its: int
+    stop: tuple
+    stop_reason: str
+    states: tuple
+    r: np.ndarray
+    starts: np.ndarray
+    n_nodes: np.ndarray
+    edges: np.ndarray | None
+
+
+def unclosed(segments, reason: str) -> str | None:
+    """Why the cycle of a traced curve was not closed, or None when it was.
+
+    A cycle is closed when the curve was traced through: from the far branch (not starting in contact) to
+    the compressive branch (F >= 0 at its end) that lies past every turning point (adhesion pulls: the
+    jumps and the pull-off lie at tensile loads), and not cut short (-cont_max_steps, a step too small,
+    too many turning points).  Else its energy would be that of part of the curve (-cont_F_max below the
+    pull-off: 0 from the far branch alone).
+    """
+    first, last = segments[0].cont.points[0], segments[-1].cont.points[-1]
+    stop = segments[-1].cont.stop
+    if stop[0] in ("ds_min", "max_steps", "max_folds"):
+        return f"the cycle was not closed: the curve ended early ({reason})"
+    if first.values["F"] > 0:
+        return f"the cycle was not closed: the curve starts in contact (F = {first.values['F']:.4g} > 0)"
+    if last.values["F"] < 0:
+        return (f"the cycle was not closed: the curve stopped in tension (F = {last.values['F']:.4g} at lambda = "
+                f"{last.p:.6g}; {reason}) before it was traced through its turning points to compression")
+    return None
+
+
+def _cycle(segments, fold, event_of_found, open_reason: str | None) -> Cycle:
+    """The cycle under ``fold``'s control: its energy and bar, or Missing with why (collective)."""
+    K = 1.0 / fold.weight if fold.weight else None
+    if open_reason is not None:
+        return Cycle(Missing(open_reason), None, K)
+    loop = energy.cycle(segments, fold)
+    if loop.energy is None:
+        return Cycle(Missing(loop.note), None, K)
+    return Cycle(Measured(loop.energy, energy.energy_bar(loop, fold, event_of_found)), loop.loops, K)
+
+
+def curve(segments, estimates: dict, profiles: bool = False) -> Traced:
+    """The traced curve (its segments, in order) as values: its branch, its events with their bars
+    (``estimates``: the :class:`~.error_bars.Estimate` of each located event by ``id`` of its ``Found``,
+    Missing where it failed; none asked for: absent), the pull-off, its cycles.
 
     Collective.  ``profiles`` (rank 0, else empty): the nodes and the pressure of
     every point, for the resolution check.
     """
     found = [(seg, f) for seg in segments for f in seg.finder.found]
-    events = [event_record(seg.problem, f, profiles) for seg, f in found]
+    events = [event_of(seg.problem, f, estimates.get(id(f)), profiles) for seg, f in found]
     pts = [p for seg in segments for p in seg.cont.points]
     radii = [contact_radius(seg.problem, p.x) for seg in segments for p in seg.cont.points]
-    record = {id(f): e for (_, f), e in zip(found, events)}
+    by_found = {id(f): e for (_, f), e in zip(found, events)}
+    last = segments[-1].cont
+    why = unclosed(segments, stop_reason(last.stop, last.set))
     cycles = {}
     for fold in (e for e in segments[0].finder.events if isinstance(e, Fold)):
-        cyc = energy.cycle(segments, fold)
-        bar = energy.energy_bar(cyc, fold, lambda f: record[id(f)])
-        cycles["spring" if fold.weight else "rigid"] = {
-            "energy": cyc["energy"], "energy_err": bar, "loops": cyc.get("loops", 0),
-            **({"energy_note": cyc["note"]} if "note" in cyc else {}),
-            **({"K": 1.0 / fold.weight} if fold.weight else {})}
+        cycles["spring" if fold.weight else "rigid"] = _cycle(segments, fold, lambda f: by_found[id(f)], why)
     states = []
     for seg in segments:
         pb = seg.problem
@@ -194,24 +272,27 @@ def curve(segments, profiles: bool = False) -> dict:
             r, H = pb.nodes(p.x), _whole(pb, pb.separation(p.x))
             if H is not None:
                 states.append((r, H, pb.law(H)[0]))
-    mins = [e for e in events if e["kind"] == "F_min"]
-    last = segments[-1].cont
+    mins = [e for e in events if e.kind == "F_min"]
     lowest = min(float(seg.problem.separation(p.x).min()) for seg in segments for p in seg.cont.points)
-    return {"points": pts, "contact_radius": radii, "cycles": cycles, "events": events, "pull_off": min(mins, key=lambda e: e["F"]) if mins else None,
-            "wall_gap": segments[-1].problem.comm.tompi4py().allreduce(lowest, op=MPI.MIN) - segments[-1].problem.law.wall,
-            "steps": sum(len(seg.cont.points) - 1 for seg in segments),
-            "rejected_steps": sum(seg.cont.rejected for seg in segments),
-            "folds": sum(seg.cont.folds for seg in segments),
-            "regrids": len(segments) - 1 - sum(seg.far for seg in segments),
-            "guard_activations": sum(seg.problem.guarded for seg in segments),
-            "smallest_step": min((p.ds for p in pts if p.ds > 0), default=0.0),
-            "most_newton_its": max(p.newton_its for p in pts), "most_ksp_its": max(p.ksp_its for p in pts),
-            "stop": last.stop, "stop_reason": stop_reason(last.stop, last.set), "states": states,
-            "grid": segments[-1].problem.nodes(segments[-1].cont.points[-1].x),
-            "grids": {"lambda": np.array([seg.cont.points[0].p for seg in segments]),
-                      "n_nodes": np.array([seg.problem.layout.N for seg in segments]),
-                      **({"edge": np.array([seg.grid.edge for seg in segments])}
-                         if all(seg.grid is not None for seg in segments) else {})}}
+    spring = cycles.get("spring")
+    return Traced(
+        branch=Branch.from_points(pts, radii, None if spring is None else spring.K),
+        found=tuple(f for _, f in found), events=tuple(events),
+        pull_off=min(mins, key=lambda e: e.F.value) if mins else None, rigid=cycles["rigid"], spring=spring,
+        wall_gap=segments[-1].problem.comm.tompi4py().allreduce(lowest, op=MPI.MIN) - segments[-1].problem.law.wall,
+        steps=sum(len(seg.cont.points) - 1 for seg in segments),
+        rejected_steps=sum(seg.cont.rejected for seg in segments),
+        folds=sum(seg.cont.folds for seg in segments),
+        regrids=len(segments) - 1 - sum(seg.far for seg in segments),
+        guard_activations=sum(seg.problem.guarded for seg in segments),
+        smallest_step=min((p.ds for p in pts if p.ds > 0), default=0.0),
+        most_newton_its=max(p.newton_its for p in pts), most_ksp_its=max(p.ksp_its for p in pts),
+        stop=last.stop, stop_reason=stop_reason(last.stop, last.set), states=tuple(states),
+        r=segments[-1].problem.nodes(segments[-1].cont.points[-1].x),
+        starts=np.array([seg.cont.points[0].p for seg in segments]),
+        n_nodes=np.array([seg.problem.layout.N for seg in segments]),
+        edges=np.array([seg.grid.edge for seg in segments]) if all(seg.grid is not None for seg in segments)
+        else None)
 
 
 #: The contact reaches the end of the domain when |P(r_m)| exceeds this share of the peak attraction.
@@ -247,40 +328,41 @@ def _missed_minimum(segments) -> str:
     return ""
 
 
-def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
-    """What makes a traced curve untrustworthy, one line each: (warnings, the subset that makes it
-    not what was asked for: exit status 3).  Collective."""
+def assess(segments, res: Traced, grid_warning: str | None, at_lambda=()) -> Assessment:
+    """What makes a traced curve untrustworthy, one line each: its warnings, the subset that makes it
+    not what was asked for (exit status 3), and ``grid_warning`` (the resolution check's).  Collective."""
     warn, short = [], []
     problem = segments[-1].problem
-    law, pts, gap, mpi = problem.law, res["points"], res["wall_gap"], problem.comm.tompi4py()
+    pts = [p for seg in segments for p in seg.cont.points]
+    law, gap, mpi = problem.law, res.wall_gap, problem.comm.tompi4py()
     if law.rule == "hermite" and gap < WALL_GAP:
         warn.append(f"the curve comes within {gap:.1e} of the wall H = {law.wall:.6g} of the {law.n}-point "
                     f"Hermite rule, where node weights down to {law.weights.min():.1e} set the repulsion: "
                     f"the loads there are properties of the rule and ill-conditioned; use fewer points")
-    if res["stop"][0] in ("ds_min", "max_steps", "max_folds"):
-        short.append(f"the curve ended early: {res['stop_reason']}")
-    if res["grid_warning"]:
-        short.append(res["grid_warning"])
-    missed_min = "" if res["grid_warning"] else _missed_minimum(segments)
+    if res.stop[0] in ("ds_min", "max_steps", "max_folds"):
+        short.append(f"the curve ended early: {res.stop_reason}")
+    if grid_warning:
+        short.append(grid_warning)
+    missed_min = "" if grid_warning else _missed_minimum(segments)
     if missed_min:
         short.append(f"{missed_min}: the load varies faster than the steps resolve; lower -cont_dF_max or -cont_ds_max")
     if pts[0].values["F"] > 0:
         short.append(f"the curve starts in contact (F = {pts[0].values['F']:.3g} > 0 at lambda = {pts[0].p:g}): "
                      f"the approach and its events lie before it; give -cont_lambda_start further apart")
-    missed = [e for e in res["events"] if e.get("target_met") is False]
+    missed = [e for e in res.events if e.target_met is False]
     if missed:
-        e = max(missed, key=lambda e: max(e.get("lambda_err", 0), e.get("F_err", 0)))
-        note = next((f"; {m['refinement_note']}" for m in missed if m.get("refinement_note")), "")
-        short.append(f"-target_error not reached for {len(missed)} event(s): {e['kind']} at lambda = {e['lambda']:.6g} "
-                     f"has lambda +- {e.get('lambda_err', 0):.1e}, F +- {e.get('F_err', 0):.1e} on levels up to "
-                     f"{max(e['levels'])}, the finest tried{note}")
+        e = max(missed, key=lambda e: max(e.lam.err or 0, e.F.err or 0))
+        note = next((f"; {m.refinement_note}" for m in missed if m.refinement_note), "")
+        short.append(f"-target_error not reached for {len(missed)} event(s): {e.kind} at lambda = {e.lam.value:.6g} "
+                     f"has lambda +- {e.lam.err or 0:.1e}, F +- {e.F.err or 0:.1e} on levels up to "
+                     f"{max(e.levels)}, the finest tried{note}")
     spring = spring_fold(segments[0].finder.events)
     start = next(seg for seg in segments if not seg.far).cont.points[0]
     if spring is not None and not spring.stable(start):
         short.append(f"the curve starts where the spring (K = {1 / spring.weight:.4g}) cannot hold the sphere "
                      f"(dZ/ds < 0 at lambda = {start.p:.6g}): its jump-in lies before the start; give "
                      f"-cont_lambda_start further apart, or leave it to the default")
-    found = [e["lambda"] for e in res["events"] if e["kind"] == "lambda"]
+    found = [e.lam.value for e in res.events if e.kind == "lambda"]
     for t in at_lambda:
         if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):
             short.append(f"-cont_at_lambda {t:g} not reached: the curve spans lambda in "
@@ -297,6 +379,6 @@ def assess(segments, res: dict, at_lambda=()) -> tuple[list[str], list[str]]:
     if edge > EDGE_SHARE * PEAK_ATTRACTION:
         short.append(f"the contact reaches the end of the domain r_m = {rm:g} (|P(r_m)| up to "
                      f"{edge:.2g}): give a larger -adh_rmax")
-    return warn + short, short
+    return Assessment(tuple(warn + short), tuple(short), grid_warning or None)
 
 

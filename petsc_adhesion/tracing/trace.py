@@ -2,7 +2,7 @@
 
     from petsc_adhesion import Model, GridChoice, trace_curve, solve_at
     c = trace_curve(Model(mu=1.0))                          # grids that follow the contact edge, error bars
-    print(c.pull_off.F, "+-", c.pull_off.F_err)
+    print(c.pull_off.F.value, "+-", c.pull_off.F.err)
     s = solve_at(-2.0, Model(mu=1.0), GridChoice("uniform", n=201))
 
 Each takes plain typed objects: the :class:`~petsc_adhesion.model.parameters.Model`
@@ -42,7 +42,8 @@ from ..discretization.influence import create_influence
 from ..discretization.problem import Problem, far_approach, step_scale
 from ..model.reference.jkr import jkr_approach, jkr_load
 from . import error_bars, results
-from .curve import Curve, Solution, model_record, program_record
+from .curve import Curve, Diagnostics, ErrorEstimate, GridRecord, Program, Solution, SpringResult
+from .measured import Missing
 from .edge_grids import MU_TRUNCATED, RMAX, grid_for
 from .tracer import Tracer
 
@@ -271,14 +272,6 @@ def configure_solvers(model, grid_choice: GridChoice = GridChoice(), solver: Sol
         problem.destroy()
 
 
-def _head(comm, model, grid_record: dict) -> dict:
-    """The program, model, grid and physical inputs of a result."""
-    head = {**program_record(comm), "model": model_record(model), "grid": grid_record}
-    if model.bodies is not None:
-        head["physical"] = model.bodies.describe()
-    return head
-
-
 def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverChoice = SolverChoice(),
                 settings: Settings | None = None, request: CurveRequest = CurveRequest(), comm=None,
                 checkpoint=None, progress=None, started=None) -> Curve:
@@ -334,6 +327,7 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
         restored = checkpoint.restore(tracer) if checkpoint is not None else None
         phase, spent = restored or ("trace", {"trace": 0.0, "errors": 0.0})
         bars = []
+        estimates = {}          # id of a located event (the core's Found) -> its Estimate, or Missing
         if restored and progress is not None:
             progress.line(f"going on from the checkpoint {checkpoint.name} at lambda "
                           f"{tracer.segments[-1].cont.points[-1].p:.6g}"
@@ -346,7 +340,7 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
             if checkpoint is not None:
                 checkpoint.pause(tr, stage, walls)
             if progress is not None and progress.due():
-                done = sum(f.estimate is not None for _, f in bars)
+                done = sum(id(f) in estimates for _, f in bars)
                 progress.update(*(_status(tr, lam0, end) if stage == "trace" else
                                   (done / len(bars), f"error bars: {done} of {len(bars)} events done")))
 
@@ -368,27 +362,32 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
                 progress.reset()
             for seg, found in bars:
                 pause(tracer, "errors")
-                if found.estimate is None:
-                    found.estimate = error_bars.event_errors(tracer, seg, found, request.target_error)
+                est = error_bars.event_errors(tracer, seg, found, request.target_error)
+                estimates[id(found)] = Missing(results.NO_BAR) if est is None else est
             errors_wall = spent["errors"] + time.perf_counter() - t1
-        res = results.curve(segments, request.profiles)
+        traced = results.curve(segments, estimates, request.profiles)
         mpi = comm.tompi4py()
-        states = res.pop("states")
         law = tracer.segments[0].problem.law
-        res["grid_warning"] = mpi.bcast(resolution.check(model, law, states, res["folds"])
-                                        if mpi.Get_rank() == 0 else None)
-        res["warnings"], res["incomplete"] = results.assess(segments, res, request.at_lambda)
+        grid_warning = mpi.bcast(resolution.check(model, law, traced.states, traced.folds)
+                                 if mpi.Get_rank() == 0 else None)
+        assessment = results.assess(segments, traced, grid_warning, request.at_lambda)
     finally:
         tracer.destroy()
-    res["events"] = [e for e in res["events"] if kept(e["kind"])]
-    if not kept("F_min"):
-        res["pull_off"] = None
-    res |= {"wall_time_s": wall, "lambda_start": lam0}
-    if request.error_bars:
-        res["error_estimate"] = {"wall_time_s": errors_wall, "target_error": request.target_error,
-                                 "levels": sorted({k for e in res["events"] for k in e.get("levels", ())})}
-    head = _head(comm, model, {"r": res["grid"], **res["grids"]})
-    return mpi.bcast(Curve.from_result(res, head) if mpi.Get_rank() == 0 else None, root=0)
+    events = tuple(e for e in traced.events if kept(e.kind))
+    estimate = ErrorEstimate(errors_wall, request.target_error, tuple(sorted({k for e in events for k in e.levels}))) \
+        if request.error_bars else None
+    diagnostics = Diagnostics(
+        steps=traced.steps, rejected_steps=traced.rejected_steps, regrids=traced.regrids, folds=traced.folds,
+        guard_activations=traced.guard_activations, smallest_step=traced.smallest_step,
+        most_newton_its=traced.most_newton_its, most_ksp_its=traced.most_ksp_its, stop_reason=traced.stop_reason,
+        wall_time_s=wall, lambda_start=lam0, wall_gap=traced.wall_gap, error_estimate=estimate)
+    spring = None if traced.spring is None else \
+        SpringResult(traced.spring.K, tuple(e for e in events if e.kind in ("jump_in", "jump_off")), traced.spring)
+    curve = Curve(model=model, program=Program.of(comm),
+                  grid=GridRecord(traced.r, traced.starts, traced.n_nodes, traced.edges), branch=traced.branch,
+                  events=events, pull_off=traced.pull_off if kept("F_min") else None, rigid=traced.rigid,
+                  spring=spring, diagnostics=diagnostics, assessment=assessment)
+    return mpi.bcast(curve if mpi.Get_rank() == 0 else None, root=0)
 
 
 def solve_at(lam: float, model, grid_choice: GridChoice = GridChoice(), solver: SolverChoice = SolverChoice(),
@@ -426,14 +425,15 @@ def solve_at(lam: float, model, grid_choice: GridChoice = GridChoice(), solver: 
         pressure, _ = problem.pressure(H)
         Hall = problem.gather(H.getArray(readonly=True))
         its, kits = newton.iterations
-        res = {"lambda": lam, "F": problem.load(H, lam), "F_beyond": problem.far_load(lam), "H0": float(Hall[0]),
-               "H": Hall, "P": problem.gather(pressure), "snes_iterations": its, "ksp_iterations": kits,
-               "wall_time_s": wall}
+        solution = Solution(lam=lam, F=problem.load(H, lam), F_beyond=problem.far_load(lam), H0=float(Hall[0]),
+                            r=np.asarray(r), H=Hall, P=problem.gather(pressure), snes_iterations=its,
+                            ksp_iterations=kits, wall_time_s=wall, model=model, program=Program.of(comm),
+                            grid=GridRecord(np.asarray(r)))
     finally:
         for obj in (H, newton, problem):
             if obj is not None:
                 obj.destroy()
-    return Solution.from_result(res, _head(comm, model, {"r": r}))
+    return solution
 
 
 def spring_start(K: float) -> float:

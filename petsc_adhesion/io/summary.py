@@ -1,0 +1,186 @@
+"""The library's result values as the files' keys: a curve's JSON summary, its events and branch as the HDF5
+records, a solve's summary (docs/output.md).
+
+The one place where the objects of :mod:`petsc_adhesion.tracing.curve` become keys.
+An event (or a landing) is read field by field (:func:`event_record`): a
+:class:`~petsc_adhesion.tracing.measured.Measured` ``x`` becomes ``x``, ``x_err``
+and ``x_grid`` (the last two absent where the value has no bar or no other grid
+value), a nested value a nested record, a profile the arrays r, H and P, and a
+field that is None (or an empty tuple) is absent.  So a new field of an event
+reaches the JSON and HDF5 files with no change here; the CSV names its columns
+(:data:`~petsc_adhesion.io.text.EVENT_COLUMNS`).
+"""
+from __future__ import annotations
+
+from dataclasses import fields, is_dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..model.physical import in_units
+from ..model.pressure import pressure_law
+from ..tracing.curve import Curve, Cycle, Profile, Program, Solution
+from ..tracing.measured import Measured, Missing
+
+if TYPE_CHECKING:                    # tracing.critical loads PETSc, which a file reader need not
+    from ..tracing.critical import Critical
+
+__all__ = ["event_record", "branch_record", "program_record", "model_record", "head_of", "summary_of",
+           "solve_summary", "cycle_summary", "critical_record", "KEYS"]
+
+#: A field's name -> the key the files have always used for it.
+KEYS = {"lam": "lambda", "note": "error_note"}
+
+
+def event_record(obj, profiles: bool = True) -> dict:
+    """An :class:`~petsc_adhesion.tracing.curve.Event` (or its landing) as the files hold it, read from its
+    fields (see the module); ``profiles`` False leaves out r, H and P (a summary's, a study case's)."""
+    out = {}
+    for f in fields(obj):
+        v, key = getattr(obj, f.name), KEYS.get(f.name, f.name)
+        if v is None or (isinstance(v, tuple) and not v):
+            continue
+        if isinstance(v, Measured):
+            out[key] = v.value
+            if v.err is not None:
+                out[f"{key}_err"] = v.err
+            if v.grid is not None:
+                out[f"{key}_grid"] = v.grid
+        elif isinstance(v, Profile):
+            if profiles:
+                out |= {"r": v.r, "H": v.H, "P": v.P}
+        elif is_dataclass(v):
+            out[key] = event_record(v, profiles)
+        else:
+            out[key] = list(v) if isinstance(v, tuple) else v
+    return out
+
+
+#: The branch's fields -> the HDF5 datasets of the group ``curve``.
+_BRANCH = {"lam": "lambda"}
+
+
+def branch_record(curve: Curve) -> dict:
+    """The points of a curve as the HDF5 group ``curve`` holds them (Z and stable_spring behind a spring)."""
+    b = curve.branch
+    return {_BRANCH.get(f.name, f.name): getattr(b, f.name) for f in fields(b) if getattr(b, f.name) is not None}
+
+
+def program_record(p: Program) -> dict:
+    """What a result says about the :class:`~petsc_adhesion.tracing.curve.Program` that made it: versions
+    and ranks."""
+    return {k.name: getattr(p, k.name) for k in fields(p)}
+
+
+def model_record(model) -> dict:
+    """The model a result was computed for: mu, sigma, r_m, the roughness average and the domain."""
+    return {"mu": model.mu, "sigma": model.sigma, "rmax": model.rmax, **pressure_law(model).describe(),
+            "domain": "half-infinite (the rigid sphere's attraction beyond r_m added)" if model.farfield
+            else "truncated at r_m (the paper's model)"}
+
+
+def _grid(result) -> dict:
+    g = result.grid
+    out = {"r": g.r}
+    if g.lam is not None:
+        out |= {"lambda": g.lam, "n_nodes": g.n_nodes, **({"edge": g.edge} if g.edge is not None else {})}
+    return out
+
+
+def head_of(result) -> dict:
+    """The program, model, grid and physical inputs of a curve or a solution, as the files hold them."""
+    head = {**program_record(result.program), "model": model_record(result.model), "grid": _grid(result)}
+    if result.model.bodies is not None:
+        head["physical"] = result.model.bodies.describe()
+    return head
+
+
+def _plain(x):
+    """Python numbers, lists and dicts of x (as its JSON file holds it)."""
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+def _common(result) -> dict:
+    """The keys every summary has: versions, the model and the grid size (the largest grid's)."""
+    return {**program_record(result.program), **model_record(result.model), "n_nodes": result.grid.largest}
+
+
+def cycle_summary(c: Cycle) -> dict:
+    """A cycle's keys: its energy with its bar and loops, or (Missing) null ones and the reason."""
+    if isinstance(c.energy, Missing):
+        return {"energy": None, "energy_err": None, "loops": None, "energy_note": c.energy.reason}
+    return {"energy": c.energy.value, "energy_err": c.energy.err, "loops": c.loops,
+            **({"energy_note": c.energy.note} if c.energy.note else {})}
+
+
+def summary_of(curve: Curve) -> dict:
+    """The JSON summary of a traced curve (docs/output.md)."""
+    def brief(e):
+        return event_record(e, profiles=False)
+
+    ev, d, a = curve.events, curve.diagnostics, curve.assessment
+    s = {**_common(curve),
+         "pull_off": brief(curve.pull_off) if curve.pull_off else None,
+         "folds": [brief(e) for e in ev if e.kind in ("snap_on", "snap_off")],
+         "equilibria": [{k: v for k, v in brief(e).items() if k not in ("F", "F_err", "F_grid")}
+                        for e in ev if e.kind == "equilibrium"],
+         "load_extrema": [brief(e) for e in ev if e.kind in ("F_min", "F_max")],
+         "at_lambda": [brief(e) for e in ev if e.kind == "lambda"],
+         **cycle_summary(curve.rigid),
+         **({"spring": {"K": curve.spring.K, "jumps": [brief(e) for e in curve.spring.jumps],
+                        **cycle_summary(curve.spring.cycle)}} if curve.spring is not None else {}),
+         "wall_gap": d.wall_gap, "steps": d.steps, "rejected_steps": d.rejected_steps, "regrids": d.regrids,
+         "guard_activations": d.guard_activations, "smallest_step": d.smallest_step,
+         "most_newton_its": d.most_newton_its, "most_ksp_its": d.most_ksp_its, "stop_reason": d.stop_reason,
+         "grid_warning": a.grid_warning or "", "warnings": list(a.warnings), "complete": a.complete,
+         "lambda_start": d.lambda_start, "wall_time_s": d.wall_time_s}
+    if d.error_estimate is not None:
+        est = d.error_estimate
+        s["error_estimate"] = {"wall_time_s": est.wall_time_s, "target_error": est.target_error,
+                               "levels": list(est.levels)}
+    if curve.model.bodies is not None:
+        s["physical"] = in_units(s, curve.model.bodies.describe())
+    return _plain(s)
+
+
+def solve_record(solution: Solution) -> dict:
+    """The scalars of a solve: its state and the solver's effort."""
+    return {"lambda": solution.lam, "F": solution.F, "F_beyond": solution.F_beyond, "H0": solution.H0,
+            "snes_iterations": solution.snes_iterations, "ksp_iterations": solution.ksp_iterations,
+            "wall_time_s": solution.wall_time_s}
+
+
+def solve_summary(solution: Solution) -> dict:
+    """The JSON summary of a fixed-approach solve."""
+    res = solve_record(solution)
+    summ = {**_common(solution), **res}
+    if solution.model.bodies is not None:
+        d = solution.model.bodies.describe()
+        summ["physical"] = {**d, "lambda_nm": res["lambda"] * d["approach_nm"], "F_nN": res["F"] * d["force_nN"],
+                            "H0_nm": res["H0"] * d["approach_nm"]}
+    return _plain(summ)
+
+
+def critical_record(c: Critical) -> dict:
+    """A critical study's case (:class:`~petsc_adhesion.tracing.critical.Critical`) as the files hold it:
+    ``sigma_c`` (or ``mu_c``) and lambda_c, F_c with their bars, the values on each level (``*_grid``), the
+    levels and their nodes, the domain's share, the bracket, the edge and contact radius at the cusp, its
+    roughness law, r_m, the wall time and any warning."""
+    k = c.kind
+    out = {c.fixed_name: c.fixed, k: c.value.value, f"{k}_err": c.value.err, "lambda_c": c.lam.value,
+           "lambda_c_err": c.lam.err, "F_c": c.F.value, "F_c_err": c.F.err, f"{k}_domain": c.domain,
+           "levels": list(c.levels), "n_nodes": list(c.n_nodes), f"{k}_grid": list(c.value_grid),
+           "lambda_c_grid": list(c.lam_grid), "F_c_grid": list(c.F_grid), "bracket": list(c.bracket),
+           "edge": c.edge, "contact_radius": c.contact_radius, "roughness": pressure_law(c.model).describe(),
+           "rmax": c.model.rmax, "wall_time_s": c.wall_time_s}
+    if c.warning is not None:
+        out["warning"] = c.warning
+    return out
