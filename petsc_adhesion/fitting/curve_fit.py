@@ -24,8 +24,11 @@ branch it was on* (a jump does not move across a point within a difference), tho
 of z_0 and F_0 exact on the traced curve.  Bars from the Jacobian at the optimum:
 covariance s^2 (J^T J)^-1, s^2 = sum of squared residuals / (n - p), carried to
 (ln E*, ln w) by the linear map of eq. (9), ln E* = ln w + (ln R - 3 ln mu - 3 ln eps)/2;
-``gamma_err`` = w sd(ln w), ``E_star_err`` = E* sd(ln E*) (a 95% interval is +-1.96
-bars; docs/fitting.md measures how often it holds).
+the bar of w is w sd(ln w), that of E* is E* sd(ln E*) (a 95% interval is +-1.96 bars;
+docs/fitting.md measures how often it holds).  The result is a
+:class:`~petsc_adhesion.fitting.results.CurveFit`, each quantity Measured or Missing where a
+parameter is at a bound or undetermined, with a warning for each, and for a chi^2 the noise
+cannot explain (:mod:`~petsc_adhesion.fitting.results`).
 """
 from __future__ import annotations
 

@@ -245,5 +245,6 @@ def misfit(chi2: float, dof: int, noise_dof: float | None) -> str | None:
     p = misfit_p(chi2, dof, noise_dof)
     if math.isnan(p) or p >= MISFIT_P:
         return None
+    prob = f"{p:.2g}" if p > 0 else "below 1e-300"
     return (f"the model does not describe these data: reduced chi^2 {chi2 / dof:.3g} with {dof} degrees of "
-            f"freedom, which the noise alone gives with probability {p:.2g} (< {MISFIT_P:g})")
+            f"freedom, which the noise alone gives with probability {prob} (< {MISFIT_P:g})")
