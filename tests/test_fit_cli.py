@@ -50,6 +50,19 @@ def test_pull_off_on_the_command_line(tmp_path):
         assert "description" in f["fit/closed_forms"].attrs
 
 
+def test_a_pull_off_whose_w_is_undetermined_exits_3(tmp_path):
+    """A pull-off as uncertain as itself: w's 95% interval is wider than w; the files are written with w null and
+    its reason, the report says WARNING, exit status 3."""
+    out = tmp_path / "f.json"
+    p = run_cli("-fit_pull_off", "12.46e-9", "-fit_pull_off_err", "12.46e-9", *BODIES, "-summary", out)
+    assert p.returncode == 3, p.stderr
+    fit = json.load(open(out))["fit"]
+    assert fit["gamma"] is None and fit["gamma_err"] is None and not fit["trustworthy"]
+    assert fit["missing"]["gamma"].startswith("its 95% interval")
+    assert f"WARNING: gamma undetermined: {fit['missing']['gamma']}" in p.stdout
+    assert "gamma = undetermined" in p.stdout
+
+
 REFUSALS = {
     "both": (("-fit_pull_off", "1e-8", "-fit_curve", "c.csv", *BODIES), "-fit_pull_off: not with -fit_curve"),
     "no_epsilon": (("-fit_pull_off", "1e-8", "-phys_radius", "2e-8"), "-phys_epsilon: required with -fit_pull_off"),
@@ -72,7 +85,8 @@ REFUSALS = {
     "no_adhesion": (("-fit_curve", "flat.csv", *TIP, "-phys_spring", "1"), "-fit_curve: no adhesion"),
     "no_contact": (("-fit_curve", "none.csv", *TIP, "-phys_spring", "1"), "-fit_curve: no contact"),
     "equal_columns": (("-fit_curve", "equal.csv", *TIP, "-phys_spring", "1"),
-                      "-fit_curve: no force-distance relation: the force is the straight line 1 z + 0"),
+                      "-fit_curve: no force-distance relation: the force is a straight line of the piezo "
+                      "position (slope 1 N/m)"),
     "one_column": (("-fit_curve", "one.csv", *TIP, "-phys_spring", "1"), "-fit_curve: 'one.csv': line 2 has 1"),
     "bad_unit": (("-fit_curve", "unit.csv", *TIP, "-phys_spring", "1"), "-fit_curve: 'unit.csv': column 2"),
     "foreign": (("-fit_curve", "x.ibw", *TIP, "-phys_spring", "1"), "-fit_curve: 'x.ibw': not a force-distance"),

@@ -124,6 +124,27 @@ def test_pull_off_of_an_independent_curve_gives_its_gamma_back():
     assert f.trustworthy
 
 
+def test_a_pull_off_as_uncertain_as_itself_leaves_w_undetermined():
+    """P_err = P: the bar of w is about P_err / P over 1 + (2/3) dln|F|/dlnmu (near 1 at small mu), so its 95%
+    interval is wider than w: w is Missing with that reason, and the fit does not hold."""
+    b = _bodies(0.01)
+    P = 2 * math.pi * b.R * 0.05
+    f = fit_pull_off(P, b, P_err=P)
+    assert isinstance(f.gamma, Missing) and f.gamma.reason.startswith("its 95% interval")
+    assert not f.complete and not f.trustworthy
+    assert f.warnings == (f"gamma undetermined: {f.gamma.reason}",)
+
+
+def test_undetermined_is_a_95_percent_interval_wider_than_the_value():
+    """The rule's edge: a bar of 1 / 1.96 of the value is the widest a determined value may have."""
+    from petsc_adhesion.fitting.results import undetermined
+
+    assert undetermined(1.0, 0.999 / 1.959964) is None
+    assert undetermined(-1.0, 0.999 / 1.959964) is None
+    assert undetermined(1.0, 1.001 / 1.959964).startswith("its 95% interval")
+    assert "singular" in undetermined(1.0, None) and "singular" in undetermined(1.0, math.nan)
+
+
 @pytest.mark.parametrize("P", [0.0, -1e-9, math.inf, 1.0])
 def test_a_pull_off_no_w_gives_is_one_line(P):
     with pytest.raises(PullOffFitError) as e:

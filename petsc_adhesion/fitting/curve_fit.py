@@ -398,8 +398,9 @@ def _refuse_a_line(data: MeasuredCurve) -> None:
     coef, *_ = np.linalg.lstsq(A, data.F, rcond=None)
     left = float(np.sqrt(np.mean((data.F - A @ coef) ** 2)))
     if left <= _LINEAR * float(np.ptp(data.F)):
-        raise CurveFitError(f"no force-distance relation: the force is the straight line {coef[0]:.6g} z + "
-                            f"{coef[1]:.6g} on approach and retract alike (two columns of one quantity?)")
+        raise CurveFitError(f"no force-distance relation: the force is a straight line of the piezo position "
+                            f"(slope {coef[0]:.6g} N/m) on approach and retract alike (two columns of one "
+                            f"quantity?)")
 
 
 def _bounds(pb: _Problem, choice: FitChoice, modulus: float | None) -> tuple[np.ndarray, np.ndarray]:
