@@ -108,9 +108,12 @@ def same(a, b, rtol=1e-9, atol=1e-13, where="") -> list:
 
 def synthetic_csv(path: str) -> None:
     """The fit case's data: a curve made by the solver (mu = 1 for a 20 nm tip on a 150 GPa flat) with noise."""
-    from petsc_adhesion.fitting.synthetic import synthetic_curve
+    from petsc_adhesion.fitting.results import Spring
+    from petsc_adhesion.fitting.synthetic import Sampling, synthetic_curve
+    from petsc_adhesion.model.physical import Bodies
 
-    c = synthetic_curve(20e-9, 0.3e-9, 1.0, 0.05, 150e9 / (1 - 0.27 ** 2) / 2, noise=2e-11, points=150, seed=4)
+    bodies = Bodies(radius=20e-9, young1=150e9 / 2, poisson1=0.27, epsilon=0.3e-9, gamma=0.05)
+    c = synthetic_curve(bodies, Spring(1.0), Sampling(noise=2e-11, points=150, seed=4))
     with open(path, "w") as f:
         f.write("z (nm), F (nN)\n")
         f.writelines(f"{z * 1e9:.10g}, {F * 1e9:.10g}\n" for z, F in zip(c.z, c.F))

@@ -42,10 +42,25 @@ def test_pull_off_on_the_command_line(tmp_path):
     assert cf["dmt"]["gamma"] == pytest.approx(12.46e-9 / (2 * math.pi * 20e-9))
     assert cf["dmt"]["gamma"] < fit["gamma"] < cf["jkr"]["gamma"]
     assert "gamma = " in p.stdout and "JKR" in p.stdout and "Maugis-Dugdale" in p.stdout
+    assert fit["trustworthy"] and fit["complete"] and fit["warnings"] == [] and fit["missing"] == {}
+    assert "WARNING" not in p.stdout
     h5py = pytest.importorskip("h5py")
     with h5py.File(out / "f.h5") as f:
         assert f.attrs["kind"] == "fit" and f["fit"].attrs["gamma"] == fit["gamma"]
         assert "description" in f["fit/closed_forms"].attrs
+
+
+def test_a_pull_off_whose_w_is_undetermined_exits_3(tmp_path):
+    """A pull-off as uncertain as itself: w's 95% interval is wider than w; the files are written with w null and
+    its reason, the report says WARNING, exit status 3."""
+    out = tmp_path / "f.json"
+    p = run_cli("-fit_pull_off", "12.46e-9", "-fit_pull_off_err", "12.46e-9", *BODIES, "-summary", out)
+    assert p.returncode == 3, p.stderr
+    fit = json.load(open(out))["fit"]
+    assert fit["gamma"] is None and fit["gamma_err"] is None and not fit["trustworthy"]
+    assert fit["missing"]["gamma"].startswith("its 95% interval")
+    assert f"WARNING: gamma undetermined: {fit['missing']['gamma']}" in p.stdout
+    assert "gamma = undetermined" in p.stdout
 
 
 REFUSALS = {
@@ -96,22 +111,58 @@ def test_what_a_fit_cannot_use_is_one_line(tmp_path, key):
     assert listing(out) == []
 
 
+def test_two_equal_columns_are_refused(tmp_path):
+    """A file whose force column is its displacement column: no force-distance relation, one line naming the
+    option, exit 2, nothing written (run from the checkout, as every test that needs today's library)."""
+    ramp = np.r_[np.linspace(0, 50, 60), np.linspace(50, 0, 60)]
+    (tmp_path / "equal.csv").write_text("\n".join(f"{v:.6g}, {v:.6g}" for v in ramp))
+    out = tmp_path / "out"
+    out.mkdir()
+    p = run_cli("-fit_curve", tmp_path / "equal.csv", *TIP, "-phys_spring", "1", "-summary", out / "f.json",
+                "-out", out / "f.h5", timeout=120)
+    msg = one_line(p)
+    assert msg.startswith("-fit_curve: no force-distance relation: the force is a straight line of the piezo "
+                          "position (slope 1 N/m)"), msg
+    assert listing(out) == []
+
+
 def test_the_measured_asylum_curve(tmp_path):
     """The MFP3D curve of tests/data (docs/fitting.md): read with its spring constant, fitted with E* held at
-    the assumed moduli; the fit reports its misfit (the contact is half as stiff as the lever, which those
-    moduli cannot make) rather than hide it, and its measured pull-off is the file's own."""
+    the assumed moduli; the model does not describe it (the contact is half as stiff as the lever, which those
+    moduli cannot make): exit 3 with the WARNING line and its reduced chi^2, the files written all the same,
+    and its measured pull-off the file's own."""
     pytest.importorskip("afmformats")
     out = tmp_path / "s.json"
     p = run_cli("-fit_curve", IBW, "-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9", "-phys_young1", "250e9",
                 "-phys_poisson1", "0.25", "-phys_young2", "170e9", "-phys_poisson2", "0.28", "-fit_modulus", "false",
                 "-summary", out, "-plot", tmp_path / "f.png", "-csv", tmp_path / "f.csv")
-    assert p.returncode == 0, p.stderr
+    assert p.returncode == 3, p.stderr
     fit = json.load(open(out))["fit"]
     assert fit["given"]["spring_N_m"] == pytest.approx(1.1841) and fit["given"]["spring_from"] == "the file"
-    assert fit["fixed"]["E_star"] == pytest.approx(1 / ((1 - 0.25**2) / 250e9 + (1 - 0.28**2) / 170e9))
+    E_star = 1 / ((1 - 0.25**2) / 250e9 + (1 - 0.28**2) / 170e9)
+    assert fit["fixed"]["E_star"] == pytest.approx(E_star) and fit["E_star"] == fit["fixed"]["E_star"]
+    assert fit["E_star_err"] is None                     # held: no bar, rather than a bar of 0
     assert fit["measured"]["pull_off_N"] == pytest.approx(12.84e-9, rel=2e-3)
-    assert 0 < fit["gamma_err"] < fit["gamma"] < 1.0
-    assert fit["reduced_chi2"] > 100                    # the misfit is said
+    assert fit["reduced_chi2"] > 100 and fit["p_value"] < 1e-6
+    assert not fit["trustworthy"]
+    warned = [line.strip() for line in p.stdout.splitlines() if "WARNING" in line]
+    assert f"WARNING: the model does not describe these data: reduced chi^2 {fit['reduced_chi2']:.3g} " \
+           f"with {fit['dof']} degrees of freedom" in warned[-1]
+    assert any(w.startswith("the model does not describe these data") for w in fit["warnings"])
     assert (tmp_path / "f.png").stat().st_size > 10_000
     rows = (tmp_path / "f.csv").read_text().splitlines()
     assert rows[0] == "z_m,F_N,leg,F_fit_N,used" and len(rows) == 2017
+
+
+def test_a_good_synthetic_fit_exits_0(tmp_path):
+    """The curve of the golden fit (tests/data/golden/curve.csv: made by the solver at w = 0.05 J/m^2 and E* =
+    75 GPa / (1 - 0.27^2) with noise): exit 0, no WARNING, both true values inside their 95% intervals."""
+    out = tmp_path / "s.json"
+    p = run_cli("-fit_curve", os.path.join(ROOT, "tests", "data", "golden", "curve.csv"), *TIP, "-phys_spring", "1",
+                "-summary", out)
+    assert p.returncode == 0, p.stderr
+    assert "WARNING" not in p.stdout
+    fit = json.load(open(out))["fit"]
+    assert fit["trustworthy"] and fit["warnings"] == [] and fit["missing"] == {}
+    assert abs(fit["gamma"] - 0.05) <= 1.96 * fit["gamma_err"]
+    assert abs(fit["E_star"] - 75e9 / (1 - 0.27**2)) <= 1.96 * fit["E_star_err"]

@@ -15,7 +15,10 @@ petsc4py = pytest.importorskip("petsc4py")
 from petsc_adhesion.fitting.curve_fit import CurveFitError, fit_curve  # noqa: E402
 from petsc_adhesion.fitting.data import CurveFileError, MeasuredCurve, read_curve  # noqa: E402
 from petsc_adhesion.fitting.pull_off import PullOffFitError, fit_pull_off  # noqa: E402
+from petsc_adhesion.fitting.results import FitChoice, Spring, misfit_p  # noqa: E402
+from petsc_adhesion.fitting.synthetic import Sampling, synthetic_curve  # noqa: E402
 from petsc_adhesion.model.physical import Bodies  # noqa: E402
+from petsc_adhesion.tracing.measured import Measured, Missing  # noqa: E402
 
 IBW = f"{ROOT}/tests/data/fmt-igor-fd_SiN_FD_plot.ibw"
 
@@ -99,9 +102,10 @@ def test_pull_off_at_small_mu_is_dmt():
     b = _bodies(0.01)
     P = 2 * math.pi * b.R * 0.05
     f = fit_pull_off(P, b)
-    assert abs(f.gamma / 0.05 - 1) < 5e-3 and abs(f.mu - 0.01) < 1e-4
-    assert f.closed_forms["dmt"]["gamma"] == pytest.approx(0.05, rel=1e-12)
-    assert f.closed_forms["jkr"]["gamma"] == pytest.approx(0.05 * 4 / 3, rel=1e-12)
+    assert abs(f.gamma.value / 0.05 - 1) < 5e-3 and abs(f.mu - 0.01) < 1e-4
+    assert f.closed_form("dmt").gamma == pytest.approx(0.05, rel=1e-12)
+    assert f.closed_form("jkr").gamma == pytest.approx(0.05 * 4 / 3, rel=1e-12)
+    assert f.trustworthy and f.warnings == ()
 
 
 def test_pull_off_of_an_independent_curve_gives_its_gamma_back():
@@ -114,10 +118,32 @@ def test_pull_off_of_an_independent_curve_gives_its_gamma_back():
     c = trace_curve(Model(mu=1.0))
     P = abs(c.pull_off.F.value) * 2 * math.pi * b.R * 0.05
     f = fit_pull_off(P, b, P_err=0.01 * P)
-    assert abs(f.gamma - 0.05) < 1.96 * f.gamma_err
+    assert f.gamma.covers(0.05, 1.96) and f.P == Measured(P, 0.01 * P)
     # a 1% force gives w to about 1 / (1 + (2/3) dln|F|/dlnmu) %: the bar says so
-    assert f.gamma_err / f.gamma == pytest.approx(0.01 / (1 + 2 / 3 * f.dlnF_dlnmu), rel=0.02)
-    assert f.closed_forms["dmt"]["gamma"] < f.gamma < f.closed_forms["jkr"]["gamma"]
+    assert f.gamma.relative == pytest.approx(0.01 / (1 + 2 / 3 * f.dlnF_dlnmu), rel=0.02)
+    assert f.closed_form("dmt").gamma < f.gamma.value < f.closed_form("jkr").gamma
+    assert f.trustworthy
+
+
+def test_a_pull_off_as_uncertain_as_itself_leaves_w_undetermined():
+    """P_err = P: the bar of w is about P_err / P over 1 + (2/3) dln|F|/dlnmu (near 1 at small mu), so its 95%
+    interval is wider than w: w is Missing with that reason, and the fit does not hold."""
+    b = _bodies(0.01)
+    P = 2 * math.pi * b.R * 0.05
+    f = fit_pull_off(P, b, P_err=P)
+    assert isinstance(f.gamma, Missing) and f.gamma.reason.startswith("its 95% interval")
+    assert not f.complete and not f.trustworthy
+    assert f.warnings == (f"gamma undetermined: {f.gamma.reason}",)
+
+
+def test_undetermined_is_a_95_percent_interval_wider_than_the_value():
+    """The rule's edge: a bar of 1 / 1.96 of the value is the widest a determined value may have."""
+    from petsc_adhesion.fitting.results import undetermined
+
+    assert undetermined(1.0, 0.999 / 1.959964) is None
+    assert undetermined(-1.0, 0.999 / 1.959964) is None
+    assert undetermined(1.0, 1.001 / 1.959964).startswith("its 95% interval")
+    assert "singular" in undetermined(1.0, None) and "singular" in undetermined(1.0, math.nan)
 
 
 @pytest.mark.parametrize("P", [0.0, -1e-9, math.inf, 1.0])
@@ -129,25 +155,90 @@ def test_a_pull_off_no_w_gives_is_one_line(P):
 
 # -- the curve --------------------------------------------------------------------------------------------
 R, EPS, K_SPRING, W = 20e-9, 0.3e-9, 1.0, 0.05
+#: What a fit of a curve is given: the tip and epsilon, no moduli.
+TIP = Bodies(radius=R, young1=None, poisson1=None, epsilon=EPS)
+
+
+def _truth(mu):
+    """The bodies of the synthetic curves: w = W, E* from eq. (9) at ``mu`` (on a rigid flat)."""
+    return Bodies(radius=R, young1=W * math.sqrt(R / (mu**3 * EPS**3)), poisson1=0.0, epsilon=EPS, gamma=W)
+
+
+def _synthetic(mu, seed, noise_share=0.01, points=300, fine=True):
+    """A curve made by the forward solver (finer steps than the fit's where ``fine``) with noise of
+    ``noise_share`` of 2 pi R w, a contact point and a baseline."""
+    from petsc_adhesion.tracing.trace import curve_settings
+
+    noise = noise_share * 2 * math.pi * R * W
+    settings = curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1) if fine else None
+    return synthetic_curve(_truth(mu), Spring(K_SPRING),
+                           Sampling(noise=noise, points=points, z0=7e-9, F0=-3e-10, seed=seed), settings=settings)
 
 
 @pytest.mark.parametrize("mu, seed", [(0.5, 11), (1.0, 12), (2.0, 13)])
 def test_curve_fit_recovers_a_synthetic_curve(mu, seed):
     """A curve made by the forward solver (finer steps than the fit's) with 1% noise, a contact point and a
-    baseline: w and E* inside their 95% intervals, the contact point too."""
-    from petsc_adhesion.fitting.synthetic import synthetic_curve
-    from petsc_adhesion.tracing.trace import curve_settings
+    baseline: w and E* inside their 95% intervals, the contact point too; the fit holds (no warning)."""
+    E = _truth(mu).E
+    f = fit_curve(_synthetic(mu, seed), TIP, Spring(K_SPRING))
+    assert f.gamma.covers(W, 1.96), f.gamma
+    assert f.E_star.covers(E, 1.96), f.E_star
+    assert f.z0.covers(7e-9, 1.96), f.z0
+    assert f.gamma.relative < 0.05 and f.E_star.relative < 0.2     # the bars say something
+    assert 0.7 < f.reduced_chi2 < 2.0                             # the noise, not a misfit
+    assert f.trustworthy and f.complete and f.warnings == () and f.p_value > 1e-3
+    assert f.rms is None and f.parameters == ("ln_E_star", "ln_gamma", "z0", "F0")
 
-    E = W * math.sqrt(R / (mu**3 * EPS**3))
+
+def test_a_noise_100_times_the_stated_is_a_misfit():
+    """The same curve fitted twice: with the noise it has stated, the fit holds; stated 100 times smaller, chi^2
+    grows 10^4 times and the fit says the model does not describe the data, with the figure."""
     noise = 0.01 * 2 * math.pi * R * W
-    d = synthetic_curve(R, EPS, K_SPRING, W, E, noise=noise, points=300, z0=7e-9, F0=-3e-10, seed=seed,
-                        settings=curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1))
-    f = fit_curve(d, R, EPS, K_SPRING)
-    assert abs(f.gamma - W) <= 1.96 * f.gamma_err, (f.gamma, f.gamma_err)
-    assert abs(f.E_star - E) <= 1.96 * f.E_star_err, (f.E_star, f.E_star_err)
-    assert abs(f.z0 - 7e-9) <= 1.96 * f.z0_err
-    assert f.gamma_err / W < 0.05 and f.E_star_err / E < 0.2     # the bars say something
-    assert 0.7 < f.chi2 / f.dof < 2.0                             # the noise, not a misfit
+    d = _synthetic(1.0, 12, fine=False, points=150)
+    good = fit_curve(d, TIP, Spring(K_SPRING), FitChoice(noise=noise))
+    assert good.trustworthy and good.noise_stated and good.p_value > 1e-3, good.warnings
+    bad = fit_curve(d, TIP, Spring(K_SPRING), FitChoice(noise=noise / 100))
+    assert not bad.trustworthy and bad.complete                 # the numbers are there; they do not hold
+    # at most 10^4 times the good fit's (its optimum, now 10^4 times worse, was open to it), and far above 1
+    assert 1e3 < bad.reduced_chi2 <= 1.0001e4 * good.reduced_chi2
+    assert bad.p_value < 1e-6
+    (w,) = bad.warnings
+    assert w.startswith("the model does not describe these data: reduced chi^2 ") and f"{bad.reduced_chi2:.3g}" in w
+
+
+def test_mu_driven_to_its_bound_is_missing():
+    """A curve made at mu = 0.3, fitted with E* held 10^4 times too stiff: w would need mu = 0.3 / 10^(8/3) =
+    6.5e-4 by eq. (9), below the model's 1e-3; the fit stops at the bound, and w is Missing with that reason."""
+    truth = _truth(0.3)
+    d = _synthetic(0.3, 3, fine=False, points=150)
+    held = Bodies(radius=R, young1=truth.E * 1e4, poisson1=0.0, epsilon=EPS)
+    f = fit_curve(d, held, Spring(K_SPRING), FitChoice(modulus=False))
+    assert isinstance(f.gamma, Missing) and "at the bound 0.001 of the model's range" in f.gamma.reason
+    assert f.mu == pytest.approx(1e-3, rel=0.02)
+    assert f.E_star == Measured(held.E, note="held at the moduli given (eq. 2)")
+    assert not f.complete and not f.trustworthy
+    assert any(w.startswith("gamma undetermined: mu = ") for w in f.warnings)
+
+
+def test_the_misfit_threshold_is_the_noise_distribution():
+    """The threshold's probability against closed forms: with a stated noise, chi^2 with dof degrees of freedom
+    (its mean dof: p near 1/2 there); with an estimated noise of nu degrees of freedom, Fisher's F, whose tail is
+    heavier (the same chi^2 less improbable); and the Wilson-Hilferty point of p = 1e-6 for dof = 300."""
+    assert misfit_p(300.0, 300, None) == pytest.approx(0.5, abs=0.02)
+    assert misfit_p(1.5 * 300, 300, 30.0) > misfit_p(1.5 * 300, 300, None)
+    # Wilson-Hilferty: chi^2_p = dof (1 - 2/(9 dof) + z sqrt(2/(9 dof)))^3, z = 4.7534 at p = 1e-6
+    dof, z = 300, 4.753424
+    x = dof * (1 - 2 / (9 * dof) + z * math.sqrt(2 / (9 * dof))) ** 3
+    assert misfit_p(x, dof, None) == pytest.approx(1e-6, rel=0.1)
+
+
+def test_two_equal_columns_are_no_curve():
+    """A file whose force column is its displacement column: the force is a straight line of z on both legs,
+    no force-distance relation; one line."""
+    z = np.r_[np.linspace(0, 50e-9, 100), np.linspace(50e-9, 0, 100)]
+    with pytest.raises(CurveFitError) as e:
+        fit_curve(MeasuredCurve(z=z, F=z.copy(), turn=100, direction=1, spring=1.0), TIP, Spring(1.0))
+    assert str(e.value).startswith("no force-distance relation") and "\n" not in str(e.value)
 
 
 def _curve(F_contact, F_pull):
@@ -165,5 +256,5 @@ def _curve(F_contact, F_pull):
 @pytest.mark.parametrize("F_contact, F_pull, says", [(0.0, 0.0, "no contact"), (5e-9, 0.0, "no adhesion")])
 def test_a_curve_without_contact_or_adhesion_is_one_line(F_contact, F_pull, says):
     with pytest.raises(CurveFitError) as e:
-        fit_curve(_curve(F_contact, F_pull), R, EPS, 1.0)
+        fit_curve(_curve(F_contact, F_pull), TIP, Spring(1.0))
     assert str(e.value).startswith(says) and "\n" not in str(e.value)

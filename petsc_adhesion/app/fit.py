@@ -21,6 +21,7 @@ from ..errors import InputError, collective, printable
 from ..fitting.curve_fit import CurveFitError, fit_curve, predict_curve
 from ..fitting.data import CurveFileError, read_curve
 from ..fitting.pull_off import PullOffFitError, fit_pull_off
+from ..fitting.results import FitChoice, Spring
 from ..io.fit import fit_summary, fit_tree, report_fit
 from ..io.inputs import check_input
 from ..io.resultset import PLOT_FORMATS, check_targets, written
@@ -70,18 +71,12 @@ class FitRequest:
     model: Model                # the roughness average and the domain (mu and bodies are the fit's)
     grid: GridChoice
     solver: object
-    bodies: Bodies | None       # pull_off: radii, moduli, epsilon, rms
-    P: float | None
+    bodies: Bodies              # radii, moduli (a curve's: where given), epsilon, rms
+    P: float | None             # pull_off: the measured pull-off (N) and its bar
     P_err: float
     data: object                # curve: the MeasuredCurve
-    radius: float | None
-    epsilon: float | None
-    modulus: float | None       # curve: E* of the -phys_ moduli (the start, or held with -fit_modulus false)
-    spring: float | None
-    spring_source: str
-    rms: float | None
-    fit_modulus: bool
-    fit_roughness: bool
+    spring: Spring | None       # curve: the cantilever
+    choice: FitChoice | None    # curve: what is fitted
     targets: dict
 
 
@@ -100,7 +95,8 @@ def _refuse_others(opts: AppOptions, what: str) -> None:
 
 
 def _moduli(opts: AppOptions, need: bool, what: str) -> float | None:
-    """E* of eq. (2) from -phys_young1, -phys_poisson1 (and -phys_young2, -phys_poisson2), or None."""
+    """E* of eq. (2) from -phys_young1, -phys_poisson1 (and -phys_young2, -phys_poisson2), or None: checked
+    here, given to the fit in the Bodies."""
     have = {n: opts.real(n) for n in ("phys_young1", "phys_poisson1", "phys_young2", "phys_poisson2") if _given(opts, n)}
     for a, b in (("phys_young1", "phys_poisson1"), ("phys_young2", "phys_poisson2")):
         if (a in have) != (b in have):
@@ -161,10 +157,7 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         if not _given(opts, name):
             need = "the tip's radius R" if name == "phys_radius" else "the Lennard-Jones law's epsilon"
             raise InputError(f"-{name}: required with {what} ({need}, m)")
-    radius, eps = opts.real("phys_radius"), opts.real("phys_epsilon")
-    if _given(opts, "phys_radius2"):
-        r2 = opts.real("phys_radius2")
-        radius = radius * r2 / (radius + r2)
+    eps = opts.real("phys_epsilon")
     rms = opts.real("phys_rms")
     if opts.choice("adh_roughness") == "none" and rms:
         raise InputError("-phys_rms: not with -adh_roughness none (a smooth surface)")
@@ -184,15 +177,14 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
     inputs = {"options_file": options_files(argv), "fit_curve": [path or ""]}
     fit_modulus, fit_rough = opts.flag("fit_modulus"), opts.flag("fit_roughness")
+    _moduli(opts, kind == "pull_off" or not fit_modulus, what if kind == "pull_off" else "-fit_modulus false")
+    bodies = Bodies(radius=opts.real("phys_radius"), young1=opts.real("phys_young1"),
+                    poisson1=opts.real("phys_poisson1"), epsilon=eps, radius2=opts.real("phys_radius2"),
+                    young2=opts.real("phys_young2"), poisson2=opts.real("phys_poisson2"), rms=rms)
     if kind == "pull_off":
-        E = _moduli(opts, True, what)
-        bodies = Bodies(radius=opts.real("phys_radius"), young1=opts.real("phys_young1"),
-                        poisson1=opts.real("phys_poisson1"), epsilon=eps, radius2=opts.real("phys_radius2"),
-                        young2=opts.real("phys_young2"), poisson2=opts.real("phys_poisson2"), rms=rms)
-        req = FitRequest("pull_off", model, grid, solver, bodies, pull, opts.real("fit_pull_off_err"), None, radius,
-                         eps, E, None, "", rms, True, False, targets)
+        req = FitRequest("pull_off", model, grid, solver, bodies, pull, opts.real("fit_pull_off_err"), None, None,
+                         None, targets)
     else:
-        E = _moduli(opts, not fit_modulus, "-fit_modulus false")
         if fit_rough and model.roughness == "none":
             raise InputError("-fit_roughness: not with -adh_roughness none (a smooth surface)")
         check_input("fit_curve", path)
@@ -210,8 +202,8 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         elif data.spring is not None and k != data.spring:
             data = data.rescaled(k)       # the file's force is its spring constant times the measured deflection
             source = f"-phys_spring (the file's force rescaled from its {data.metadata.get('spring constant')} N/m)"
-        req = FitRequest("curve", model, grid, solver, None, None, 0.0, data, radius, eps, E, k, source, rms,
-                         fit_modulus, fit_rough, targets)
+        req = FitRequest("curve", model, grid, solver, bodies, None, 0.0, data, Spring(k, source),
+                         FitChoice(modulus=fit_modulus, roughness=fit_rough), targets)
     if comm.getRank() == 0:
         check_targets(targets, inputs)
     return req
@@ -223,46 +215,40 @@ def _fit(req: FitRequest, comm):
         if req.kind == "pull_off":
             return fit_pull_off(req.P, req.bodies, req.P_err, model=req.model, grid=req.grid, solver=req.solver,
                                 comm=comm)
-        return fit_curve(req.data, req.radius, req.epsilon, req.spring, modulus=req.modulus, rms=req.rms,
-                         fit_modulus=req.fit_modulus, fit_roughness=req.fit_roughness, model=req.model,
-                         grid=req.grid, solver=req.solver, comm=comm)
+        return fit_curve(req.data, req.bodies, req.spring, req.choice, model=req.model, grid=req.grid,
+                         solver=req.solver, comm=comm)
     except PullOffFitError as e:
         raise InputError(f"-fit_pull_off: {printable(str(e))}") from None
     except CurveFitError as e:
         raise InputError(f"-fit_curve: {printable(str(e))}") from None
 
 
-def _curve_arrays(req: FitRequest, fit) -> tuple[dict, dict]:
+def _model_curve(fit) -> dict:
+    """The fitted model's force on an even grid of MODEL_POINTS piezo positions over the data, each leg."""
     import numpy as np
 
-    data = {"z": fit.z, "F": fit.F, "leg": fit.leg, "F_fit": fit.F_fit, "used": fit.used.astype(int)}
-    z = np.linspace(float(fit.z.min()), float(fit.z.max()), MODEL_POINTS)
-    model = {"z": z, "F_approach": predict_curve(fit, z, "approach"), "F_retract": predict_curve(fit, z, "retract")}
-    return data, model
+    z = np.linspace(float(fit.data.z.min()), float(fit.data.z.max()), MODEL_POINTS)
+    return {"z": z, "F_approach": predict_curve(fit, z, "approach"), "F_retract": predict_curve(fit, z, "retract")}
 
 
 def execute(opts: AppOptions, argv: list[str], report: bool = True):
-    """The fit of the options database: (exit status, the library's fit)."""
+    """The fit of the options database: (exit status, the library's fit).  The status is 3 where the fit does
+    not hold (its warnings: a parameter at a bound or undetermined, a misfit; docs/fitting.md), its files
+    written all the same; else 0."""
     comm = PETSc.COMM_WORLD
     req = collective(comm, read, opts, comm, argv)
     fit = _fit(req, comm)
-    summary = dict(fit.summary)
-    if req.kind == "curve":
-        summary["given"] = {**summary["given"], "file": req.data.path, "format": req.data.source,
-                            "spring_from": req.spring_source}
     head = program_record(Program.of(comm))
     head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted
     given = opts.given()
-    data = model = None
-    if req.kind == "curve":
-        data, model = _curve_arrays(req, fit)
+    model = _model_curve(fit) if req.kind == "curve" else None
     with written(req.targets) as files:
-        write_fit(fit_tree(head, given, summary, data, model), fit_summary(head, given, summary), files)
+        write_fit(fit_tree(head, given, fit, model), fit_summary(head, given, fit), files)
         if report:
-            report_fit(summary)
+            report_fit(fit)
         files.commit()
     PETSc.garbage_cleanup()
-    return 0, fit
+    return (0 if fit.trustworthy else 3), fit
 
 
 def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:

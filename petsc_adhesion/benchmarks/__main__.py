@@ -189,21 +189,24 @@ def bench_fit(repeats: int | None = None) -> dict:
     import math
 
     from ..fitting.curve_fit import fit_curve
-    from ..fitting.synthetic import synthetic_curve
+    from ..fitting.results import Spring
+    from ..fitting.synthetic import Sampling, synthetic_curve
+    from ..model.physical import Bodies
 
     R, eps, k, w, mu = 20e-9, 0.3e-9, 1.0, 0.05, 1.0
     E = w * math.sqrt(R / (mu**3 * eps**3))
-    data = synthetic_curve(R, eps, k, w, E, noise=0.01 * 2 * math.pi * R * w, points=300, z0=5e-9, seed=1)
+    data = synthetic_curve(Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w), Spring(k),
+                           Sampling(noise=0.01 * 2 * math.pi * R * w, points=300, z0=5e-9, seed=1))
     times = []
     for _ in range(repeats or 3):
         t0 = time.perf_counter()
-        f = fit_curve(data, R, eps, k)
+        f = fit_curve(data, Bodies(radius=R, young1=None, poisson1=None, epsilon=eps), Spring(k))
         times.append(time.perf_counter() - t0)
-        if abs(f.gamma - w) > 1.96 * f.gamma_err or abs(f.E_star - E) > 1.96 * f.E_star_err:
-            raise RuntimeError(f"fit of the mu = 1 curve: w = {f.gamma:.5g} +- {f.gamma_err:.2g} (true {w:g}), "
-                               f"E* = {f.E_star:.5g} +- {f.E_star_err:.2g} (true {E:.5g})")
+        if not (f.trustworthy and f.gamma.covers(w, 1.96) and f.E_star.covers(E, 1.96)):
+            raise RuntimeError(f"fit of the mu = 1 curve: w = {f.gamma} (true {w:g}), E* = {f.E_star} (true "
+                               f"{E:.5g}); {'; '.join(f.warnings)}")
     return {"fit": row("fit of a force curve, mu = 1", times, 60.0, traces=f.traces, evaluations=f.iterations,
-                       gamma=f.gamma, gamma_err=f.gamma_err, E_star=f.E_star, E_star_err=f.E_star_err)}
+                       gamma=f.gamma.value, gamma_err=f.gamma.err, E_star=f.E_star.value, E_star_err=f.E_star.err)}
 
 
 def _where(key: tuple) -> str:

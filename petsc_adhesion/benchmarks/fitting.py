@@ -53,7 +53,10 @@ def coverage_case(mu: float, seed: int) -> dict:
     """One synthetic curve (forward solver, finer steps than the fit's, noise of ``seed``) and its fit."""
     _init()
     from ..fitting.curve_fit import fit_curve
-    from ..fitting.synthetic import synthetic_curve
+    from ..fitting.results import Spring
+    from ..fitting.synthetic import Sampling, synthetic_curve
+    from ..io.fit import fit_record
+    from ..model.physical import Bodies
     from ..tracing.trace import curve_settings
 
     s = SYNTH
@@ -63,16 +66,17 @@ def coverage_case(mu: float, seed: int) -> dict:
     z0, F0 = float(rng.uniform(-20e-9, 20e-9)), float(rng.uniform(-1e-9, 1e-9))
     noise = s["noise_share"] * 2 * math.pi * R * w
     t = time.perf_counter()
-    data = synthetic_curve(R, eps, k, w, E, noise=noise, points=s["points"], z0=z0, F0=F0, seed=seed,
+    truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w)
+    data = synthetic_curve(truth, Spring(k), Sampling(noise=noise, points=s["points"], z0=z0, F0=F0, seed=seed),
                            settings=curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1))
     made = time.perf_counter() - t
-    fit = fit_curve(data, R, eps, k)
+    fit = fit_curve(data, Bodies(radius=R, young1=None, poisson1=None, epsilon=eps), Spring(k))
     row = {"mu": mu, "seed": seed, "gamma": w, "E_star": E, "z0_m": z0, "F0_N": F0, "noise_N": noise,
            "K": data.metadata["K"], "synth_s": made}
-    f = fit.summary
-    row["fit"] = {k_: f[k_] for k_ in ("gamma", "gamma_err", "gamma_err_fit", "E_star", "E_star_err",
-                                       "E_star_err_fit", "mu", "reduced_chi2", "traces", "iterations",
-                                       "wall_time_s", "status", "notes") if k_ in f}
+    f = fit_record(fit)
+    row["fit"] = {k_: f[k_] for k_ in ("gamma", "gamma_err", "E_star", "E_star_err", "mu", "reduced_chi2",
+                                       "p_value", "traces", "iterations", "wall_time_s", "status", "notes",
+                                       "warnings") if k_ in f}
     row["fit"]["z0_m"], row["fit"]["z0_err_m"] = f["offsets"]["z0_m"], f["offsets"]["z0_err_m"]
     return row
 
@@ -94,7 +98,7 @@ def _inside(row: dict, key: str, err: str = "") -> bool | None:
 
 
 def coverage_section(rows: list, made: dict) -> str:
-    ok = [r for r in rows if "fit" in r]
+    ok = [r for r in rows if "fit" in r and r["fit"].get("gamma_err") and r["fit"].get("E_star_err")]
     lines = ["## Coverage of the curve fit's intervals", "",
              "<!-- made by: python -m petsc_adhesion.benchmarks.fitting coverage (data: docs/data/fitting_coverage.json;"
              " -table redraws from it) -->", "",
@@ -126,6 +130,10 @@ def coverage_section(rows: list, made: dict) -> str:
     for r in rows:
         if "fit" not in r:
             lines.append(f"| {r['mu']:g} | {r['seed']} | failed: {r['error']} | | | | | | |")
+            continue
+        if r not in ok:
+            lines.append(f"| {r['mu']:g} | {r['seed']} | undetermined: {'; '.join(r['fit'].get('warnings', []))} "
+                         f"| | | | | | |")
             continue
         f = r["fit"]
         lines.append(f"| {r['mu']:g} | {r['seed']} | {f['gamma']:.5g} +- {f['gamma_err']:.2g} | "
@@ -160,7 +168,7 @@ def pull_off_rows() -> list:
         P = abs(e.F) * 2 * math.pi * R * w
         cf = closed_forms(P, b)
         rows.append({"mu": mu, "F": e.F, "F_err": e.F_err, "seconds": time.perf_counter() - t,
-                     **{f"{k}_ratio": cf[k]["gamma"] / w for k in ("dmt", "jkr", "maugis_dugdale")}})
+                     **{f"{c.name}_ratio": c.gamma / w for c in cf}})
         print(f"mu = {mu:g}: F = {e.F:.6f}", flush=True)
     return rows
 

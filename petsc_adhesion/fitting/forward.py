@@ -30,7 +30,9 @@ import numpy as np
 
 from ..model.reference.rigid import rigid_load
 
-__all__ = ["Piece", "ForwardCurve", "APPROACH", "RETRACT"]
+__all__ = ["Piece", "ForwardCurve", "APPROACH", "RETRACT", "curve_branch", "curve_stop_reason", "curve_jumps",
+           "event_landing", "event_value",
+           "pull_off_values"]
 
 APPROACH, RETRACT = "approach", "retract"
 #: Table entries per interval between two traced points.
@@ -87,12 +89,47 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return out
 
 
+# -- what fitting/ reads of a traced Curve: these functions alone ---------------------------------------------
+def curve_branch(curve) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(lambda, Z, F, stable behind the spring) at every computed point of a curve traced behind a spring."""
+    b = curve.branch
+    lam, Z, F = (np.asarray(a, dtype=float) for a in (b.lam, b.Z, b.F))
+    return lam, Z, F, np.asarray(b.stable_spring, dtype=bool)
+
+
+def curve_stop_reason(curve) -> str:
+    """Why the traced curve ended."""
+    return str(curve.diagnostics.stop_reason)
+
+
+def curve_jumps(curve, kind: str) -> list:
+    """The events of ``kind`` (jump_in or jump_off) of a curve traced behind a spring."""
+    return [e for e in curve.events if e.kind == kind]
+
+
+def event_landing(e):
+    """The state a jump lands on (an event), None where the library found none."""
+    return getattr(e, "landing", None)
+
+
+def event_value(e, key: str) -> float:
+    """An event's ``key`` (lam or F) on its grid (its best value when it has none)."""
+    m = getattr(e, key)                 # a Measured
+    return float(m.grid if m.grid is not None else m.value)
+
+
+def pull_off_values(e) -> tuple[float, float | None, float]:
+    """A pull-off event's (best F, its bar or None, F on its grid)."""
+    F = e.F                             # a Measured
+    return float(F.value), (None if F.err is None else float(F.err)), \
+        float(F.grid if F.grid is not None else F.value)
+
+
 def _value(e, key: str, K: float | None = None) -> float:
     """An event's value on its grid (its best value when it has none): lam, F, or Z = lam + F / K."""
     if key == "Z":
         return _value(e, "lam") + _value(e, "F") / K
-    m = getattr(e, key)                 # a Measured
-    return float(m.grid if m.grid is not None else m.value)
+    return event_value(e, key)
 
 
 class ForwardCurve:
@@ -105,12 +142,10 @@ class ForwardCurve:
     """
 
     def __init__(self, curve, K: float):
-        b = curve.branch
-        lam, Z, F = (np.asarray(v, dtype=float) for v in (b.lam, b.Z, b.F))
-        stable = np.asarray(b.stable_spring, dtype=bool)
+        lam, Z, F, stable = curve_branch(curve)
         self.K = float(K)
         self.notes: list[str] = []
-        events = {k: [e for e in curve.events if e.kind == k] for k in ("jump_in", "jump_off")}
+        events = {k: curve_jumps(curve, k) for k in ("jump_in", "jump_off")}
         used = set()
         raw = []
         for i0, i1 in _runs(stable):
@@ -183,7 +218,7 @@ class ForwardCurve:
         """The piece the jump of ``event`` at an end of piece ``i`` lands on: the library's landing, else the
         next piece in the jump's direction that holds its Z."""
         Zf = _value(event, "Z", self.K)
-        land = event.landing
+        land = event_landing(event)
         others = range(i + step, len(self.pieces) if step > 0 else -1, step)
         if land is not None:
             lam_l = _value(land, "lam")

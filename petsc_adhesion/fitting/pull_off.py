@@ -27,11 +27,15 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 from .. import brent
 from ..model.parameters import Model, tabor
+from ..model.physical import Bodies
 from ..model.reference.maugis_dugdale import maugis_dugdale_pull_off
+from ..tracing.measured import Measured, Missing
+from .forward import curve_stop_reason, pull_off_values
+from .results import BOUND_MARGIN, ClosedForm, PullOffFit, undetermined
 
 __all__ = ["PullOffFit", "PullOffFitError", "fit_pull_off", "model_pull_off", "maugis_dugdale_gamma", "MU_RANGE",
            "closed_forms"]
@@ -46,39 +50,6 @@ class PullOffFitError(ValueError):
     """A pull-off no work of adhesion gives within the model's range; one line."""
 
 
-@dataclass(frozen=True)
-class PullOffFit:
-    """The work of adhesion of a measured pull-off (SI): ``gamma`` (J/m^2) and its bar ``gamma_err``; ``mu``
-    (eq. 9) and ``sigma`` of the model at gamma; ``F`` the model's pull-off there (2 pi R gamma units) with
-    its bar ``F_err``; ``dlnF_dlnmu`` the slope of |F_p| against mu; ``closed_forms`` what DMT, JKR and
-    Maugis-Dugdale give for gamma (and mu); ``curves`` the curves traced, ``wall_time_s`` the time."""
-
-    P: float
-    P_err: float
-    gamma: float
-    gamma_err: float
-    mu: float
-    sigma: float
-    F: float
-    F_err: float
-    F_grid: float
-    dlnF_dlnmu: float
-    closed_forms: dict
-    curves: int
-    wall_time_s: float
-    bodies: object = field(repr=False, default=None)
-    history: list = field(repr=False, default_factory=list)
-
-    @property
-    def summary(self) -> dict:
-        """The ``fit`` object of a ``-summary`` file (docs/fitting.md)."""
-        return {"kind": "pull_off", "P_N": self.P, "P_err_N": self.P_err, "gamma": self.gamma,
-                "gamma_err": self.gamma_err, "mu": self.mu, "sigma": self.sigma, "F_pull_off": self.F,
-                "F_pull_off_err": self.F_err, "F_pull_off_grid": self.F_grid, "dlnF_dlnmu": self.dlnF_dlnmu,
-                "closed_forms": self.closed_forms, "curves_traced": self.curves, "wall_time_s": self.wall_time_s,
-                "iterations": [{"gamma": g, "mu": m, "F_grid": f} for g, m, f in self.history]}
-
-
 def model_pull_off(model: Model, grid=None, solver=None, error_bars: bool = False, comm=None):
     """The load-controlled pull-off of ``model`` (its most tensile F_min, an
     :class:`~petsc_adhesion.tracing.curve.Event`): the curve traced until the load is back at 0."""
@@ -89,26 +60,25 @@ def model_pull_off(model: Model, grid=None, solver=None, error_bars: bool = Fals
         c = trace_curve(model, grid or GridChoice(), solver or SolverChoice(), curve_settings(observable_max=0.0),
                         CurveRequest(error_bars=error_bars, kinds=("F_min",)), comm=comm)
     if c.pull_off is None:
-        raise RuntimeError(f"the curve at mu = {model.mu:.6g} has no pull-off ({c.diagnostics.stop_reason})")
+        raise RuntimeError(f"the curve at mu = {model.mu:.6g} has no pull-off ({curve_stop_reason(c)})")
     return c.pull_off
 
 
-def closed_forms(P: float, bodies) -> dict:
+def closed_forms(P: float, bodies: Bodies) -> tuple:
     """What DMT, JKR and Maugis-Dugdale give for the work of adhesion of the pull-off P (N) of ``bodies``
-    (their R, E, epsilon): {dmt, jkr, maugis_dugdale: {gamma, mu}}."""
+    (their R, E, epsilon): a :class:`~petsc_adhesion.fitting.results.ClosedForm` each."""
     R = bodies.R
 
     def mu(w):
         return tabor(R, w, bodies.E, bodies.epsilon)
 
-    out = {}
+    out = []
     for name, factor in (("dmt", 2.0), ("jkr", 1.5)):
         w = P / (factor * math.pi * R)
-        out[name] = {"gamma": w, "mu": mu(w), "formula": f"P / ({factor:g} pi R)"}
+        out.append(ClosedForm(name, w, mu(w), f"P / ({factor:g} pi R)"))
     w = maugis_dugdale_gamma(P, R, bodies.E, bodies.epsilon)
-    out["maugis_dugdale"] = {"gamma": w, "mu": mu(w), "lambda_MD": 1.157 * mu(w),
-                             "formula": "P = 2 pi R w |F_MD(1.157 mu(w))|"}
-    return out
+    out.append(ClosedForm("maugis_dugdale", w, mu(w), "P = 2 pi R w |F_MD(1.157 mu(w))|", 1.157 * mu(w)))
+    return tuple(out)
 
 
 def maugis_dugdale_gamma(P: float, R: float, E: float, epsilon: float) -> float:
@@ -127,7 +97,7 @@ def maugis_dugdale_gamma(P: float, R: float, E: float, epsilon: float) -> float:
     return math.exp(brent.root(g, lo, hi, xtol=1e-12))
 
 
-def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = None, grid=None, solver=None,
+def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | None = None, grid=None, solver=None,
                  comm=None, rtol: float = 1e-7) -> PullOffFit:
     """The work of adhesion whose model pull-off is the measured ``P`` (N, its magnitude), with its bar (see
     the module for the equations).
@@ -145,8 +115,10 @@ def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = Non
     rtol
         The relative tolerance of w on the grid.
 
-    Raises :class:`PullOffFitError` (one line) for a P no w gives: P <= 0 or not finite, or a w whose mu
-    would leave [1e-12, 50].
+    Returns the :class:`~petsc_adhesion.fitting.results.PullOffFit`, its ``warnings`` saying where it does
+    not hold (mu at a bound of the model's range; w undetermined, Missing then).  Raises
+    :class:`PullOffFitError` (one line) for a P no w gives: P <= 0 or not finite, or a w whose mu would leave
+    [1e-12, 50].
     """
     t0 = time.perf_counter()
     if not (math.isfinite(P) and P > 0):
@@ -176,8 +148,8 @@ def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = Non
         if lnw not in cache:
             w = math.exp(lnw)
             e = model_pull_off(model_at(w), grid, solver, comm=comm)
-            cache[lnw] = abs(e.F.value)
-            history.append((w, mu_of(w), e.F.value))
+            cache[lnw] = abs(pull_off_values(e)[0])
+            history.append((w, mu_of(w), pull_off_values(e)[0]))
         return cache[lnw]
 
     def g(lnw: float) -> float:
@@ -192,7 +164,7 @@ def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = Non
     w = math.exp(lnw)
     # the best pull-off at the root (extrapolated over nested grids), its bar, and the slope of |F_p| in mu
     best = model_pull_off(model_at(w), grid, solver, error_bars=True, comm=comm)
-    Fg = best.F.grid if best.F.grid is not None else best.F.value
+    F_best, F_err, Fg = pull_off_values(best)
     up = min(lnw + _DLOGW, math.log(hi_w))
     down = max(lnw - _DLOGW, math.log(lo_w))
     slope_w = 1.0 + (math.log(pull(up)) - math.log(pull(down))) / (up - down)     # d ln(w |F_p|) / d ln w
@@ -200,14 +172,34 @@ def fit_pull_off(P: float, bodies, P_err: float = 0.0, model: Model | None = Non
     if slope_w <= 0:
         raise PullOffFitError(f"P = {P:.4g} N: the model's pull-off falls faster than 1/w about w = {w:.4g} J/m^2 "
                               f"(mu = {mu_of(w):.3g}): the pull-off does not determine w there")
-    lnw -= math.log(abs(best.F.value) / abs(Fg)) / slope_w       # one Newton step onto the best pull-off
+    lnw -= math.log(abs(F_best) / abs(Fg)) / slope_w       # one Newton step onto the best pull-off
     w = math.exp(lnw)
-    F_err = best.F.err or 0.0
-    rel = math.hypot(F_err / abs(best.F.value), P_err / P) / slope_w
-    return PullOffFit(P=P, P_err=P_err, gamma=w, gamma_err=w * rel, mu=mu_of(w), sigma=sigma, F=best.F.value, F_err=F_err,
-                      F_grid=Fg, dlnF_dlnmu=dlnF_dlnmu, closed_forms=closed_forms(P, bodies), curves=len(cache) + 1,
+    gamma, warned = _verdict(w, F_best, F_err, P, P_err, slope_w, mu_of(w))
+    return PullOffFit(P=Measured(P, P_err), gamma=gamma, mu=mu_of(w), sigma=sigma,
+                      F=Measured(F_best, F_err, Fg, None if F_err is not None else "no bar: the grids did not nest"),
+                      dlnF_dlnmu=dlnF_dlnmu, closed_forms=closed_forms(P, bodies), curves=len(cache) + 1,
                       wall_time_s=time.perf_counter() - t0, bodies=replace(bodies, gamma=w, hamaker=None),
-                      history=history)
+                      history=tuple(history), warnings=tuple(warned))
+
+
+def _verdict(w: float, F: float, F_err: float | None, P: float, P_err: float, slope_w: float,
+             mu: float) -> tuple:
+    """(gamma: Measured, or Missing where mu is at a bound of the model's range or w undetermined; the
+    warnings that say so).  The bar: sqrt((F_err / F)^2 + (P_err / P)^2) / slope_w relative."""
+    rel = math.hypot((F_err or 0.0) / abs(F), P_err / P) / slope_w
+    err = w * rel if (F_err is not None or P_err > 0) else None
+    lo, hi = (math.log(m) for m in MU_RANGE)
+    if math.log(mu) - lo <= BOUND_MARGIN or hi - math.log(mu) <= BOUND_MARGIN:
+        edge = MU_RANGE[0] if math.log(mu) - lo <= BOUND_MARGIN else MU_RANGE[1]
+        why = (f"mu = {mu:.4g} is at the bound {edge:g} of the model's range [{MU_RANGE[0]:g}, {MU_RANGE[1]:g}]: "
+               f"the pull-off asks for a mu the model does not reach")
+    elif err is None:
+        return Measured(w, None, note="no bar: neither the pull-off's nor the measurement's"), []
+    else:
+        why = undetermined(w, err)
+    if why is None:
+        return Measured(w, err), []
+    return Missing(why), [f"gamma undetermined: {why}"]
 
 
 def _solve(g, x0: float, lo: float, hi: float, rtol: float, P: float, mu_of) -> float:

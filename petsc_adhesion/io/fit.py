@@ -1,19 +1,24 @@
 """A fit's result files and console lines (docs/output.md, docs/fitting.md): the ``fit`` of the JSON summary
 and the HDF5 group of the same name, the CSV of a fitted curve, the report.
 
-The fit's summary is the library's (:attr:`~petsc_adhesion.fitting.pull_off.PullOffFit.summary`,
-:attr:`~petsc_adhesion.fitting.curve_fit.CurveFit.summary`); a curve's data and the fitted
-model's force at its points go into the HDF5 file's ``fit/data`` and the CSV.
+The only place a fit's typed result (:class:`~petsc_adhesion.fitting.results.CurveFit`,
+:class:`~petsc_adhesion.fitting.results.PullOffFit`) becomes keys: :func:`fit_record` reads its
+attributes into the ``fit`` object (a Measured's value and bar as ``x`` and ``x_err``, a Missing as
+null with its reason under ``missing``), :func:`fit_summary` and :func:`fit_tree` put it into the JSON and
+the HDF5 file (the covariance as a matrix, the data and the fitted model's curve as datasets),
+:func:`write_fit_csv` writes a fitted curve's points and :func:`report_fit` the console lines.
 """
 from __future__ import annotations
 
 import csv
+import math
 
 import numpy as np
 
 from ..errors import tell
+from ..tracing.measured import Measured, Missing
 
-__all__ = ["fit_tree", "fit_summary", "write_fit_csv", "report_fit", "DESCRIBE_FIT"]
+__all__ = ["fit_record", "fit_tree", "fit_summary", "write_fit_csv", "report_fit", "DESCRIBE_FIT"]
 
 #: Units and descriptions of the HDF5 groups of a fit (io.write describes every group with them).
 DESCRIBE_FIT = {
@@ -35,34 +40,105 @@ DESCRIBE_FIT = {
     "fit/fixed": ("E_star: Pa", "parameters held at a given value (-fit_modulus false)"),
     "fit/given": ("*_m: m; spring_N_m: N/m; E_star_start: Pa", "the given constants: tip radius, epsilon, spring "
                   "constant (and where it came from), the modulus the fit started from"),
+    "fit/missing": ("", "the quantities the fit did not determine (null above), each with its reason: at a bound "
+                    "of the model's range, or undetermined (docs/fitting.md)"),
     "fit/data": ("z: m; F, F_fit: N", "the measured curve and the fit at its points: piezo displacement z, force F "
                  "(tensile negative), leg (0 approach, 1 retract), F_fit, used (0: left out, next to a jump)"),
     "fit/model": ("z: m; F_*: N", "the fitted model's force on an even grid of z on the approach and the retract"),
 }
 
 
-def fit_summary(head: dict, options: dict, fit_summary_: dict) -> dict:
+def _value(q) -> float | None:
+    return float(q.value) if isinstance(q, Measured) else None
+
+
+def _err(q) -> float | None:
+    return None if not isinstance(q, Measured) or q.err is None else float(q.err)
+
+
+def _finite(x) -> float | None:
+    return float(x) if x is not None and math.isfinite(x) else None
+
+
+def _missing(**quantities) -> dict:
+    return {k: q.reason for k, q in quantities.items() if isinstance(q, Missing)}
+
+
+def _verdict(fit) -> dict:
+    return {"complete": fit.complete, "trustworthy": fit.trustworthy, "warnings": list(fit.warnings)}
+
+
+def _curve_record(fit) -> dict:
+    d, m, f = fit.data, fit.measured, fit.fitted
+    given = {"radius_m": fit.bodies.R, "epsilon_m": fit.bodies.epsilon, "spring_N_m": fit.spring.k,
+             "file": d.path, "format": d.source, "spring_from": fit.spring.source}
+    if fit.choice.modulus and fit.bodies.young1 is not None:
+        given["E_star_start"] = fit.bodies.E
+    if fit.noise_stated:
+        given["noise_N"] = fit.noise_N
+    return {"kind": "curve", "gamma": _value(fit.gamma), "gamma_err": _err(fit.gamma),
+            "E_star": _value(fit.E_star), "E_star_err": _err(fit.E_star),
+            "rms": _value(fit.rms), "rms_err": _err(fit.rms), "mu": fit.mu, "sigma": fit.sigma, "K": fit.K,
+            "offsets": {"z0_m": _value(fit.z0), "z0_err_m": _err(fit.z0), "F0_N": _value(fit.F0),
+                        "F0_err_N": _err(fit.F0)},
+            "chi2": fit.chi2, "dof": fit.dof, "reduced_chi2": _finite(fit.reduced_chi2),
+            "p_value": _finite(fit.p_value), "noise_N": fit.noise_N, "residual_rms_N": fit.residual_rms_N,
+            "n_points": int(d.z.size), "parameters": list(fit.parameters),
+            "covariance": [[_finite(c) for c in row] for row in np.asarray(fit.covariance, dtype=float)],
+            "measured": {"pull_off_N": m.pull_off_N, "pull_off_z_m": m.pull_off_z_m, "jump_in_z_m": m.jump_in_z_m,
+                         "jump_in_drop_N": m.jump_in_drop_N, "contact_N": m.contact_N, "F0_N": m.F0_N,
+                         "noise_N": m.noise_N},
+            "fitted": {k: v for k, v in (("jump_in_z_m", f.jump_in_z_m), ("pull_off_N", f.pull_off_N),
+                                         ("jump_off_z_m", f.jump_off_z_m)) if v is not None},
+            "fixed": {"E_star": fit.E_star.value} if not fit.choice.modulus else {},
+            "given": given, "traces": fit.traces, "iterations": fit.iterations, "status": fit.status,
+            "wall_time_s": fit.wall_time_s, "notes": list(fit.notes),
+            "missing": _missing(gamma=fit.gamma, E_star=fit.E_star, rms=fit.rms, z0=fit.z0, F0=fit.F0),
+            **_verdict(fit)}
+
+
+def _pull_off_record(fit) -> dict:
+    forms = {}
+    for c in fit.closed_forms:
+        forms[c.name] = {"gamma": c.gamma, "mu": c.mu, **({"lambda_MD": c.lambda_MD} if c.lambda_MD else {}),
+                         "formula": c.formula}
+    return {"kind": "pull_off", "P_N": fit.P.value, "P_err_N": fit.P.err, "gamma": _value(fit.gamma),
+            "gamma_err": _err(fit.gamma), "mu": fit.mu, "sigma": fit.sigma, "F_pull_off": fit.F.value,
+            "F_pull_off_err": fit.F.err, "F_pull_off_grid": fit.F.grid, "dlnF_dlnmu": fit.dlnF_dlnmu,
+            "closed_forms": forms, "curves_traced": fit.curves, "wall_time_s": fit.wall_time_s,
+            "iterations": [{"gamma": g, "mu": m, "F_grid": f} for g, m, f in fit.history],
+            "missing": _missing(gamma=fit.gamma), **_verdict(fit)}
+
+
+def fit_record(fit) -> dict:
+    """The ``fit`` object of a ``-summary`` file (docs/fitting.md) read off a CurveFit or a PullOffFit."""
+    return _pull_off_record(fit) if hasattr(fit, "closed_forms") else _curve_record(fit)
+
+
+def fit_summary(head: dict, options: dict, fit) -> dict:
     """The JSON summary of a fit: the program, the options as given, the fit."""
-    return {**head, "kind": "fit", "options": options, "fit": fit_summary_}
+    return {**head, "kind": "fit", "options": options, "fit": fit_record(fit)}
 
 
-def fit_tree(head: dict, options: dict, fit_summary_: dict, data: dict | None = None,
-             model: dict | None = None) -> dict:
-    """The HDF5 tree of a fit: its summary, the covariance as a matrix, the data and the model's curve."""
-    fit = dict(fit_summary_)
-    if "covariance" in fit:
-        fit["covariance"] = np.asarray(fit["covariance"], dtype=float)
-    fit.pop("notes", None)
-    fit["notes"] = list(fit_summary_.get("notes", ())) or ""
-    if data is not None:
-        fit["data"] = {k: np.asarray(v) for k, v in data.items()}
+def fit_tree(head: dict, options: dict, fit, model: dict | None = None) -> dict:
+    """The HDF5 tree of a fit: its record, the covariance as a matrix, a curve's data and fit at its points,
+    and ``model`` (the fitted model's force on an even grid, from the caller) where given."""
+    rec = fit_record(fit)
+    if "covariance" in rec:
+        rec["covariance"] = np.asarray(fit.covariance, dtype=float)
+    for key in ("notes", "warnings"):
+        rec[key] = list(rec[key]) if rec.get(key) else ""
+    if not hasattr(fit, "closed_forms"):
+        rec["data"] = {"z": np.asarray(fit.data.z), "F": np.asarray(fit.data.F), "leg": np.asarray(fit.leg),
+                       "F_fit": np.asarray(fit.F_fit), "used": np.asarray(fit.used).astype(int)}
     if model is not None:
-        fit["model"] = {k: np.asarray(v) for k, v in model.items()}
-    return {**head, "kind": "fit", "options": options, "fit": fit}
+        rec["model"] = {k: np.asarray(v) for k, v in model.items()}
+    return {**head, "kind": "fit", "options": options, "fit": rec}
 
 
 def write_fit_csv(path: str, data: dict) -> None:
-    """A row per measured point: z (m), F (N), leg (0 approach, 1 retract), F_fit (N), used (0/1)."""
+    """A row per measured point: z (m), F (N), leg (0 approach, 1 retract), F_fit (N), used (0/1), from the
+    ``data`` group of :func:`fit_tree`."""
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["z_m", "F_N", "leg", "F_fit_N", "used"])
@@ -74,35 +150,48 @@ def _pct(x: float, ref: float) -> str:
     return f"{100 * (x / ref - 1):+.1f}%"
 
 
-def report_fit(s: dict) -> None:
-    """The console lines of a fit's summary (rank 0)."""
+def _pm(q, scale: float, unit: str, digits: str = ".6g") -> str:
+    """``value +- bar unit`` of a Measured in ``unit`` (``scale`` SI per unit); its note where it has no bar;
+    ``undetermined`` for a Missing."""
+    if isinstance(q, Missing):
+        return "undetermined"
+    if q.err is not None:
+        return f"{q.value / scale:{digits}} +- {q.err / scale:.2g} {unit}"
+    return f"{q.value / scale:{digits}} {unit}" + (f" ({q.note})" if q.note else "")
+
+
+def report_fit(fit) -> None:
+    """The console lines of a fit (rank 0): its numbers, its notes, and a WARNING line for each reason it does
+    not hold."""
     out = []
-    if s["kind"] == "pull_off":
-        err = f" +- {s['P_err_N'] * 1e9:.3g}" if s["P_err_N"] else ""
-        out.append(f"fit of the pull-off P = {s['P_N'] * 1e9:.6g}{err} nN: {s['curves_traced']} curves traced, "
-                   f"{s['wall_time_s']:.3g} s")
-        out.append(f"  gamma = {s['gamma']:.6g} +- {s['gamma_err']:.2g} J/m^2   mu = {s['mu']:.6g}   sigma = "
-                   f"{s['sigma']:g}   model pull-off F = {s['F_pull_off']:.8f} +- {s['F_pull_off_err']:.1e} "
-                   f"(2 pi R gamma)")
+    if hasattr(fit, "closed_forms"):
+        P = fit.P
+        err = f" +- {P.err * 1e9:.3g}" if P.err else ""
+        out.append(f"fit of the pull-off P = {P.value * 1e9:.6g}{err} nN: {fit.curves} curves traced, "
+                   f"{fit.wall_time_s:.3g} s")
+        F_err = f"{fit.F.err:.1e}" if fit.F.err is not None else "(no bar)"
+        out.append(f"  gamma = {_pm(fit.gamma, 1.0, 'J/m^2')}   mu = {fit.mu:.6g}   sigma = {fit.sigma:g}   "
+                   f"model pull-off F = {fit.F.value:.8f} +- {F_err} (2 pi R gamma)")
         names = {"jkr": "JKR", "dmt": "DMT", "maugis_dugdale": "Maugis-Dugdale"}
         for key, name in names.items():
-            c = s["closed_forms"][key]
-            out.append(f"  {name:<15} would say gamma = {c['gamma']:.6g} J/m^2 ({_pct(c['gamma'], s['gamma'])} "
-                       f"from ours; {c['formula']})")
+            c = fit.closed_form(key)
+            ours = f"{_pct(c.gamma, fit.gamma.value)} from ours; " if isinstance(fit.gamma, Measured) else ""
+            out.append(f"  {name:<15} would say gamma = {c.gamma:.6g} J/m^2 ({ours}{c.formula})")
     else:
-        out.append(f"fit of the curve {s['given'].get('file', '')}: {s['n_points']} points, {s['traces']} curves "
-                   f"traced, {s['iterations']} evaluations, {s['wall_time_s']:.3g} s ({s['status']})")
-        out.append(f"  gamma = {s['gamma']:.6g} +- {s['gamma_err']:.2g} J/m^2   E* = {s['E_star'] / 1e9:.6g} +- "
-                   f"{s['E_star_err'] / 1e9:.2g} GPa   mu = {s['mu']:.4g}   K = {s['K']:.4g}")
-        if s.get("rms") is not None:
-            bar = f" +- {s['rms_err'] * 1e9:.2g}" if s.get("rms_err") else " (held)"
-            out.append(f"  rms = {s['rms'] * 1e9:.4g}{bar} nm   sigma = {s['sigma']:.4g}")
-        o = s["offsets"]
-        out.append(f"  contact point z0 = {o['z0_m'] * 1e9:.6g} +- {o['z0_err_m'] * 1e9:.2g} nm   baseline F0 = "
-                   f"{o['F0_N'] * 1e9:.5g} +- {o['F0_err_N'] * 1e9:.2g} nN")
-        out.append(f"  noise {s['noise_N'] * 1e9:.3g} nN, residual rms {s['residual_rms_N'] * 1e9:.3g} nN, reduced "
-                   f"chi^2 {s['reduced_chi2']:.3g} ({s['dof']} degrees of freedom); pull-off measured "
-                   f"{s['measured']['pull_off_N'] * 1e9:.4g} nN, fitted {s['fitted']['pull_off_N'] * 1e9:.4g} nN")
-    for n in s.get("notes", ()):
+        m, f = fit.measured, fit.fitted
+        out.append(f"fit of the curve {fit.data.path or ''}: {fit.data.z.size} points, {fit.traces} curves "
+                   f"traced, {fit.iterations} evaluations, {fit.wall_time_s:.3g} s ({fit.status})")
+        out.append(f"  gamma = {_pm(fit.gamma, 1.0, 'J/m^2')}   E* = {_pm(fit.E_star, 1e9, 'GPa')}   "
+                   f"mu = {fit.mu:.4g}   K = {fit.K:.4g}")
+        if fit.rms is not None:
+            out.append(f"  rms = {_pm(fit.rms, 1e-9, 'nm', '.4g')}   sigma = {fit.sigma:.4g}")
+        out.append(f"  contact point z0 = {_pm(fit.z0, 1e-9, 'nm')}   baseline F0 = {_pm(fit.F0, 1e-9, 'nN', '.5g')}")
+        red = f"{fit.reduced_chi2:.3g}" if math.isfinite(fit.reduced_chi2) else "undefined"
+        out.append(f"  noise {fit.noise_N * 1e9:.3g} nN{' (stated)' if fit.noise_stated else ''}, residual rms "
+                   f"{fit.residual_rms_N * 1e9:.3g} nN, reduced chi^2 {red} ({fit.dof} degrees of freedom); "
+                   f"pull-off measured {m.pull_off_N * 1e9:.4g} nN, fitted {f.pull_off_N * 1e9:.4g} nN")
+    for n in getattr(fit, "notes", ()):
         out.append(f"  note: {n}")
+    for w in fit.warnings:
+        out.append(f"  WARNING: {w}")
     tell("\n".join(out))

@@ -31,11 +31,12 @@ UNITS = {"nN": 1e-9, "nm": 1e-9, "MPa": 1e6, "aJ": 1e-18}
 class Bodies:
     """A sphere (or two) on a flat, in SI: radii (m), Young's moduli (Pa), Poisson's ratios, the work of
     adhesion gamma (J/m^2) or a Hamaker constant (J) with its cut-off (m), the equilibrium spacing
-    epsilon (m) and the rms roughness (m) of the combined surfaces."""
+    epsilon (m) and the rms roughness (m) of the combined surfaces.  A fit of a force curve may leave the
+    moduli None (not given: it finds E*); then ``E`` and ``mu`` are not defined."""
 
     radius: float
-    young1: float
-    poisson1: float
+    young1: float | None
+    poisson1: float | None
     epsilon: float
     gamma: float | None = None
     hamaker: float | None = None

@@ -23,6 +23,19 @@ def read_fit(source) -> dict:
         return out
 
 
+def _pm(fit: dict, key: str, scale: float) -> str:
+    """``value +- bar`` of ``key`` in units of ``scale``: "undetermined" where the fit has no value (null in
+    JSON, an empty string in HDF5), the value alone where it has no bar (held)."""
+    def number(k):
+        v = fit.get(k)
+        return None if v is None or isinstance(v, (str, bytes)) else float(v)
+
+    v, e = number(key), number(f"{key}_err")
+    if v is None:
+        return "undetermined"
+    return f"{v / scale:.4g}" + (f" +- {e / scale:.2g}" if e is not None else " (held)")
+
+
 def fit_figure(source, out: str, fmt: str = "png") -> None:
     """Force (nN) against the piezo displacement (nm) of a fitted curve: approach and retract measured, the
     fitted model as lines, the points left out of the fit hollow; below, the residuals in units of the
@@ -47,8 +60,7 @@ def fit_figure(source, out: str, fmt: str = "png") -> None:
             ax.plot(m["z"] * 1e9, m[f"F_{name}"] * 1e9, "-", lw=1.5, color="k" if k else "0.4",
                     label=f"{name}, fitted model")
         rx.plot(z[sel & used], (d["F_fit"][sel & used] * 1e9 - F[sel & used]) / noise, ".", ms=2, color=colour)
-    g, ge, E, Ee = (float(fit[k]) for k in ("gamma", "gamma_err", "E_star", "E_star_err"))
-    ax.set_title(f"gamma = {g:.4g} +- {ge:.2g} J/m^2, E* = {E / 1e9:.4g} +- {Ee / 1e9:.2g} GPa, "
+    ax.set_title(f"gamma = {_pm(fit, 'gamma', 1.0)} J/m^2, E* = {_pm(fit, 'E_star', 1e9)} GPa, "
                  f"mu = {float(fit['mu']):.3g}", fontsize=10)
     ax.set_ylabel("force (nN)")
     rx.axhline(0.0, color="0.5", lw=0.8)
