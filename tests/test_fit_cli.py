@@ -115,7 +115,8 @@ def test_two_equal_columns_are_refused(tmp_path):
     """A file whose force column is its displacement column: no force-distance relation, one line naming the
     option, exit 2, nothing written (run from the checkout, as every test that needs today's library)."""
     ramp = np.r_[np.linspace(0, 50, 60), np.linspace(50, 0, 60)]
-    (tmp_path / "equal.csv").write_text("\n".join(f"{v:.6g}, {v:.6g}" for v in ramp))
+    # in units an AFM measures (nm and nN), so that the units' plausibility passes and the relation is judged
+    (tmp_path / "equal.csv").write_text("z (nm), F (nN)\n" + "\n".join(f"{v:.6g}, {v:.6g}" for v in ramp))
     out = tmp_path / "out"
     out.mkdir()
     p = run_cli("-fit_curve", tmp_path / "equal.csv", *TIP, "-phys_spring", "1", "-summary", out / "f.json",
