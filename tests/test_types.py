@@ -1,0 +1,107 @@
+"""The library type-checked by mypy, and the wheel without the benchmarks.
+
+mypy reads its settings from pyproject.toml ([tool.mypy]: the library petsc_adhesion/, the benchmarks
+excluded, check_untyped_defs); the problems and pressure laws are checked against the protocols of
+core/protocol.py wherever a function takes one.  ./run installs mypy; without it the check skips.
+The benchmarks stay in the checkout (./run bench, ./run figures) and out of the wheel: the wheel built
+from pyproject.toml's settings holds every module of the library and none of the benchmarks.
+"""
+import glob
+import importlib.util
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zipfile
+
+import pytest
+
+from conftest import ROOT
+
+PACKAGE = os.path.join(ROOT, "petsc_adhesion")
+BENCHMARKS = os.path.join(PACKAGE, "benchmarks")
+
+
+def _library_modules() -> set:
+    """Paths (relative to the checkout, '/'-separated) of the library's modules: every .py file of the
+    package outside the benchmarks."""
+    out = set()
+    for d, dirs, files in os.walk(PACKAGE):
+        dirs[:] = [x for x in dirs if x != "__pycache__" and os.path.join(d, x) != BENCHMARKS]
+        out |= {os.path.relpath(os.path.join(d, f), ROOT).replace(os.sep, "/") for f in files if f.endswith(".py")}
+    return out
+
+
+def _mypy(*args, cwd=ROOT):
+    if importlib.util.find_spec("mypy") is None:
+        pytest.skip("mypy is not installed in this Python (./run setup installs it)")
+    # no cache: the check reads only the checkout and writes nothing into it
+    cmd = [sys.executable, "-m", "mypy", "--config-file", os.path.join(ROOT, "pyproject.toml"),
+           "--cache-dir", os.devnull, *args]
+    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=600)
+
+
+def test_library_has_no_type_errors():
+    """mypy over the library as pyproject.toml configures it: no errors, and every library module checked."""
+    r = _mypy()
+    assert r.returncode == 0, "mypy found errors:\n" + r.stdout + r.stderr
+    m = re.search(r"Success: no issues found in (\d+) source files", r.stdout)
+    assert m, r.stdout + r.stderr
+    # the check reached the whole library, no more (the benchmarks excluded), no less
+    assert int(m.group(1)) == len(_library_modules())
+
+
+BAD_LAW = '''
+import numpy as np
+from petsc_adhesion.discretization.resolution import attraction_range
+
+
+class NoWall:
+    """A law without its wall."""
+    rule, n, sigma, smooth = "none", 1, 0.0, True
+
+    def __call__(self, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return H, H
+
+    def error(self, H: np.ndarray) -> np.ndarray:
+        return H
+
+    def describe(self) -> dict:
+        return {}
+
+
+attraction_range(NoWall())
+'''
+
+
+def test_law_without_wall_is_refused(tmp_path):
+    """The pressure-law protocol is checked where a law is taken: a law lacking its wall is a type error
+    (the library itself passes, test above)."""
+    bad = tmp_path / "bad_law.py"
+    bad.write_text(BAD_LAW)
+    r = _mypy(str(bad), cwd=tmp_path)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert re.search(r'bad_law\.py:\d+: error: Argument 1 to "attraction_range" has incompatible type "NoWall"',
+                     r.stdout), r.stdout
+    assert '"wall"' in r.stdout, r.stdout
+
+
+def test_wheel_leaves_out_the_benchmarks(tmp_path):
+    """The wheel built with pyproject.toml's settings: every library module and the options' table, no benchmark."""
+    src = tmp_path / "src"
+    src.mkdir()
+    for f in ("pyproject.toml", "README.md"):
+        shutil.copy(os.path.join(ROOT, f), src / f)
+    # a copy, so that the build's egg-info and build/ land outside the checkout
+    shutil.copytree(PACKAGE, src / "petsc_adhesion", ignore=shutil.ignore_patterns("__pycache__"))
+    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation",
+                        "--no-index", "-w", str(tmp_path / "dist"), str(src)],
+                       capture_output=True, text=True, timeout=300, env=dict(os.environ, PYTHONWARNINGS="ignore"))
+    assert r.returncode == 0, r.stdout + r.stderr
+    wheels = glob.glob(str(tmp_path / "dist" / "petsc_adhesion-*.whl"))
+    assert len(wheels) == 1, wheels
+    names = set(zipfile.ZipFile(wheels[0]).namelist())
+    assert not [n for n in names if n.startswith("petsc_adhesion/benchmarks")]
+    assert {n for n in names if n.endswith(".py")} == _library_modules()
+    assert "petsc_adhesion/app/options/petsc_options.txt" in names
