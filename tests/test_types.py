@@ -33,18 +33,25 @@ def _library_modules() -> set:
     return out
 
 
-def _mypy(*args, cwd=ROOT):
+@pytest.fixture(scope="module")
+def mypy(tmp_path_factory):
+    """Run mypy with pyproject.toml's settings from the checkout; its cache outside the checkout, shared by
+    this module's runs."""
     if importlib.util.find_spec("mypy") is None:
         pytest.skip("mypy is not installed in this Python (./run setup installs it)")
-    # no cache: the check reads only the checkout and writes nothing into it
-    cmd = [sys.executable, "-m", "mypy", "--config-file", os.path.join(ROOT, "pyproject.toml"),
-           "--cache-dir", os.devnull, *args]
-    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=600)
+    cache = tmp_path_factory.mktemp("mypy_cache")
+
+    def run(*args):
+        cmd = [sys.executable, "-m", "mypy", "--config-file", os.path.join(ROOT, "pyproject.toml"),
+               "--cache-dir", str(cache), *args]
+        return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
+
+    return run
 
 
-def test_library_has_no_type_errors():
+def test_library_has_no_type_errors(mypy):
     """mypy over the library as pyproject.toml configures it: no errors, and every library module checked."""
-    r = _mypy()
+    r = mypy()
     assert r.returncode == 0, "mypy found errors:\n" + r.stdout + r.stderr
     m = re.search(r"Success: no issues found in (\d+) source files", r.stdout)
     assert m, r.stdout + r.stderr
@@ -52,39 +59,41 @@ def test_library_has_no_type_errors():
     assert int(m.group(1)) == len(_library_modules())
 
 
-BAD_LAW = '''
+LAW = '''
 import numpy as np
 from petsc_adhesion.discretization.resolution import attraction_range
 
 
-class NoWall:
-    """A law without its wall."""
+class Law:
+    """A smooth law by its members: eq. (5) at the gap H + 1."""
     rule, n, sigma, smooth = "none", 1, 0.0, True
-
+{wall}
     def __call__(self, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return H, H
+        g = H + 1.0
+        return g ** -9 - g ** -3, 3 * g ** -4 - 9 * g ** -10
 
     def error(self, H: np.ndarray) -> np.ndarray:
-        return H
+        return np.zeros_like(H)
 
     def describe(self) -> dict:
-        return {}
+        return {{}}
 
 
-attraction_range(NoWall())
+attraction_range(Law())
 '''
 
 
-def test_law_without_wall_is_refused(tmp_path):
-    """The pressure-law protocol is checked where a law is taken: a law lacking its wall is a type error
-    (the library itself passes, test above)."""
-    bad = tmp_path / "bad_law.py"
-    bad.write_text(BAD_LAW)
-    r = _mypy(str(bad), cwd=tmp_path)
+def test_law_without_wall_is_refused(mypy, tmp_path):
+    """The pressure-law protocol is checked where a law is taken: a law lacking its wall is a type error, the
+    same law with it is not."""
+    (tmp_path / "with_wall.py").write_text(LAW.format(wall="    wall = -1.0\n"))
+    (tmp_path / "without_wall.py").write_text(LAW.format(wall=""))
+    r = mypy(str(tmp_path / "with_wall.py"), str(tmp_path / "without_wall.py"))
     assert r.returncode == 1, r.stdout + r.stderr
-    assert re.search(r'bad_law\.py:\d+: error: Argument 1 to "attraction_range" has incompatible type "NoWall"',
-                     r.stdout), r.stdout
-    assert '"wall"' in r.stdout, r.stdout
+    assert "with_wall.py" not in r.stdout, r.stdout
+    assert re.search(r'without_wall\.py:\d+: error: Argument 1 to "attraction_range" has incompatible type "Law"; '
+                     r'expected "PressureLaw".*\n.*without_wall\.py:\d+: note: "Law" is missing following "PressureLaw" '
+                     r'protocol member:\n.*without_wall\.py:\d+: note: +wall\n', r.stdout), r.stdout
 
 
 def test_wheel_leaves_out_the_benchmarks(tmp_path):

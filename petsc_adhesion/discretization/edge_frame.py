@@ -25,6 +25,7 @@ from petsc4py import PETSc
 
 from .. import brent
 from ..core.bordered import Border
+from ..core.protocol import PressureLaw
 from ..model.pressure import pressure_law
 from ..model.reference.rigid import load_beyond, load_beyond_rates
 from .grid import l2_weights, load_weights
@@ -40,7 +41,7 @@ SMOOTH_LEVEL = 0.5
 SMOOTH_PEAK = 3.0 ** (1.0 / 6.0) - 1.0
 
 
-def peak_attraction(law) -> float:
+def peak_attraction(law: PressureLaw) -> float:
     """The H at which the law attracts most (P most negative), above its wall.
 
     A rough average spreads the attraction over the heights, and the peak can lie
@@ -57,7 +58,7 @@ def peak_attraction(law) -> float:
     return float(brent.minimum(lambda h: float(law(np.array([h]))[0][0]), lo, hi, xatol=1e-10))
 
 
-def edge_level(law) -> float:
+def edge_level(law: PressureLaw) -> float:
     """H at the pinned contact edge: as far beyond the law's peak attraction as a smooth surface's
     SMOOTH_LEVEL is beyond its own, so inside the cohesive zone whatever the roughness."""
     return SMOOTH_LEVEL if law.smooth else peak_attraction(law) + (SMOOTH_LEVEL - SMOOTH_PEAK)

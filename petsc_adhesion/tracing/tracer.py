@@ -35,6 +35,7 @@ from mpi4py import MPI
 from .. import brent
 from ..core.continuation import Continuation, Settings
 from ..core.events import EVENT_TOL, EventFinder
+from ..core.protocol import TracedProblem
 from ..discretization import grid
 from ..discretization.edge_frame import EdgeFrameProblem, edge_level
 from ..discretization.influence import create_influence
@@ -119,7 +120,7 @@ class Segment:
 
     kind: str             # "fixed", "edge" or "scaled"
     grid: object          # the EdgeGrid (None for a fixed grid)
-    problem: object
+    problem: TracedProblem
     cont: Continuation
     finder: EventFinder
     far: bool = False     # the far branch traced back from the start (Tracer.extend_back)
