@@ -83,14 +83,43 @@ attraction_range(Law())
 '''
 
 
-def test_law_without_wall_is_refused(mypy, tmp_path):
-    """The pressure-law protocol is checked where a law is taken: a law lacking its wall is a type error, the
-    same law with it is not."""
+#: Each class of the library as the protocol it implements: mypy compares their members' types.
+CONFORMS = '''
+from petsc_adhesion.core.fold import FoldSystem
+from petsc_adhesion.core.protocol import ContinuationProblem, FoldBase, PressureLaw, TracedProblem
+from petsc_adhesion.discretization.edge_frame import EdgeFrameProblem
+from petsc_adhesion.discretization.problem import Problem
+from petsc_adhesion.model import pressure
+
+
+def physical(p: Problem) -> tuple[TracedProblem, FoldBase]:
+    return p, p
+
+
+def edge(p: EdgeFrameProblem) -> TracedProblem:
+    return p
+
+
+def fold(f: FoldSystem[Problem]) -> ContinuationProblem:
+    return f
+
+
+def laws(a: pressure.PressureLaw, b: pressure.WallLaw, c: pressure.HistogramLaw) -> list[PressureLaw]:
+    return [a, b, c]
+'''
+
+
+def test_the_classes_conform_to_their_protocols_and_a_law_without_wall_does_not(mypy, tmp_path):
+    """The problems (physical frame, frame of the edge, fold system) and the pressure laws conform to the
+    protocols of core/protocol.py in their members' types, not only their names (which tests/test_protocol.py
+    checks at run time); a law lacking its wall is a type error where a law is taken, the same law with it
+    is not."""
+    (tmp_path / "conforms.py").write_text(CONFORMS)
     (tmp_path / "with_wall.py").write_text(LAW.format(wall="    wall = -1.0\n"))
     (tmp_path / "without_wall.py").write_text(LAW.format(wall=""))
-    r = mypy(str(tmp_path / "with_wall.py"), str(tmp_path / "without_wall.py"))
+    r = mypy(*(str(tmp_path / f) for f in ("conforms.py", "with_wall.py", "without_wall.py")))
     assert r.returncode == 1, r.stdout + r.stderr
-    assert "with_wall.py" not in r.stdout, r.stdout
+    assert "conforms.py" not in r.stdout and "with_wall.py" not in r.stdout.replace("without_wall.py", ""), r.stdout
     assert re.search(r'without_wall\.py:\d+: error: Argument 1 to "attraction_range" has incompatible type "Law"; '
                      r'expected "PressureLaw".*\n.*without_wall\.py:\d+: note: "Law" is missing following "PressureLaw" '
                      r'protocol member:\n.*without_wall\.py:\d+: note: +wall\n', r.stdout), r.stdout

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
-from typing import TYPE_CHECKING, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -96,8 +96,9 @@ class TracedProblem(ContinuationProblem, Protocol):
     the frame of the edge); these members give its physical meaning.
     """
 
-    #: the model (mu, sigma, roughness, r_m) the problem discretizes
-    model: object
+    #: the model (mu, sigma, roughness, r_m) the problem discretizes: a Model of model/parameters.py,
+    #: which the core does not import (Any: object would refuse every use of it, and a problem's own type)
+    model: Any
 
     @property
     def law(self) -> PressureLaw:
@@ -106,8 +107,9 @@ class TracedProblem(ContinuationProblem, Protocol):
     #: the nodal rows [lo, hi) this rank owns
     lo: int
     hi: int
-    #: rows of the nodal part on this rank, of all ranks, and whether this is the last rank
-    layout: object
+    #: rows of the nodal part on this rank, of all ranks, and whether this is the last rank (a Layout of
+    #: discretization/preconditioning.py, which the core does not import)
+    layout: Any
     #: Newton steps the domain guard shortened so far
     guarded: int
 
