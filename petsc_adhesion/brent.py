@@ -84,7 +84,8 @@ def minimum(f, a: float, b: float, xatol: float = 1e-5, maxiter: int = 500) -> f
         raise ValueError("Optimization bounds must be finite scalars.")
     if a > b:
         raise ValueError("The lower bound exceeds the upper bound.")
-    a, b = np.float64(a), np.float64(b)
+    # numpy floats from here on, as scipy's (a subclass of float, which numpy 1's stubs do not say)
+    a, b = np.float64(a), np.float64(b)  # type: ignore[assignment]
     sqrt_eps = math.sqrt(2.2e-16)
     golden_mean = 0.5 * (3.0 - math.sqrt(5.0))
     fulc = a + golden_mean * (b - a)

@@ -12,11 +12,13 @@ from petsc4py import PETSc
 
 from conftest import make_problem
 from petsc_adhesion.core.fold import FoldSystem
-from petsc_adhesion.core.protocol import ContinuationProblem, FoldBase, TracedProblem
+from petsc_adhesion.core.protocol import ContinuationProblem, FoldBase, PressureLaw, TracedProblem
 from petsc_adhesion.discretization import grid, preconditioning
 from petsc_adhesion.discretization.edge_frame import EdgeFrameProblem
 from petsc_adhesion.discretization.influence import create_influence
+from petsc_adhesion.model import pressure
 from petsc_adhesion.model.parameters import Model
+from petsc_adhesion.model.roughness import Measured, TruncatedGaussian, Weibull
 from petsc_adhesion.tracing.critical import fold_system
 
 
@@ -59,6 +61,30 @@ def _check_jacobian(pb, x, p, bound):
 def _contact_state(pb, r, gap):
     """A state with a repulsive centre (flat near the wall) and attraction around it."""
     return np.maximum(0.5 * r**2 - 1.0, pb.law.wall + gap)
+
+
+# -- the pressure laws ----------------------------------------------------------------------------------
+LAWS = {"smooth": lambda: pressure.PressureLaw(0.0), "hermite": lambda: pressure.PressureLaw(0.2, "hermite", 16),
+        "truncated_gaussian": lambda: pressure.WallLaw(TruncatedGaussian(0.2, 3.0)),
+        "weibull": lambda: pressure.WallLaw(Weibull(0.2, -1.0)),
+        "measured": lambda: pressure.HistogramLaw(Measured(0.2 * np.sin(np.arange(1.0, 2001.0))))}
+
+
+@pytest.mark.parametrize("kind", LAWS)
+def test_every_pressure_law_keeps_the_protocol(kind):
+    """Each law is a PressureLaw: (P, dP/dH) of H's shape above its wall, FloatingPointError at it,
+    dP/dH the derivative of P (central differences, step 1e-5: error ~1e-9 relative), error(H) >= 0 of H's
+    shape, and nothing to describe exactly when smooth.  (mypy checks the members' types, tests/test_types.py.)"""
+    law = LAWS[kind]()
+    assert isinstance(law, PressureLaw)
+    assert law.smooth == (kind == "smooth") and law.n >= 1 and (law.describe() == {}) == law.smooth
+    H = law.wall + np.array([0.3, 0.8, 1.5, 4.0])
+    P, dP = law(H)
+    assert P.shape == dP.shape == law.error(H).shape == H.shape and np.all(law.error(H) >= 0)
+    h = 1e-5
+    assert np.allclose(dP, (law(H + h)[0] - law(H - h)[0]) / (2 * h), rtol=1e-6, atol=1e-9)
+    with pytest.raises(FloatingPointError):
+        law(np.array([law.wall + 1.0, law.wall]))
 
 
 # -- the physical frame ---------------------------------------------------------------------------------

@@ -139,7 +139,7 @@ def _decode(tree, arrays):
 
 def write_file(path: str, header: dict, tree: dict) -> None:
     """Write ``tree`` (nested dicts and lists of JSON values and numpy arrays) atomically, with ``header``."""
-    arrays = []
+    arrays: list[np.ndarray] = []
     meta = json.dumps(_encode(tree, arrays)).encode()
     buf = io.BytesIO()
     np.savez(buf, *arrays, meta=np.frombuffer(meta, dtype=np.uint8))
@@ -258,7 +258,7 @@ class Checkpoint:
         self.rank0 = self.mpi.Get_rank() == 0
         self.saved = saved          # the state read for the restart (its arrays on rank 0 only)
         self.last = time.perf_counter()
-        self.rows = {}              # segment number -> {"x", "xdot": gathered rows (rank 0)}, "n": points sent
+        self.rows: dict[int, dict] = {}     # segment number -> {"x", "xdot": gathered rows (rank 0)}, "n": points sent
         if path and self.rank0:
             ResultSet({"checkpoint": path})    # removes the temporaries of saves killed on this host
 

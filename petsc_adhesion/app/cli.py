@@ -229,9 +229,9 @@ def _main(argv: list[str]) -> int:
         _say(str(e))
         return EXIT_INPUT
     except PETSc.Error as e:
-        bad = petsc_error(e)
-        _say(str(bad) if isinstance(bad, InputError) else bad)
-        return EXIT_INPUT if isinstance(bad, InputError) else EXIT_FAILED
+        why = petsc_error(e)
+        _say(str(why) if isinstance(why, InputError) else why)
+        return EXIT_INPUT if isinstance(why, InputError) else EXIT_FAILED
     except (RuntimeError, FloatingPointError, OSError) as e:
         what = f"cannot write '{e.filename}': {e.strerror}" if isinstance(e, OSError) and e.filename \
             else first_line(e)

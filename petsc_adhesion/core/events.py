@@ -147,7 +147,7 @@ class Found:
 
     event: object
     label: str
-    point: object
+    point: Point
     segment: int
     before: float                 # the test function's value at the segment's start
     landing: object = None        # for a fold: the point it jumps to (see jumps)

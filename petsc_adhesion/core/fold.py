@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 from contextlib import contextmanager
+from typing import Generic, TypeVar
 
 import numpy as np
 from mpi4py import MPI
@@ -43,14 +44,18 @@ from petsc4py import PETSc
 from .bordered import Border
 from .capi import python_errors
 from .newton import TRUE_RESIDUAL, PCReuse, PetscSettings, SolverOptions, Tolerances
+from .protocol import FoldBase
 
 __all__ = ["FoldSystem", "FOLD_PREFIX"]
 
 #: Options prefix of the bordered solves of g (-fold_ksp_type, ...).
 FOLD_PREFIX = "fold_"
 
+#: The type of the base problem, so that its owner may use the members it has beyond the protocol
+Base = TypeVar("Base", bound=FoldBase)
 
-class FoldSystem:
+
+class FoldSystem(Generic[Base]):
     """The fold system [G; g] = 0 in x = (u, p), continuation parameter s = ``name``: the problem protocol.
 
     Parameters
@@ -76,8 +81,14 @@ class FoldSystem:
         self.sizes = (self.nloc + n1, N + 1)
         # p weighs like a uniform change of u in the continuation's norm
         self.weights = np.append(base.weights, 1.0) if self.last else base.weights
-        self.jacobian = self.bordered = self.pmat = self.ksp = None
-        self.rhs = self.z = self.work = None
+        # None until made below: destroy() frees those made before a refused option
+        self.jacobian: PETSc.Mat = None
+        self.bordered: PETSc.Mat = None
+        self.pmat: PETSc.Mat | None = None
+        self.ksp: PETSc.KSP = None
+        self.rhs: PETSc.Vec = None
+        self.z: PETSc.Vec = None
+        self.work: PETSc.Vec = None
         try:
             self.jacobian = PETSc.Mat().createPython((self.sizes, self.sizes), _Shell(self.jacobian_mult),
                                                      comm=self.comm)
@@ -98,11 +109,18 @@ class FoldSystem:
             raise
         self.reuse = PCReuse()
         self.phi = self.psi = np.full(self.nloc, 1.0 / math.sqrt(N))
-        self._key = None            # (x, s) of the state below
-        self.s, self.v, self.w, self.g, self.gap = None, None, None, 0.0, math.inf
-        self.row = self.row_all = self.gp = None
+        self._key: tuple[np.ndarray, float] | None = None     # (x, s) of the state below
+        # the state below (s, v, g, w), set by _at; w only when asked for
+        self.s: float | None = None
+        self.v: np.ndarray | None = None
+        self.w: np.ndarray | None = None
+        self.g, self.gap = 0.0, math.inf
+        # the row [g_u, g_p] and the column G_p at the point of linearize
+        self.row: np.ndarray | None = None
+        self.row_all: np.ndarray | None = None
+        self.gp: np.ndarray | None = None
         self.g_p = 0.0
-        self.guard = None           # the parameter of the domain guard: set by adapt
+        self.guard: float | None = None           # the parameter of the domain guard: set by adapt
 
     # -- x = (u, p) ------------------------------------------------------------------
     def create_vec(self) -> PETSc.Vec:
@@ -188,10 +206,26 @@ class FoldSystem:
             self._key = None
             if not self._at(x, s, True):
                 raise FloatingPointError(f"a state below the wall at {self.parameter} = {s:.6g}")
-            self.phi = self.v / math.sqrt(self._dot(self.v, self.v))
-            self.psi = self.w / math.sqrt(self._dot(self.w, self.w))
+            v, w = self._nulls()
+            self.phi = v / math.sqrt(self._dot(v, v))
+            self.psi = w / math.sqrt(self._dot(w, w))
             self.reuse.expire()
         self._key = None
+
+    def _nulls(self) -> tuple[np.ndarray, np.ndarray]:
+        """v and w of the state below: :meth:`_at` with ``left`` has set them."""
+        assert self.v is not None and self.w is not None, "the null vectors before the state is computed"
+        return self.v, self.w
+
+    def _linearized(self) -> tuple[np.ndarray, np.ndarray]:
+        """The row g_u and the column G_p at the point of :meth:`linearize`, which has set them."""
+        assert self.row is not None and self.gp is not None, "the Jacobian's border before linearize"
+        return self.row, self.gp
+
+    def _guard(self) -> float:
+        """The parameter of the domain guard, which :meth:`adapt` has set."""
+        assert self.guard is not None, "the domain guard before adapt"
+        return self.guard
 
     # -- the protocol -------------------------------------------------------------------
     def residual(self, X: PETSc.Vec, s: float, R: PETSc.Vec) -> None:
@@ -210,7 +244,7 @@ class FoldSystem:
         x = X.getArray(readonly=True)
         self._at(x, s, True)
         u, p = self.split(x)
-        column, derivative = self.base.parameter_derivatives(self.parameter, u, p, self.v, self.w, self.gap)
+        column, derivative = self.base.parameter_derivatives(self.parameter, u, p, *self._nulls(), self.gap)
         out[:self.nloc] = column
         out[self.nloc:] = -derivative
         return out
@@ -220,7 +254,7 @@ class FoldSystem:
         x = X.getArray(readonly=True)
         self._at(x, s, True)
         u, p = self.split(x)
-        row, along_p = self.base.second_derivatives(u, p, self.v, self.w)
+        row, along_p = self.base.second_derivatives(u, p, *self._nulls())
         self.row, self.g_p = -row, (-along_p if along_p else 0.0)
         self.gp = self.base.dG_dp(self._h, p, np.zeros(self.nloc))
         full = self._mpi.allgather(self.row)
@@ -232,7 +266,7 @@ class FoldSystem:
 
     def fill_pmat(self, P: PETSc.Mat, borders=()) -> None:
         """Assemble P at the linearization point."""
-        own = Border(self.gp, self.row_all if self.last else None, self.g_p)
+        own = Border(self._linearized()[1], self.row_all if self.last else None, self.g_p)
         self.base.fill_pmat(P, [own, *borders])
 
     def setup_pc(self, pc: PETSc.PC, bordered: bool = False) -> None:
@@ -242,12 +276,12 @@ class FoldSystem:
     def inside(self, x: np.ndarray) -> bool:
         """The base problem's guard on u at the parameter of the last point the borders were adapted at (the
         protocol gives no parameter here; a corrector that moves s out of the domain gets a NaN residual)."""
-        with self._at_parameter(self.guard):
+        with self._at_parameter(self._guard()):
             return self.base.inside(x[:self.nloc])
 
     def step_fraction(self, x: np.ndarray, y: np.ndarray) -> float:
         """The base problem's guard on the u part of the step x -> x - y, at the parameter of :meth:`inside`."""
-        with self._at_parameter(self.guard):
+        with self._at_parameter(self._guard()):
             return self.base.step_fraction(x[:self.nloc], y[:self.nloc])
 
     def record_guard(self) -> None:

@@ -8,7 +8,9 @@ call nothing else.  Code that follows a curve over several discretizations
 (the tracer, the error bars, the results, the checkpoint) needs a little more
 of each discretization, :class:`TracedProblem`; the fold system
 (:mod:`~petsc_adhesion.core.fold`) continues a turning point in a second
-parameter through :class:`FoldBase`.  ``residual``, ``dG_dp`` and
+parameter through :class:`FoldBase`.  The adhesion problems evaluate a pressure
+law of the model, :class:`PressureLaw`, which the discretization and the tracing
+read too.  ``residual``, ``dG_dp`` and
 ``linearize`` get x as a PETSc Vec; the other members deal in the rank's local
 parts (numpy arrays); parameters are floats.
 
@@ -24,11 +26,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["Point", "ContinuationProblem", "TracedProblem", "FoldBase", "POINT_FIELDS", "check_point"]
+if TYPE_CHECKING:       # for the annotations only: importing petsc4py here would initialise it
+    from petsc4py import PETSc
+
+__all__ = ["Point", "ContinuationProblem", "TracedProblem", "FoldBase", "PressureLaw", "POINT_FIELDS", "check_point"]
 
 
 @runtime_checkable
@@ -42,11 +47,11 @@ class ContinuationProblem(Protocol):
     """
 
     #: the PETSc communicator of every object of the problem
-    comm: object
+    comm: PETSc.Comm
     #: the name of p, for monitors ("lambda")
     parameter: str
     #: G_x at the point of :meth:`linearize` (a PETSc Mat, often a shell)
-    jacobian: object
+    jacobian: PETSc.Mat
     #: local weights w of the inner product <u, v> = sum w u v of the continuation's norm
     weights: np.ndarray
 
@@ -97,15 +102,20 @@ class TracedProblem(ContinuationProblem, Protocol):
     so that code following a curve over grids asks no problem for its class.
     """
 
-    #: the model (mu, sigma, roughness, r_m) the problem discretizes
-    model: object
-    #: its pressure law (:func:`~petsc_adhesion.model.pressure.pressure_law`)
-    law: object
+    #: the model (mu, sigma, roughness, r_m) the problem discretizes: a Model of model/parameters.py,
+    #: which the core does not import (Any: object would refuse every use of it, and a problem's own type)
+    model: Any
+
+    @property
+    def law(self) -> PressureLaw:
+        """Its pressure law (:func:`~petsc_adhesion.model.pressure.pressure_law`), at the parameters of now."""
+
     #: the nodal rows [lo, hi) this rank owns
     lo: int
     hi: int
-    #: rows of the nodal part on this rank, of all ranks, and whether this is the last rank
-    layout: object
+    #: rows of the nodal part on this rank, of all ranks, and whether this is the last rank (a Layout of
+    #: discretization/preconditioning.py, which the core does not import)
+    layout: Any
     #: Newton steps the domain guard shortened so far
     guarded: int
 
@@ -148,8 +158,9 @@ class FoldBase(ContinuationProblem, Protocol):
     through the problem (never by writing its fields).
     """
 
-    def set_parameter(self, name: str, value: float) -> None:
-        """Make the problem that of the second parameter ``name`` at ``value``."""
+    def set_parameter(self, name: str, value: float) -> bool:
+        """Make the problem that of the second parameter ``name`` at ``value``; False (the problem
+        unchanged) where ``value`` is outside the parameter's range."""
 
     def jacobian_transpose(self, u, y) -> None:
         """y = G_u^T u at the point of :meth:`linearize` (Vecs)."""
@@ -166,6 +177,57 @@ class FoldBase(ContinuationProblem, Protocol):
 
     def domain_gap(self, u: np.ndarray) -> float:
         """How far the local part u lies inside the domain at the current parameters (collective)."""
+
+    def destroy(self) -> None:
+        """Free the PETSc objects of the problem (the fold system owns its base problem)."""
+
+
+@runtime_checkable
+class PressureLaw(Protocol):
+    """What the problems, the grids, the resolution check and the results ask of a pressure law.
+
+    The surface stress P(H) at mean separation H in units of 8 gamma / (3 epsilon), P > 0
+    repulsion: the Lennard-Jones law sigma_LJ(g) = g^-9 - g^-3 of a gap g = H + 1 (eq. 5)
+    when smooth, else its average over the roughness heights S, E[sigma_LJ(H + 1 - S)]
+    (eq. 7, 10) by a quadrature (eq. 14 for Gaussian heights).  The laws of
+    :mod:`~petsc_adhesion.model.pressure` (which the core does not import) are the
+    implementations: the paper's Gauss-Hermite rule (the class that module names
+    ``PressureLaw``: one implementation of this protocol, not the protocol), the wall quadrature of heights
+    bounded above (``WallLaw``) and the exact average over a measured histogram
+    (``HistogramLaw``).  Read-only members: a law is not changed once made (a problem
+    at another roughness takes another law).
+    """
+
+    @property
+    def wall(self) -> float:
+        """The H at or below which some gap H + 1 - S closes: the highest asperity's, S_max - 1."""
+
+    @property
+    def smooth(self) -> bool:
+        """No roughness (sigma = 0): eq. (5) itself, no quadrature."""
+
+    @property
+    def rule(self) -> str:
+        """The name of the height distribution and its average ("none", "hermite", "truncated_gaussian", ...)."""
+
+    @property
+    def n(self) -> int:
+        """Points per node of the average (1 when smooth)."""
+
+    @property
+    def sigma(self) -> float:
+        """The rms of the heights (units of epsilon)."""
+
+    def __call__(self, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(P(H), dP/dH) at the nodal separations H, the derivative exact for the quadrature;
+        FloatingPointError when some H is at or below :attr:`wall`."""
+
+    def error(self, H: np.ndarray) -> np.ndarray:
+        """An estimate of |P - the average P stands for| at H (zero where the rule is the model)."""
+
+    def describe(self) -> dict:
+        """The roughness model as result files record it ({} when smooth)."""
+
 
 
 #: The fields of a :class:`Point` beside its vectors x and xdot.

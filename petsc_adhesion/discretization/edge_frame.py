@@ -24,6 +24,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..core.bordered import Border
+from ..core.protocol import PressureLaw
 from ..model.pressure import pressure_law
 from ..model.reference.rigid import load_beyond, load_beyond_rates
 from .contact import SMOOTH_LEVEL, SMOOTH_PEAK, deformation_at, edge_level, peak_attraction, rate_at

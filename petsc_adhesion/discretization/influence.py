@@ -156,7 +156,8 @@ def _add_rows(r: np.ndarray, lo: int, out: np.ndarray) -> None:
     left, right = _regular(*piece, q)
     # the few pieces too close to r_i are redone, which beats masking all
     cut = np.flatnonzero(q < _Q_SPLIT)
-    left[cut], right[cut] = _split(*(v[cut] for v in piece), dist[cut])
+    rr, cc, ll, u0, du = (v[cut] for v in piece)
+    left[cut], right[cut] = _split(rr, cc, ll, u0, du, dist[cut])
     out[:, :-1] += left.reshape(c.shape)
     out[:, 1:] += right.reshape(c.shape)
 

@@ -114,7 +114,7 @@ class Band:
 
     def __init__(self, band: int = BAND):
         self.band = band
-        self._patterns = {}
+        self._patterns: dict[Layout, tuple[np.ndarray, np.ndarray]] = {}
 
     def pattern(self, layout: Layout):
         """Local CSR row pointers and global columns of the band of G_x (made once per layout)."""
@@ -136,9 +136,10 @@ class Band:
         at = np.repeat(ai[1:], extra)                       # each row's end, once per border column
         tail = layout.N + np.arange(extra)
         cols = [np.insert(aj, at, np.tile(tail, layout.nloc))]
-        vals = [np.insert(v, at, np.stack([b.column[:layout.nloc] for b in borders], axis=1).ravel()
-                          if extra else [])] if v is not None else None
-        counts = [np.diff(ai) + extra]
+        # values only with v (vals stays empty without)
+        vals: list[np.ndarray] = [np.insert(v, at, np.stack([b.column[:layout.nloc] for b in borders], axis=1).ravel()
+                                            if extra else [])] if v is not None else []
+        counts: list = [np.diff(ai) + extra]
         for k in range(extra if layout.last else 0):
             cols.append(np.concatenate([np.arange(layout.N + k + 1), tail[k + 1:]]))
             counts.append([cols[-1].size])

@@ -11,6 +11,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..core.protocol import PressureLaw
 from .grid import PAPER_UNIFORM
 from .problem import MU_SOFT
 
@@ -29,7 +30,7 @@ UNRESOLVED_SHARE = 0.02
 MAX_TRUE_FOLDS = 12
 
 
-def attraction_range(law) -> float:
+def attraction_range(law: PressureLaw) -> float:
     """The width in H of the law's attraction: from its zero (P = 0, the start of the attraction)
     out to where it has fallen to RANGE_SHARE of its peak.  Sampled on a geometric scale
     from the wall (3000 points, relative accuracy ~1e-3, ample for a grid spacing)."""
@@ -45,7 +46,7 @@ def attraction_range(law) -> float:
 RANGE_SHARE = 0.1
 
 
-def cohesive_zone(model, law) -> float:
+def cohesive_zone(model, law: PressureLaw) -> float:
     """The cohesive zone at the contact edge: 0.75 mu^-1.5 for a smooth surface, wider with roughness.
 
     The roughness average spreads the attraction over a wider range of the mean gap
@@ -88,7 +89,7 @@ def measured_zone(r: np.ndarray, P: np.ndarray) -> float:
     return float(r[k] - half) / INNER_SHARE
 
 
-def zone_of(model, law, r: np.ndarray | None = None, P: np.ndarray | None = None,
+def zone_of(model, law: PressureLaw, r: np.ndarray | None = None, P: np.ndarray | None = None,
             formula: float | None = None) -> float:
     """The cohesive zone to resolve: :func:`cohesive_zone` (``formula`` when the caller has it), or for a
     rough soft sphere (mu from MU_SOFT) the wider :func:`measured_zone` of the state (r, P) where it is
@@ -100,7 +101,7 @@ def zone_of(model, law, r: np.ndarray | None = None, P: np.ndarray | None = None
     return max(zone, seen) if np.isfinite(seen) else zone
 
 
-def check(model, law, states, folds: int) -> str:
+def check(model, law: PressureLaw, states, folds: int) -> str:
     """One line when a grid did not resolve the cohesive zone where the contact edge was, else "".
 
     ``states``: (nodes, H, P) of each point of the curve; the contact edge of a

@@ -76,6 +76,7 @@ class Model:
         if name != "sigma":
             raise ValueError(f"no parameter '{name}': mu or sigma")
         if self.roughness == "measured":
+            assert self.heights is not None, "a measured roughness without its heights"
             return replace(self, heights=self.heights * (value / Measured(self.heights).rms), bodies=None)
         return replace(self, sigma=value, bodies=None)
 

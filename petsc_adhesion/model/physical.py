@@ -56,13 +56,17 @@ class Bodies:
         """The combined modulus, eq. (2) (a rigid counterface when E2 is not given)."""
         compliance = (1 - self.poisson1**2) / self.young1
         if self.young2 is not None:
+            assert self.poisson2 is not None, "young2 without poisson2: the options' reading refuses it"
             compliance += (1 - self.poisson2**2) / self.young2
         return 1.0 / compliance
 
     @property
     def work_of_adhesion(self) -> float:
         """gamma, or A / (12 pi D0^2) from the Hamaker constant."""
-        return self.gamma if self.gamma is not None else self.hamaker / (12 * math.pi * self.hamaker_cutoff**2)
+        if self.gamma is not None:
+            return self.gamma
+        assert self.hamaker is not None, "neither gamma nor hamaker: the options' reading refuses it"
+        return self.hamaker / (12 * math.pi * self.hamaker_cutoff**2)
 
     @property
     def mu(self) -> float:

@@ -107,7 +107,7 @@ class PressureLaw:
         """Gaps H - S_l + 1, shape (len(H), n) (or (len(H),) when smooth)."""
         return H + 1.0 if self.smooth else np.subtract.outer(H + 1.0, self.shifts)
 
-    def __call__(self, H: np.ndarray):
+    def __call__(self, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Return P(H) (eq. 14; eq. 5 when smooth) and its exact derivative dP/dH."""
         # in one piece, as before: blocks would change the BLAS row sums in the last bit
         g = self.gaps(H)
@@ -151,10 +151,10 @@ class WallLaw:
         self.wall = dist.top - 1.0
         self.points = points
         self.quadrature = None if self.smooth else WallQuadrature(dist, points, panel_points(points))
-        self.n = 1 if self.smooth else self.quadrature.size
-        self._reference = None
+        self.n = 1 if self.quadrature is None else self.quadrature.size
+        self._reference: WallQuadrature | None = None
 
-    def __call__(self, H: np.ndarray):
+    def __call__(self, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Return P(H) and dP/dH."""
         return self._average(H, self.quadrature)
 
@@ -175,8 +175,8 @@ class WallLaw:
         return {"roughness": self.rule, **shape, "rms": self.dist.rms, "highest_asperity": self.dist.top,
                 "quadrature_points": self.points}
 
-    def _average(self, H: np.ndarray, rule: WallQuadrature | None):
-        if self.smooth:
+    def _average(self, H: np.ndarray, rule: WallQuadrature | None) -> tuple[np.ndarray, np.ndarray]:
+        if rule is None:                    # the smooth law
             _refuse_closed(H + 1.0, H, self.wall)
             return lennard_jones(H + 1.0)
 
@@ -215,7 +215,7 @@ class HistogramLaw:
         self.jumps = np.diff(dist.density, prepend=0.0, append=0.0)
         self.n = self.edges.size
 
-    def __call__(self, H: np.ndarray):
+    def __call__(self, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Return P(H) and dP/dH."""
         def block(h):
             phi, p = self._kernels(h)

@@ -55,7 +55,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..core.continuation import Continuation, Point, Settings
-from ..core.events import EventFinder, Fold
+from ..core.events import EventFinder, Fold, Found
 from ..core.fold import FoldSystem
 from ..discretization.influence import create_influence
 from ..discretization.preconditioning import Dense
@@ -88,7 +88,7 @@ def at_parameter(model, name: str, value: float):
     return model.with_parameter(name, value)
 
 
-def fold_system(model, r: np.ndarray, name: str, s0: float, comm=None) -> FoldSystem:
+def fold_system(model, r: np.ndarray, name: str, s0: float, comm=None) -> FoldSystem[Problem]:
     """The fold system of ``model`` at ``name`` = ``s0`` on the nodes r, continued in ``name``: the adhesion
     problem (:class:`~petsc_adhesion.discretization.problem.Problem`, dense PC) under
     :class:`~petsc_adhesion.core.fold.FoldSystem`, with x = (H, lambda)."""
@@ -101,20 +101,20 @@ def fold_system(model, r: np.ndarray, name: str, s0: float, comm=None) -> FoldSy
         raise
 
 
-def _state(fs: FoldSystem, r: np.ndarray, H: np.ndarray, lam: float) -> np.ndarray:
+def _state(fs: FoldSystem[Problem], r: np.ndarray, H: np.ndarray, lam: float) -> np.ndarray:
     """The local part of (H, lambda) for a state H on nodes r: its deformation H - r^2/2 interpolated."""
     base = fs.base
     mine = base.r[base.lo:base.lo + fs.nloc]
     return fs.join(np.interp(mine, r, H - 0.5 * r * r) + 0.5 * mine * mine, lam)
 
 
-def _whole(fs: FoldSystem, x: np.ndarray) -> tuple[np.ndarray, float]:
+def _whole(fs: FoldSystem[Problem], x: np.ndarray) -> tuple[np.ndarray, float]:
     """(all of H, lambda) of a local part x, on every rank."""
     h, lam = fs.split(x)
     return fs.base.gather(h), lam
 
 
-def _edge(fs: FoldSystem, x: np.ndarray, s: float) -> tuple[float, float]:
+def _edge(fs: FoldSystem[Problem], x: np.ndarray, s: float) -> tuple[float, float]:
     """(radius of peak attraction, contact radius) of a state at s (:mod:`~petsc_adhesion.tracing.tracer`)."""
     fs.base.set_parameter(fs.parameter, s)
     fs.forget()
@@ -138,6 +138,7 @@ def ordinary_folds(model, comm=None) -> list[dict]:
     try:
         segments = tracer.run(far_approach(model))
         last = segments[-1].cont
+        assert last.stop is not None, "a run ends with its reason"
         if last.stop[0] != "observable_max":
             raise RuntimeError(f"the curve at mu = {model.mu:g}, sigma = {model.sigma:g} ended before equilibrium: "
                                f"{results.stop_reason(last.stop, settings)}")
@@ -199,9 +200,9 @@ def bracket(model, name: str, comm=None, ratio: float = BRACKET) -> tuple[float,
 class Cusp:
     """A cusp located on one grid: the fold problem, its continuation and the located event."""
 
-    problem: FoldSystem
+    problem: FoldSystem[Problem]
     cont: Continuation
-    found: object
+    found: Found
 
     @property
     def point(self) -> Point:
@@ -219,7 +220,7 @@ class Cusp:
         self.problem.destroy()
 
 
-def _to_cusp(fp: FoldSystem, cont: Continuation, start: Point):
+def _to_cusp(fp: FoldSystem[Problem], cont: Continuation, start: Point):
     """Run ``cont`` from ``start`` until the fold curve turns in s: the located event, or RuntimeError.
 
     After every step the borders of g become the null vectors there (:meth:`~petsc_adhesion.core.fold.FoldSystem.adapt`);
@@ -235,6 +236,7 @@ def _to_cusp(fp: FoldSystem, cont: Continuation, start: Point):
 
     cont.run(start, on_step=on_step, until=lambda a, b: bool(finder.found))
     if not finder.found:
+        assert cont.stop is not None, "a run ends with its reason"
         raise RuntimeError(f"the fold curve did not turn in {fp.parameter} from {start.p:.6g}: "
                            f"stopped ({cont.stop[0]}) at {fp.parameter} = {cont.points[-1].p:.6g}")
     return finder.found[0]

@@ -35,6 +35,7 @@ from mpi4py import MPI
 from ..core.continuation import Continuation, Settings
 from ..core.newton import PetscSettings
 from ..core.events import EVENT_TOL, EventFinder
+from ..core.protocol import TracedProblem
 from ..discretization import grid
 from ..discretization.contact import contact_radius, crossing
 from ..discretization.edge_frame import EdgeFrameProblem
@@ -78,7 +79,7 @@ class Segment:
 
     kind: str             # "fixed", "edge" or "scaled"
     grid: object          # the EdgeGrid (None for a fixed grid)
-    problem: object
+    problem: TracedProblem
     cont: Continuation
     finder: EventFinder
     far: bool = False     # the far branch traced back from the start (Tracer.extend_back)

@@ -32,7 +32,7 @@ DOMAIN_SHARE = 0.05
 def smallest_domain(mu: float) -> float:
     """The smallest r_m that holds the contact: the JKR contact radius at zero load, and the
     radius beyond which the rigid sphere's attraction carries at most DOMAIN_SHARE of F = -1."""
-    reach = brent.root(lambda r: abs(load_beyond(r, 0.0)) - DOMAIN_SHARE, 0.1, 100.0)
+    reach = brent.root(lambda r: abs(float(load_beyond(r, 0.0))) - DOMAIN_SHARE, 0.1, 100.0)
     return max(reach, jkr_zero_load(mu)[0] if mu > 0 else 0.0)
 
 
@@ -91,7 +91,7 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
         if (start is not None and t < start) or (stop is not None and t > stop):
             raise InputError(f"-cont_at_lambda: {t:g} is outside the traced range "
                              f"[{'-inf' if start is None else f'{start:g}'}, {'inf' if stop is None else f'{stop:g}'}]")
-    if opts.db.hasName("adh_rmax") and model.rmax < smallest_domain(model.mu):
+    if opts.db.hasName("adh_rmax") and model.rmax is not None and model.rmax < smallest_domain(model.mu):
         raise InputError(f"-adh_rmax: {model.rmax:g} leaves out part of the contact at mu = {model.mu:g}: "
                          f"expected at least {smallest_domain(model.mu):.3g} (the JKR contact radius, or the "
                          f"reach of {DOMAIN_SHARE:.0%} of the attraction)")

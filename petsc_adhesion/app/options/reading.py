@@ -280,16 +280,16 @@ def read_physical(opts: AppOptions) -> Bodies | None:
     # each input's share of log mu (eq. 9), against a 1 um polymer sphere: the option that moved mu most is named
     shares = {"phys_radius": math.log(bodies.R / 1e-6) / 3,
               ("phys_gamma" if "gamma" in given else "phys_hamaker"): 2 * math.log(bodies.work_of_adhesion / 0.05) / 3,
-              ("phys_young2" if "young2" in given and bodies.young2 < bodies.young1 else "phys_young1"):
+              ("phys_young2" if bodies.young2 is not None and bodies.young2 < bodies.young1 else "phys_young1"):
                   -2 * math.log(bodies.E / 1e9) / 3,
               "phys_epsilon": -math.log(bodies.epsilon / 4e-10)}
     logmu = math.log(tabor(1e-6, 0.05, 1e9, 4e-10)) + sum(shares.values())
     if not mu <= TABLE["adh_mu"].hi:       # an overflow of eq. (9) too: its log says by how much
-        name = max(shares, key=shares.get)
+        name = max(shares, key=shares.__getitem__)
         raise InputError(f"-{name}: with the other -phys_ options gives mu = {math.exp(min(logmu, 700)):.3g} by "
                          f"eq. (9), outside [0, {TABLE['adh_mu'].hi:g}]")
     if mu < MU_SMALLEST:
-        name = min(shares, key=shares.get)
+        name = min(shares, key=shares.__getitem__)
         raise InputError(f"-{name}: with the other -phys_ options gives mu = {mu:.3g} by eq. (9), below "
                          f"{MU_SMALLEST:g}: a rigid sphere to double precision; use -adh_mu 0")
     if bodies.sigma is not None and not bodies.sigma <= TABLE["adh_sigma"].hi:
@@ -362,6 +362,7 @@ def read_grid(opts: AppOptions, model: Model) -> GridChoice:
         nu, extra, start = choice.paper_uniform, choice.paper_extra, choice.paper_refine_from
         if extra > nu - 1:
             raise InputError(f"-grid_paper_extra: expected an integer in [0, {nu - 1}], got {extra}")
+        assert model.rmax is not None, "read_model gives the model its domain"
         if start >= model.rmax:
             raise InputError(f"-grid_paper_refine_from: expected a real in [0, {model.rmax:g}), got {start:g}")
     return choice

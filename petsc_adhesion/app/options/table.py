@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from ...app import checkpoint, progress
 from ...core.bordered import ARCLENGTH_PREFIX
@@ -30,7 +31,7 @@ class Option:
 
     name: str
     kind: str          # "real" | "int" | "choice" | "string" | "flag" | "reals" | "rules"
-    default: object
+    default: Any       # of the option's kind: a float for a real, a tuple for reals, ...
     help: str
     lo: float = -math.inf
     hi: float = math.inf

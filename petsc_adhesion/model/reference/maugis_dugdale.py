@@ -55,7 +55,7 @@ def maugis_parameter(mu: ArrayLike) -> float | np.ndarray:
     return _out(_MAUGIS_PER_TABOR * np.asarray(mu, dtype=float))
 
 
-def _md_curve(lmd: float, m_minus_1: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _md_curve(lmd: float, m_minus_1: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Maugis' (Abar, Pbar, Deltabar) at m = c/a, taking m - 1 to keep digits near m = 1."""
     q = np.asarray(m_minus_1, dtype=float)
     m2 = (1.0 + q) ** 2
