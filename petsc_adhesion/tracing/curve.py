@@ -19,11 +19,15 @@ negative when tensile), r and contact radii in sqrt(epsilon R), P in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..version import __version__
 from .measured import Measured, Missing
+
+if TYPE_CHECKING:                    # model_spread traces curves: it imports this module, not the reverse
+    from .model_spread import ModelSpread
 
 __all__ = ["Profile", "Landing", "Event", "Branch", "Cycle", "SpringResult", "ErrorEstimate", "Diagnostics",
            "Assessment", "Program", "GridRecord", "Curve", "Solution", "EVENT_KINDS"]
@@ -243,7 +247,12 @@ class Curve:
     ``model``: the :class:`~petsc_adhesion.model.parameters.Model` it was computed for; ``program`` and
     ``grid`` records; ``branch``: the points (:class:`Branch`); ``events`` in the order found; ``pull_off``
     the most tensile load minimum (load control; None without one); ``rigid``: the cycle of a rigid machine;
-    ``spring``: behind a spring, its jumps and cycle (else None); ``diagnostics``; ``assessment``.
+    ``spring``: behind a spring, its jumps and cycle (else None); ``diagnostics``; ``assessment``;
+    ``spread``: the events under other roughness laws (:class:`~.model_spread.ModelSpread`), set by the
+    caller that computed it (``dataclasses.replace``; the command line does for every rough run), Missing
+    where it could not be, None where none was asked for (a smooth model, ``-adh_model_spread false``,
+    the library's :func:`~.trace.trace_curve` alone).  It is no part of the assessment: a law that moves an
+    event warns (:attr:`ModelSpread.warnings`) but leaves the curve complete.
     """
 
     model: object = field(repr=False)
@@ -256,6 +265,7 @@ class Curve:
     spring: SpringResult | None
     diagnostics: Diagnostics = field(repr=False)
     assessment: Assessment = field(repr=False)
+    spread: ModelSpread | Missing | None = field(default=None, repr=False)
 
     @property
     def complete(self) -> bool:
