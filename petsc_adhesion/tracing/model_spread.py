@@ -283,7 +283,7 @@ def _quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, 
     warning = None
     if (bar > 0 and spread > WARN_BARS * bar) or spread > WARN_RELATIVE * scale:
         far_value = next(v for v, r in zip(values, rules) if r == far).value
-        size = [] if math.isinf(relative) else [f"{100 * relative:.0f}% of the value"]
+        size = [] if math.isinf(relative) else [f"{100 * relative:.2g}% of the value"]
         if bar:
             size.append(f"{spread / bar:.2g} times its error bar")
         warning = (f"the {name} is {ref.value:.6g} under {reference.label} and {far_value:.6g} under "
