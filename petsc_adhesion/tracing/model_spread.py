@@ -32,7 +32,7 @@ from .measured import Measured, Missing
 from .trace import CurveRequest, GridChoice, SolverChoice, trace_curve
 
 __all__ = ["Rule", "EventValues", "CurveValues", "Quantity", "ModelSpread", "curve_values", "parse_rules",
-           "default_rules", "model_spread", "report_lines", "WARN_BARS", "WARN_RELATIVE", "KINDS", "LAWS"]
+           "default_rules", "model_spread", "spread_quantity", "report_lines", "WARN_BARS", "WARN_RELATIVE", "KINDS", "LAWS"]
 
 #: A spread warns when it exceeds this many error bars of the reference value ...
 WARN_BARS = 10.0
@@ -266,8 +266,9 @@ def _advice(reference: Rule) -> str:
             "measured heights (-adh_roughness measured -adh_roughness_file)")
 
 
-def _quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, reference: Rule) -> Quantity:
-    """The spread of one quantity (the distances of the laws that have it) and its warning."""
+def spread_quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, reference: Rule) -> Quantity:
+    """The spread of one quantity (the distances of the laws that have it) and its warning; also of a quantity
+    not of a curve (the work of adhesion of a pull-off fit, :mod:`~petsc_adhesion.fitting.pull_off`)."""
     dist = [(abs(v.value - ref.value), r) for v, r in zip(values, rules) if isinstance(v, Measured)]
     if not dist:
         return Quantity(name, unit, ref, values, None, None, None)
@@ -283,7 +284,7 @@ def _quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, 
     warning = None
     if (bar > 0 and spread > WARN_BARS * bar) or spread > WARN_RELATIVE * scale:
         far_value = next(v for v, r in zip(values, rules) if r == far).value
-        size = [] if math.isinf(relative) else [f"{100 * relative:.2g}% of the value"]
+        size = [] if math.isinf(relative) else [f"{100 * relative:.3g}% of the value"]
         if bar:
             size.append(f"{spread / bar:.2g} times its error bar")
         warning = (f"the {name} is {ref.value:.6g} under {reference.label} and {far_value:.6g} under "
@@ -339,11 +340,11 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
         for attr, unit in fields:
             values = tuple(_missing(rule, alt, name) if pairs[i][1] is None else getattr(pairs[i][1], attr)
                            for rule, alt, pairs in zip(rules, alts, matched))
-            quantities.append(_quantity(f"{name} {unit}", unit, getattr(e, attr), values, rules, reference))
+            quantities.append(spread_quantity(f"{name} {unit}", unit, getattr(e, attr), values, rules, reference))
     if isinstance(ref.energy, Measured):
         values = tuple(Missing(f"{rule.label}: its curve could not be traced") if alt is None else alt.energy
                        for alt, rule in zip(alts, rules))
-        quantities.append(_quantity("energy of a cycle", "energy", ref.energy, values, rules, reference))
+        quantities.append(spread_quantity("energy of a cycle", "energy", ref.energy, values, rules, reference))
     bodies = model.bodies
     units = bodies.scales() if bodies is not None else None
     return ModelSpread(reference, rules, tuple(quantities), tuple(notes), wall, times,
