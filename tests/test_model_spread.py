@@ -302,3 +302,44 @@ def test_the_probes_results_warn(probe):
     assert F["relative"] > 4 and F["warning"] in s["warnings"] and s["complete"] == curve.complete
     assert F["value"] * m["force_nN"] == pytest.approx(-17.77, abs=0.01)
     assert s["warnings"] == curve.warnings + spread.warnings
+
+
+def test_a_rough_pull_off_fit_has_gammas_spread(tmp_path):
+    """-fit_pull_off with an rms of 0.09 nm (sigma = 0.3): gamma solved for again under the truncated Gaussian
+    at K = 3; its value is a root of the same equation, 2 pi R w |F_p| = P with F_p that law's pull-off on the
+    grid, checked here by tracing that curve; the spread warns (measured: 0.313 J/m^2 under hermite:16, 0.174
+    under truncated_gaussian:3, 44 % and 27 bars apart) and the fit is still trustworthy, exit 0."""
+    import json
+
+    import h5py
+    from conftest import run_cli
+
+    from petsc_adhesion.fitting.pull_off import model_pull_off
+    from petsc_adhesion.model.parameters import tabor
+
+    P = 12.46e-9
+    grid = ("-grid_type", "uniform", "-grid_n", "201")
+    proc = run_cli("-fit_pull_off", P, "-fit_pull_off_err", "0.2e-9", "-phys_radius", "20e-9", "-phys_young1",
+                   "150e9", "-phys_poisson1", "0.27", "-phys_epsilon", "0.3e-9", "-phys_rms", "0.09e-9", *grid,
+                   "-adh_model_spread_rules", "truncated_gaussian:3", "-summary", tmp_path / "f.json",
+                   "-out", tmp_path / "f.h5")
+    assert proc.returncode == 0, proc.stderr
+    fit = json.loads((tmp_path / "f.json").read_text())["fit"]
+    m = fit["model_spread"]
+    (q,) = m["quantities"]
+    assert m["reference"] == "hermite:16" and m["rules"] == ["truncated_gaussian:3"]
+    assert q["value"] == fit["gamma"] and q["err"] == fit["gamma_err"]
+    (w,) = q["values"]
+    bodies = Bodies(radius=20e-9, young1=150e9, poisson1=0.27, epsilon=0.3e-9, rms=0.09e-9)
+    law = Model(mu=tabor(bodies.R, w, bodies.E, bodies.epsilon), sigma=0.3, roughness="truncated_gaussian",
+                roughness_cutoff=3.0, rmax=GridChoice("uniform").default_rmax)
+    F = model_pull_off(law, GridChoice("uniform", n=201)).F.value
+    assert 2 * math.pi * bodies.R * w * abs(F) == pytest.approx(P, rel=1e-6)
+    # the bounded law needs a smaller w for the same force: its surfaces come closer
+    assert w < fit["gamma"] and q["spread"] == pytest.approx(fit["gamma"] - w, rel=1e-12)
+    assert q["relative"] > WARN_RELATIVE and q["spread"] > WARN_BARS * fit["gamma_err"] and q["warning"]
+    assert fit["trustworthy"] and fit["warnings"] == []
+    assert "WARNING: the work of adhesion gamma is" in proc.stdout
+    with h5py.File(tmp_path / "f.h5") as f:
+        assert list(f["fit/model_spread/quantities/0000"].attrs["values"]) == [w]
+        assert f["fit/model_spread"].attrs["description"]
