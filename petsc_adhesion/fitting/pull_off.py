@@ -216,7 +216,8 @@ def _gamma_spread(gamma, model: Model, rules: tuple, root) -> ModelSpread | Miss
         raise ValueError(f"{reference.label}: the reference's own law, not an alternative to it")
     if isinstance(gamma, Missing):
         return Missing(f"gamma is undetermined under {reference.label}: no value to spread about")
-    values, notes, times = [], [], []
+    values: list[Measured | Missing] = []
+    notes, times = [], []
     t0 = time.perf_counter()
     for rule in rules:
         t = time.perf_counter()

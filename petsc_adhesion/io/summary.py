@@ -13,7 +13,7 @@ reaches the JSON and HDF5 files with no change here; the CSV names its columns
 from __future__ import annotations
 
 from dataclasses import fields, is_dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -160,6 +160,8 @@ def summary_of(curve: Curve) -> dict:
         return event_record(e, profiles=False)
 
     ev, d, a = curve.events, curve.diagnostics, curve.assessment
+    spread = cast("ModelSpread | Missing | None", curve.spread)
+    spread_warnings = spread.warnings if spread is not None and not isinstance(spread, Missing) else []
     s = {**_common(curve),
          "pull_off": brief(curve.pull_off) if curve.pull_off else None,
          "folds": [brief(e) for e in ev if e.kind in ("snap_on", "snap_off")],
@@ -175,7 +177,7 @@ def summary_of(curve: Curve) -> dict:
          "most_newton_its": d.most_newton_its, "most_ksp_its": d.most_ksp_its, "stop_reason": d.stop_reason,
          "grid_warning": a.grid_warning or "", "complete": a.complete,
          # the spread's warnings among the run's, though they leave it complete (docs/model.md)
-         "warnings": list(a.warnings) + (curve.spread.warnings if curve.spread else []),
+         "warnings": list(a.warnings) + spread_warnings,
          "lambda_start": d.lambda_start, "wall_time_s": d.wall_time_s}
     if d.error_estimate is not None:
         est = d.error_estimate
@@ -183,8 +185,8 @@ def summary_of(curve: Curve) -> dict:
                                "levels": list(est.levels)}
     if curve.model.bodies is not None:
         s["physical"] = in_units(s, curve.model.bodies.describe())
-    if curve.spread is not None:         # after physical: in_units reads the events, not the spread
-        s["model_spread"] = spread_record(curve.spread)
+    if spread is not None:               # after physical: in_units reads the events, not the spread
+        s["model_spread"] = spread_record(spread)
     return _plain(s)
 
 

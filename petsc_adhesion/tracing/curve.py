@@ -19,15 +19,11 @@ negative when tensile), r and contact radii in sqrt(epsilon R), P in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..version import __version__
 from .measured import Measured, Missing
-
-if TYPE_CHECKING:                    # model_spread traces curves: it imports this module, not the reverse
-    from .model_spread import ModelSpread
 
 __all__ = ["Profile", "Landing", "Event", "Branch", "Cycle", "SpringResult", "ErrorEstimate", "Diagnostics",
            "Assessment", "Program", "GridRecord", "Curve", "Solution", "EVENT_KINDS"]
@@ -265,7 +261,9 @@ class Curve:
     spring: SpringResult | None
     diagnostics: Diagnostics = field(repr=False)
     assessment: Assessment = field(repr=False)
-    spread: ModelSpread | Missing | None = field(default=None, repr=False)
+    # a ModelSpread | Missing | None, typed object: model_spread traces curves and imports this module, not
+    # the reverse (no import cycle, not even for the checker)
+    spread: object = field(default=None, repr=False)
 
     @property
     def complete(self) -> bool:
