@@ -343,3 +343,21 @@ def test_a_rough_pull_off_fit_has_gammas_spread(tmp_path):
     with h5py.File(tmp_path / "f.h5") as f:
         assert list(f["fit/model_spread/quantities/0000"].attrs["values"]) == [w]
         assert f["fit/model_spread"].attrs["description"]
+
+
+def test_a_study_refuses_the_spreads_options(tmp_path):
+    """A study's cases compute no spread: asking for one is refused in one line, exit 2, nothing written;
+    so is asking -fit_curve for one."""
+    from conftest import run_cli
+
+    out = tmp_path / "st.json"
+    proc = run_cli("-study_sigma", "0.1,0.2", "-adh_model_spread_rules", "weibull:0", "-grid_type", "uniform",
+                   "-grid_n", "101", "-summary", out)
+    assert proc.returncode == 2 and not out.exists()
+    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread_rules: applies to one run's curve or "
+                                   "-fit_pull_off, not a study of many cases; remove it")
+    proc = run_cli("-fit_curve", tmp_path / "c.csv", "-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9",
+                   "-adh_model_spread", "false", "-summary", out)
+    assert proc.returncode == 2 and not out.exists()
+    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: applies to a curve's run or "
+                                   "-fit_pull_off, not -fit_curve; remove it")

@@ -109,7 +109,14 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
               "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
-    spread_rules = read_model_spread(opts, model)
+    if is_study(opts):                 # a study's cases report no spread: an option asking for one is refused
+        for name in ("adh_model_spread", "adh_model_spread_rules"):
+            if opts.db.hasName(name):
+                raise InputError(f"-{name}: applies to one run's curve or -fit_pull_off, not a study of many "
+                                 "cases; remove it")
+        spread_rules = None
+    else:
+        spread_rules = read_model_spread(opts, model)
     return Request(model, grid_choice, read_solver(opts), read_settings(opts, model), read_request(opts, kinds, profiles, model.bodies),
                    lam, opts.string("adh_guess"), targets, inputs, spread_rules)
 
