@@ -264,7 +264,9 @@ def test_a_rough_run_has_its_spread_in_every_result(rough_run):
         assert g.attrs["reference"] == "hermite:16" and list(g.attrs["rules"]) == m["rules"]
         assert g.attrs["units"] and g.attrs["description"]
         h = g["quantities/0001"]
-        assert h.attrs["name"] == "pull-off F" and list(h.attrs["values"]) == F["values"]
+        assert h.attrs["name"] == "pull-off F" and dict(h["values"].attrs) == {
+            **dict(zip(m["rules"], F["values"])), "units": h["values"].attrs["units"],
+            "description": h["values"].attrs["description"]}
         assert h.attrs["description"] and "model_spread" not in f["summary"]
     out = proc.stdout + proc.stderr
     assert "model spread: the events under 4 other roughness laws" in out
@@ -341,13 +343,13 @@ def test_a_rough_pull_off_fit_has_gammas_spread(tmp_path):
     assert fit["trustworthy"] and fit["warnings"] == []
     assert "WARNING: the work of adhesion gamma is" in proc.stdout
     with h5py.File(tmp_path / "f.h5") as f:
-        assert list(f["fit/model_spread/quantities/0000"].attrs["values"]) == [w]
+        assert f["fit/model_spread/quantities/0000/values"].attrs["truncated_gaussian:3"] == w
         assert f["fit/model_spread"].attrs["description"]
 
 
 def test_a_study_refuses_the_spreads_options(tmp_path):
     """A study's cases compute no spread: asking for one is refused in one line, exit 2, nothing written;
-    so is asking -fit_curve for one."""
+    so is asking one solve (-adh_lambda) or -fit_curve for one."""
     from conftest import run_cli
 
     out = tmp_path / "st.json"
@@ -356,6 +358,10 @@ def test_a_study_refuses_the_spreads_options(tmp_path):
     assert proc.returncode == 2 and not out.exists()
     assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread_rules: applies to one run's curve or "
                                    "-fit_pull_off, not a study of many cases; remove it")
+    proc = run_cli("-adh_sigma", "0.2", "-adh_lambda", "-1", "-adh_model_spread", "true", "-summary", out)
+    assert proc.returncode == 2 and not out.exists()
+    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: applies to one run's curve or "
+                                   "-fit_pull_off, not -adh_lambda (one solve); remove it")
     proc = run_cli("-fit_curve", tmp_path / "c.csv", "-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9",
                    "-adh_model_spread", "false", "-summary", out)
     assert proc.returncode == 2 and not out.exists()

@@ -109,11 +109,11 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
               "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
-    if is_study(opts):                 # a study's cases report no spread: an option asking for one is refused
+    if is_study(opts) or lam is not None:    # no spread of a study's cases nor of one solve: asking is refused
         for name in ("adh_model_spread", "adh_model_spread_rules"):
             if opts.db.hasName(name):
-                raise InputError(f"-{name}: applies to one run's curve or -fit_pull_off, not a study of many "
-                                 "cases; remove it")
+                what = "-adh_lambda (one solve)" if lam is not None else "a study of many cases"
+                raise InputError(f"-{name}: applies to one run's curve or -fit_pull_off, not {what}; remove it")
         spread_rules = None
     else:
         spread_rules = read_model_spread(opts, model)

@@ -51,8 +51,9 @@ DESCRIBE_FIT = {
     "fit/model_spread": ("value, err, values, spread: J/m^2; relative: 1; wall_time_s, rule_times_s: s",
                          "gamma's model spread (a pull-off fit with roughness, docs/model.md): the same root solve "
                          "under the other roughness laws (rules), on the grid without bars; quantities/0000: "
-                         "gamma under the reference's law with its bar, under each rule (NaN: not solved for, "
-                         "missing says why), the spread, relative and warning"),
+                         "gamma under the reference's law with its bar, the spread, relative and warning; its "
+                         "group values: gamma under each rule, one attribute per rule (absent: not solved for, "
+                         "missing says why)"),
 }
 
 

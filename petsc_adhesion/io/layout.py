@@ -76,10 +76,11 @@ DESCRIBE = {
     "model_spread/quantities": ("", "one group per event quantity of the reference curve"),
     "model_spread/quantities/*": (f"value, err, values, spread: the quantity's unit (lambda: {_EPS}; F: {_LOAD}; "
                                   "energy: 2 pi R gamma epsilon); relative: 1",
-                                  "one quantity: its value and error bar under the reference's law, its values "
-                                  "under each rule in their order (NaN where that law's curve has not the event: "
-                                  "missing says why), the spread (the largest distance from the reference), "
-                                  "relative to the value (lambda's to at least 1) and the warning"),
+                                  "one quantity: its value and error bar under the reference's law, the spread "
+                                  "(the largest distance from the reference), relative to the value (lambda's to "
+                                  "at least 1), the warning, and missing: why a law has not the quantity"),
+    "model_spread/quantities/*/values": ("the quantity's unit", "the quantity under each rule, one attribute per "
+                                         "rule named by it; a rule whose curve has not the event absent"),
     "summary": (f"{_STATE}; {_ERRORS}; *_s: s; *_nm: nm; *_nN: nN", "the JSON summary (docs/output.md); "
                 "physical: its events in nm and nN"),
     "study": ("", "a study (kind: study): what its cases compute, the options swept, ranks per case, the figure"),
@@ -124,10 +125,11 @@ def _h5_summary(summary: dict) -> dict:
 
 
 def spread_tree(spread) -> dict:
-    """The HDF5 group ``model_spread``: the summary's record with a law's missing value NaN (its reason in
-    ``missing``), so that a quantity's values are one array."""
+    """The HDF5 group ``model_spread``: the summary's record, a quantity's values a group ``values`` of one
+    attribute per law that has it, named by the rule (a law without it absent, its reason in ``missing``:
+    no NaN, no 0 in its place)."""
     rec = spread_record(spread)
-    quantities = [{**q, "values": [np.nan if v is None else v for v in q["values"]]}
+    quantities = [{**q, "values": {r: v for r, v in zip(rec["rules"], q["values"]) if v is not None}}
                   for q in rec.get("quantities", [])]
     return {**rec, **({"quantities": quantities} if quantities else {})}
 
