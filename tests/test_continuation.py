@@ -159,7 +159,7 @@ def folds_of(summary):
 #: -1.7 (between snap-off -1.74 and snap-on -1.63: three states) and 0 (Fig. 12)
 MU1 = ("-adh_mu", "1", "-grid_type", "paper", "-cont_at_lambda", "-3,-1.7,0", "-profiles")
 #: the paper's grid and truncated model on [0, 10] (docs/numerics.md)
-PAPER_MODEL = ("-grid_type", "paper", "-adh_farfield", "false")
+PAPER_MODEL = ("-grid_type", "paper", "-adh_farfield", "false", "-adh_model_spread", "false")
 #: mu = 0.01: a denser curve (ds_max 0.05) for the comparison with eq. (28)
 DMT = ("-grid_type", "paper", "-cont_ds_max", "0.05", "-cont_at_lambda", "0", "-profiles")
 

@@ -73,7 +73,7 @@ def test_a_flat_pull_off_gets_its_bar(tmp_path):
     levels its lambda lies 0.024 back, behind the first point of the step that found it.  Its levels'
     traces start a step further back: it has a bar (before: none, 'not found again'), and the bars cover
     a run refined to 1e-6 (measured: lambda 2.7e-3 off with a bar of 6.8e-3, F 1.1e-6 with 2.8e-6)."""
-    args = ("-adh_mu", 3, "-adh_sigma", 0.2, "-cont_F_max", 0)
+    args = ("-adh_mu", 3, "-adh_sigma", 0.2, "-cont_F_max", 0, "-adh_model_spread", "false")
     po, ref = (summary(tmp_path, name, *args, *extra)["pull_off"]
                for name, extra in (("run", ()), ("refined", ("-target_error", 1e-6))))
     assert "error_note" not in po and ref["lambda_err"] <= 1e-6 and ref["F_err"] <= 1e-6

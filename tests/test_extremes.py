@@ -29,7 +29,7 @@ def test_tiny_mu_is_the_rigid_limit(tmp_path):
 def test_large_roughness(tmp_path, mu):
     """sigma = 2: the wall of the 16-point rule is at H = 12.26; the attraction is weak and
     spread out, the reduction of the pull-off above 99% and nearly independent of mu."""
-    s, h5 = trace(tmp_path, "-adh_mu", mu, "-adh_sigma", 2)
+    s, h5 = trace(tmp_path, "-adh_mu", mu, "-adh_sigma", 2, "-adh_model_spread", "false")
     import h5py
     with h5py.File(h5) as f:
         H0 = f["curve/H0"][()]
@@ -95,7 +95,7 @@ def hardest(tmp_path_factory):
     from test_cli import run_all
     d = tmp_path_factory.mktemp("hardest")
     procs = run_all({c: (("-adh_mu", c[0], "-adh_sigma", c[1], "-cont_F_max", 0.2, "-cont_error_estimate", "false",
-                          "-summary", d / f"{c[0]}_{c[1]}.json"), {}) for c in HARDEST})
+                          "-adh_model_spread", "false", "-summary", d / f"{c[0]}_{c[1]}.json"), {}) for c in HARDEST})
     return {c: (p, d / f"{c[0]}_{c[1]}.json") for c, p in procs.items()}
 
 
@@ -137,7 +137,8 @@ def test_two_ranks_pass_the_stiff_folds_as_one_does(tmp_path, case):
     """Two ranks trace one rank's curve through every fold.  With block Jacobi on two ranks (the default
     before), GMRES could not converge beside the primary snap-off, where G_H is singular: both cases stopped
     there ("step below -cont_ds_min" at lambda = -8.19 and -12.58) with one fold pair found."""
-    args = ("-adh_mu", case[0], "-adh_sigma", case[1], "-cont_F_max", 0.2, "-cont_error_estimate", "false")
+    args = ("-adh_mu", case[0], "-adh_sigma", case[1], "-cont_F_max", 0.2, "-cont_error_estimate", "false",
+            "-adh_model_spread", "false")
     runs = []
     for np_ in (1, 2):
         js = tmp_path / f"np{np_}.json"

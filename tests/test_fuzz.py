@@ -230,6 +230,8 @@ class Generator:
             case.add("-adh_sigma", _num(sigma))
             if sigma > 0 and self.chance(0.2):
                 case.add("-adh_hermite_points", self.pick([2, 4, 8, 16, 20]))
+            if sigma > 0 and curve:     # the model spread's four more curves are past HANG (test_model_spread.py)
+                case.add("-adh_model_spread", "false")
         if self.chance(0.1):
             case.add("-adh_pmat", "band", "-adh_pmat_band", int(self.rng.integers(0, 30)))
         elif self.chance(0.1):

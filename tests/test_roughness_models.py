@@ -15,7 +15,7 @@ import pytest
 from test_cli import plain_error, run_all
 
 GRID = ("-adh_mu", "1", "-grid_type", "uniform", "-grid_n", "201", "-adh_rmax", "10", "-cont_F_max", "0.2",
-        "-cont_error_estimate", "false")
+        "-cont_error_estimate", "false", "-adh_model_spread", "false")
 TG = ("-adh_roughness", "truncated_gaussian")
 WB = ("-adh_roughness", "weibull", "-adh_roughness_skewness", "-1")
 POINTS = (3, 6, 12, 24, 48)

@@ -118,7 +118,7 @@ def test_rough_soft_sphere_bars_cover_finer_grids(tmp_path):
     runs = {}
     for name, extra in (("default", ()), ("fine", ("-target_error", "3e-6"))):
         js = tmp_path / f"{name}.json"
-        proc = run_cli("-adh_mu", 100, "-adh_sigma", 1, *extra, "-summary", js)
+        proc = run_cli("-adh_mu", 100, "-adh_sigma", 1, "-adh_model_spread", "false", *extra, "-summary", js)
         assert proc.returncode == 0, proc.stderr
         runs[name] = json.loads(js.read_text())
     d, f = runs["default"], runs["fine"]

@@ -32,7 +32,7 @@ from ..model.physical import Bodies
 from ..tracing.curve import Program
 from ..tracing.trace import GridChoice
 from .options.checks import check_petsc_values, check_unused
-from .options.reading import AppOptions, read_grid, read_solver
+from .options.reading import AppOptions, read_grid, read_model_spread, read_solver
 from .options.table import ROUGHNESS_OPTIONS, TABLE
 from .optionsfile import options_files
 
@@ -44,7 +44,7 @@ FIT_OPTIONS = {"phys_radius", "phys_radius2", "phys_young1", "phys_poisson1", "p
                "phys_epsilon", "phys_rms", "phys_spring", "adh_roughness", "adh_rmax", "adh_farfield", "adh_pmat",
                "adh_pmat_band", "adh_pc_reuse_its", "grid_type", "grid_n", "grid_paper_uniform", "grid_paper_extra",
                "grid_paper_split", "grid_paper_refine_from", "out", "summary", "plot", "csv",
-               *ROUGHNESS_OPTIONS}
+               "adh_model_spread", "adh_model_spread_rules", *ROUGHNESS_OPTIONS}
 _OUTPUTS = ("out", "summary", "plot", "csv")
 #: Points per leg of the fitted model's curve in the files.
 MODEL_POINTS = 400
@@ -78,6 +78,7 @@ class FitRequest:
     spring: Spring | None       # curve: the cantilever
     choice: FitChoice | None    # curve: what is fitted
     targets: dict
+    spread_rules: tuple | None = None   # pull_off: the laws of gamma's model spread (None: none)
 
 
 def _given(opts: AppOptions, name: str) -> bool:
@@ -183,8 +184,11 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
                     young2=opts.real("phys_young2"), poisson2=opts.real("phys_poisson2"), rms=rms)
     if kind == "pull_off":
         req = FitRequest("pull_off", model, grid, solver, bodies, pull, opts.real("fit_pull_off_err"), None, None,
-                         None, targets)
+                         None, targets, read_model_spread(opts, model))
     else:
+        for name in ("adh_model_spread", "adh_model_spread_rules"):
+            if _given(opts, name):
+                raise InputError(f"-{name}: applies to a curve's run or -fit_pull_off, not -fit_curve; remove it")
         if fit_rough and model.roughness == "none":
             raise InputError("-fit_roughness: not with -adh_roughness none (a smooth surface)")
         check_input("fit_curve", path)
@@ -214,7 +218,7 @@ def _fit(req: FitRequest, comm):
     try:
         if req.kind == "pull_off":
             return fit_pull_off(req.P, req.bodies, req.P_err, model=req.model, grid=req.grid, solver=req.solver,
-                                comm=comm)
+                                comm=comm, spread_rules=req.spread_rules)
         return fit_curve(req.data, req.bodies, req.spring, req.choice, model=req.model, grid=req.grid,
                          solver=req.solver, comm=comm)
     except PullOffFitError as e:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import sys
 from contextlib import nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from petsc4py import PETSc
 
@@ -28,6 +28,7 @@ from ..io.resultset import PLOT_FORMATS, check_targets, mark_done, written
 from ..io.write import write_curve, write_solve
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
+from ..tracing.model_spread import model_spread
 from ..tracing.trace import (
     CurveRequest,
     GridChoice,
@@ -47,6 +48,7 @@ from .options.reading import (
     AppOptions,
     read_grid,
     read_model,
+    read_model_spread,
     read_request,
     read_settings,
     read_solver,
@@ -84,6 +86,7 @@ class Request:
     guess: str | None                 # -adh_guess
     targets: dict                     # option -> output path
     inputs: dict                      # option -> paths read
+    spread_rules: tuple | None = None  # the laws of the model spread (-adh_model_spread), None: none
 
 
 def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False) -> Request:
@@ -106,8 +109,16 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
               "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
+    if is_study(opts) or lam is not None:    # no spread of a study's cases nor of one solve: asking is refused
+        for name in ("adh_model_spread", "adh_model_spread_rules"):
+            if opts.db.hasName(name):
+                what = "-adh_lambda (one solve)" if lam is not None else "a study of many cases"
+                raise InputError(f"-{name}: applies to one run's curve or -fit_pull_off, not {what}; remove it")
+        spread_rules = None
+    else:
+        spread_rules = read_model_spread(opts, model)
     return Request(model, grid_choice, read_solver(opts), read_settings(opts, model), read_request(opts, kinds, profiles, model.bodies),
-                   lam, opts.string("adh_guess"), targets, inputs)
+                   lam, opts.string("adh_guess"), targets, inputs, spread_rules)
 
 
 def execute(opts: AppOptions, argv: list[str], report: bool = True):
@@ -127,6 +138,9 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         with ck.on_interrupt():
             result = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, checkpoint=ck,
                                  progress=progress, started=lambda: check_unused(db=opts.db))
+            if req.spread_rules is not None:   # the same curve under the other laws, events only
+                result = replace(result, spread=model_spread(result, req.model, req.grid, req.solver, req.settings,
+                                                             req.curve, req.spread_rules, comm=comm))
     else:
         guess = None if req.guess is None else \
             collective(comm, read_guess, req.guess, pressure_law(req.model).wall)

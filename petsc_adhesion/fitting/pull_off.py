@@ -21,6 +21,11 @@ Beside it, what the closed forms would have said: DMT's w = P / (2 pi R), JKR's
 w = P / (1.5 pi R) and Maugis-Dugdale's, solved self-consistently in the same way with
 its pull-off at lambda_MD = 1.157 mu (:mod:`~petsc_adhesion.model.reference.maugis_dugdale`;
 a smooth surface: the roughness does not enter it).
+
+With roughness, gamma's model spread (``spread_rules``;
+:mod:`~petsc_adhesion.tracing.model_spread`): the same root solve under each other
+roughness law, on the grid without bars, the largest distance from gamma and the
+warning of a curve's spread (beyond ten of gamma's bars or 10 % of it).
 """
 from __future__ import annotations
 
@@ -28,6 +33,7 @@ import math
 import time
 import warnings
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from .. import brent
 from ..model.parameters import Model, tabor
@@ -36,6 +42,9 @@ from ..model.reference.maugis_dugdale import maugis_dugdale_pull_off
 from ..tracing.measured import Measured, Missing
 from .forward import curve_stop_reason, pull_off_values
 from .results import BOUND_MARGIN, ClosedForm, PullOffFit, undetermined
+
+if TYPE_CHECKING:                    # tracing.model_spread traces curves: loaded where a spread is made
+    from ..tracing.model_spread import ModelSpread
 
 __all__ = ["PullOffFit", "PullOffFitError", "fit_pull_off", "model_pull_off", "maugis_dugdale_gamma", "MU_RANGE",
            "closed_forms"]
@@ -98,7 +107,7 @@ def maugis_dugdale_gamma(P: float, R: float, E: float, epsilon: float) -> float:
 
 
 def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | None = None, grid=None, solver=None,
-                 comm=None, rtol: float = 1e-7) -> PullOffFit:
+                 comm=None, rtol: float = 1e-7, spread_rules: tuple | None = None) -> PullOffFit:
     """The work of adhesion whose model pull-off is the measured ``P`` (N, its magnitude), with its bar (see
     the module for the equations).
 
@@ -114,6 +123,9 @@ def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | No
         As :func:`~petsc_adhesion.tracing.trace.trace_curve`'s.
     rtol
         The relative tolerance of w on the grid.
+    spread_rules
+        The roughness laws (:class:`~petsc_adhesion.tracing.model_spread.Rule`) gamma is solved for again,
+        its model spread (None: none; a rough model only).
 
     Returns the :class:`~petsc_adhesion.fitting.results.PullOffFit`, its ``warnings`` saying where it does
     not hold (mu at a bound of the model's range; w undetermined, Missing then).  Raises
@@ -138,8 +150,8 @@ def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | No
 
     lo_w, hi_w = w_of(MU_RANGE[0]), w_of(MU_RANGE[1])
 
-    def model_at(w):
-        return replace(template, mu=mu_of(w), sigma=sigma, bodies=replace(bodies, gamma=w, hamaker=None))
+    def model_at(w, law=template):
+        return replace(law, mu=mu_of(w), sigma=sigma, bodies=replace(bodies, gamma=w, hamaker=None))
 
     cache = {}
 
@@ -154,6 +166,13 @@ def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | No
 
     def g(lnw: float) -> float:
         return math.log(2 * math.pi * R * math.exp(lnw) * pull(lnw) / P)
+
+    def root_under(law: Model, x0: float) -> float:
+        """w of the same root solve under another roughness law, on the grid (no bar)."""
+        def g_law(lnw: float) -> float:
+            F = pull_off_values(model_pull_off(model_at(math.exp(lnw), law), grid, solver, comm=comm))[0]
+            return math.log(2 * math.pi * R * math.exp(lnw) * abs(F) / P)
+        return math.exp(_solve(g_law, x0, math.log(lo_w), math.log(hi_w), rtol, P, mu_of))
 
     w_md = maugis_dugdale_gamma(P, R, E, eps)
     if w_md > hi_w * 1.5:
@@ -175,11 +194,41 @@ def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | No
     lnw -= math.log(abs(F_best) / abs(Fg)) / slope_w       # one Newton step onto the best pull-off
     w = math.exp(lnw)
     gamma, warned = _verdict(w, F_best, F_err, P, P_err, slope_w, mu_of(w))
+    spread = None if spread_rules is None else \
+        _gamma_spread(gamma, replace(template, sigma=sigma), tuple(spread_rules), lambda law: root_under(law, lnw))
     return PullOffFit(P=Measured(P, P_err), gamma=gamma, mu=mu_of(w), sigma=sigma,
                       F=Measured(F_best, F_err, Fg, None if F_err is not None else "no bar: the grids did not nest"),
                       dlnF_dlnmu=dlnF_dlnmu, closed_forms=closed_forms(P, bodies), curves=len(cache) + 1,
                       wall_time_s=time.perf_counter() - t0, bodies=replace(bodies, gamma=w, hamaker=None),
-                      history=tuple(history), warnings=tuple(warned))
+                      history=tuple(history), warnings=tuple(warned), spread=spread)
+
+
+def _gamma_spread(gamma, model: Model, rules: tuple, root) -> ModelSpread | Missing:
+    """gamma's model spread: ``root(law)``, the work of adhesion of the same pull-off under each law of
+    ``rules`` (the curves on the grid, no bars), against ``gamma`` under ``model``'s law, with the warning
+    rule of a curve's spread (ten bars or 10 %); a law whose root fails is Missing with its reason."""
+    from ..tracing.model_spread import ModelSpread, Rule, spread_quantity
+
+    reference = Rule.of(model)
+    if model.roughness == "none" or model.sigma == 0:
+        return Missing("a smooth surface (sigma = 0): there is no roughness law to vary")
+    if reference in rules:
+        raise ValueError(f"{reference.label}: the reference's own law, not an alternative to it")
+    if isinstance(gamma, Missing):
+        return Missing(f"gamma is undetermined under {reference.label}: no value to spread about")
+    values: list[Measured | Missing] = []
+    notes, times = [], []
+    t0 = time.perf_counter()
+    for rule in rules:
+        t = time.perf_counter()
+        try:
+            values.append(Measured(root(rule.model(model))))
+        except (PullOffFitError, RuntimeError, FloatingPointError) as why:
+            values.append(Missing(f"{rule.label}: {why}"))
+            notes.append(f"{rule.label}: gamma could not be solved for ({why})")
+        times.append(time.perf_counter() - t)
+    q = spread_quantity("work of adhesion gamma", "gamma", gamma, tuple(values), rules, reference)
+    return ModelSpread(reference, rules, (q,), tuple(notes), time.perf_counter() - t0, tuple(times))
 
 
 def _verdict(w: float, F: float, F_err: float | None, P: float, P_err: float, slope_w: float,

@@ -188,7 +188,9 @@ class PullOffFit:
     (0: exact); ``gamma`` (J/m^2) Measured or Missing; ``mu`` (eq. 9) and ``sigma`` of the model at gamma;
     ``F`` the model's pull-off there (2 pi R gamma; its value on the grid, ``grid``); ``dlnF_dlnmu`` the slope
     of |F_p| against mu; ``closed_forms`` what DMT, JKR and Maugis-Dugdale say; ``curves`` traced,
-    ``history`` the secant's (gamma, mu, F on the grid); ``warnings`` why it does not hold."""
+    ``history`` the secant's (gamma, mu, F on the grid); ``warnings`` why it does not hold; ``spread``: gamma
+    under other roughness laws (a :class:`~petsc_adhesion.tracing.model_spread.ModelSpread` of the one quantity
+    "gamma"; None where none was asked for), whose warnings leave the fit trustworthy."""
 
     P: Measured
     gamma: Quantity
@@ -202,6 +204,7 @@ class PullOffFit:
     bodies: Bodies = field(repr=False, default=None)
     history: tuple = field(repr=False, default=())
     warnings: tuple = ()
+    spread: object = field(repr=False, default=None)    # ModelSpread | Missing | None: gamma under other laws
 
     @property
     def complete(self) -> bool:

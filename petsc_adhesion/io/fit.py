@@ -17,6 +17,9 @@ import numpy as np
 
 from ..errors import tell
 from ..tracing.measured import Measured, Missing
+from .layout import spread_tree
+from .report import spread_lines
+from .summary import spread_record
 
 __all__ = ["fit_record", "fit_tree", "fit_summary", "write_fit_csv", "report_fit", "DESCRIBE_FIT"]
 
@@ -45,6 +48,12 @@ DESCRIBE_FIT = {
     "fit/data": ("z: m; F, F_fit: N", "the measured curve and the fit at its points: piezo displacement z, force F "
                  "(tensile negative), leg (0 approach, 1 retract), F_fit, used (0: left out, next to a jump)"),
     "fit/model": ("z: m; F_*: N", "the fitted model's force on an even grid of z on the approach and the retract"),
+    "fit/model_spread": ("value, err, values, spread: J/m^2; relative: 1; wall_time_s, rule_times_s: s",
+                         "gamma's model spread (a pull-off fit with roughness, docs/model.md): the same root solve "
+                         "under the other roughness laws (rules), on the grid without bars; quantities/0000: "
+                         "gamma under the reference's law with its bar, the spread, relative and warning; its "
+                         "group values: gamma under each rule, one attribute per rule (absent: not solved for, "
+                         "missing says why)"),
 }
 
 
@@ -107,7 +116,8 @@ def _pull_off_record(fit) -> dict:
             "F_pull_off_err": fit.F.err, "F_pull_off_grid": fit.F.grid, "dlnF_dlnmu": fit.dlnF_dlnmu,
             "closed_forms": forms, "curves_traced": fit.curves, "wall_time_s": fit.wall_time_s,
             "iterations": [{"gamma": g, "mu": m, "F_grid": f} for g, m, f in fit.history],
-            "missing": _missing(gamma=fit.gamma), **_verdict(fit)}
+            "missing": _missing(gamma=fit.gamma), **_verdict(fit),
+            **({"model_spread": spread_record(fit.spread)} if fit.spread is not None else {})}
 
 
 def fit_record(fit) -> dict:
@@ -133,6 +143,8 @@ def fit_tree(head: dict, options: dict, fit, model: dict | None = None) -> dict:
                        "F_fit": np.asarray(fit.F_fit), "used": np.asarray(fit.used).astype(int)}
     if model is not None:
         rec["model"] = {k: np.asarray(v) for k, v in model.items()}
+    if getattr(fit, "spread", None) is not None:       # a law's missing value NaN, as a curve's spread
+        rec["model_spread"] = spread_tree(fit.spread)
     return {**head, "kind": "fit", "options": options, "fit": rec}
 
 
@@ -177,6 +189,8 @@ def report_fit(fit) -> None:
             c = fit.closed_form(key)
             ours = f"{_pct(c.gamma, fit.gamma.value)} from ours; " if isinstance(fit.gamma, Measured) else ""
             out.append(f"  {name:<15} would say gamma = {c.gamma:.6g} J/m^2 ({ours}{c.formula})")
+        if fit.spread is not None:     # gamma under the other roughness laws; its warnings leave the fit trustworthy
+            out += [f"  {line}" for line in spread_lines(fit.spread)]
     else:
         m, f = fit.measured, fit.fitted
         out.append(f"fit of the curve {fit.data.path or ''}: {fit.data.z.size} points, {fit.traces} curves "

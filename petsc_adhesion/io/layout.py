@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .summary import branch_record, event_record, head_of, solve_record, summary_of
+from .summary import branch_record, event_record, head_of, solve_record, spread_record, summary_of
 
-__all__ = ["DESCRIBE", "curve_tree", "study_table", "CRITICAL_KEYS", "critical_table", "with_options", "case_tree", "solve_tree"]
+__all__ = ["DESCRIBE", "curve_tree", "study_table", "CRITICAL_KEYS", "critical_table", "with_options", "case_tree", "solve_tree",
+           "spread_tree"]
 
 # Units of the dimensionless results (docs/model.md)
 _EPS, _LOAD, _RAD, _PRES = "epsilon", "2 pi R gamma", "sqrt(epsilon R)", "8 gamma / (3 epsilon)"
@@ -68,6 +69,18 @@ DESCRIBE = {
     "events/*/landing/r": (_RAD, "the nodes of the grid the landing was located on (-profiles)"),
     "events/*/landing/H": (_EPS, "separation at the nodes after the jump (-profiles)"),
     "events/*/landing/P": (_PRES, "pressure at the nodes after the jump (-profiles)"),
+    "model_spread": ("wall_time_s, rule_times_s: s; force_nN: nN per 2 pi R gamma; approach_nm: nm per epsilon",
+                     "the model spread (docs/model.md): the curve's events traced again, events only, under the "
+                     "other roughness laws (rules) against the reference's; notes where a law has other events; "
+                     "warnings where a law moves an event beyond ten error bars or 10 % of its value"),
+    "model_spread/quantities": ("", "one group per event quantity of the reference curve"),
+    "model_spread/quantities/*": (f"value, err, values, spread: the quantity's unit (lambda: {_EPS}; F: {_LOAD}; "
+                                  "energy: 2 pi R gamma epsilon); relative: 1",
+                                  "one quantity: its value and error bar under the reference's law, the spread "
+                                  "(the largest distance from the reference), relative to the value (lambda's to "
+                                  "at least 1), the warning, and missing: why a law has not the quantity"),
+    "model_spread/quantities/*/values": ("the quantity's unit", "the quantity under each rule, one attribute per "
+                                         "rule named by it; a rule whose curve has not the event absent"),
     "summary": (f"{_STATE}; {_ERRORS}; *_s: s; *_nm: nm; *_nN: nN", "the JSON summary (docs/output.md); "
                 "physical: its events in nm and nN"),
     "study": ("", "a study (kind: study): what its cases compute, the options swept, ranks per case, the figure"),
@@ -108,14 +121,27 @@ def _h5_summary(summary: dict) -> dict:
     out = cycle(summary)
     if out.get("spring"):
         out = {**out, "spring": cycle(out["spring"])}
-    return out
+    return {k: v for k, v in out.items() if k != "model_spread"}     # a group of its own (spread_tree)
+
+
+def spread_tree(spread) -> dict:
+    """The HDF5 group ``model_spread``: the summary's record, a quantity's values a group ``values`` of one
+    attribute per law that has it, named by the rule (a law without it absent, its reason in ``missing``:
+    no NaN, no 0 in its place)."""
+    rec = spread_record(spread)
+    quantities = [{**q, "values": {r: v for r, v in zip(rec["rules"], q["values"]) if v is not None}}
+                  for q in rec.get("quantities", [])]
+    return {**rec, **({"quantities": quantities} if quantities else {})}
 
 
 def curve_tree(curve, options: dict) -> dict:
     """The HDF5 tree of a :class:`~petsc_adhesion.tracing.curve.Curve`: its head, the options of its run, the
-    points, the events and the summary."""
-    return {**with_options(head_of(curve), options), "kind": "curve", "curve": branch_record(curve),
+    points, the events, the summary and the model spread (when computed)."""
+    tree = {**with_options(head_of(curve), options), "kind": "curve", "curve": branch_record(curve),
             "events": [event_record(e) for e in curve.events], "summary": _h5_summary(summary_of(curve))}
+    if curve.spread is not None:
+        tree["model_spread"] = spread_tree(curve.spread)
+    return tree
 
 
 def case_tree(curve, keep: tuple | None = None) -> dict:

@@ -6,6 +6,14 @@ from ..tracing.curve import Curve, Cycle, Event, Solution
 from ..tracing.measured import Measured, Missing
 from .summary import summary_of
 
+
+def spread_lines(spread) -> list[str]:
+    """The console lines of a model spread (:func:`~petsc_adhesion.tracing.model_spread.report_lines`,
+    imported here: it traces curves, and a reader of files need not load PETSc)."""
+    from ..tracing.model_spread import report_lines
+
+    return report_lines(spread)
+
 __all__ = ["report_curve", "report_solve"]
 
 
@@ -54,6 +62,8 @@ def report_curve(curve: Curve) -> None:
             out.append(f"  {f.kind:<8} (K = {sp.K:.4g})  {_pm('Z', f.Z)}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}"
                        f"{_note(f)}")
         out.append(f"  energy of a cycle       {_energy(sp.cycle)}  (spring K = {sp.K:.4g})")
+    if curve.spread is not None:        # the model's spread, apart from the numerical bars above
+        out += [f"  {line}" for line in spread_lines(curve.spread)]
     if curve.model.bodies is not None:
         out += _physical_lines(summary_of(curve)["physical"])
     for w in curve.warnings:

@@ -13,7 +13,7 @@ reaches the JSON and HDF5 files with no change here; the CSV names its columns
 from __future__ import annotations
 
 from dataclasses import fields, is_dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -24,9 +24,10 @@ from ..tracing.measured import Measured, Missing
 
 if TYPE_CHECKING:                    # tracing.critical loads PETSc, which a file reader need not
     from ..tracing.critical import Critical
+    from ..tracing.model_spread import ModelSpread
 
 __all__ = ["event_record", "branch_record", "program_record", "model_record", "head_of", "summary_of",
-           "solve_summary", "cycle_summary", "critical_record", "KEYS"]
+           "solve_summary", "cycle_summary", "critical_record", "spread_record", "KEYS"]
 
 #: A field's name -> the key the files have always used for it.
 KEYS = {"lam": "lambda", "note": "error_note"}
@@ -121,12 +122,46 @@ def cycle_summary(c: Cycle) -> dict:
             **({"energy_note": c.energy.note} if c.energy.note else {})}
 
 
+def spread_record(spread: ModelSpread | Missing) -> dict:
+    """A model spread (:class:`~petsc_adhesion.tracing.model_spread.ModelSpread`) as the files hold it: the
+    reference's law, the other ``rules``, one record per quantity (its ``name``, ``unit``, the reference's
+    ``value`` and ``err``, ``values`` under each rule in their order, null where that law's curve has not
+    the event, with ``missing`` saying why, ``spread``, ``relative`` and ``warning``, each absent where
+    there is none), the ``notes``, ``warnings``, wall times and the units in nN and nm; a Missing spread
+    its ``reason``."""
+    if isinstance(spread, Missing):
+        return {"reason": spread.reason}
+    quantities = []
+    for q in spread.quantities:
+        r = {"name": q.name, "unit": q.unit, "value": q.reference.value,
+             "values": [v.value if isinstance(v, Measured) else None for v in q.values]}
+        if q.reference.err is not None:
+            r["err"] = q.reference.err
+        if any(isinstance(v, Missing) for v in q.values):
+            r["missing"] = [v.reason if isinstance(v, Missing) else "" for v in q.values]
+        if q.spread is not None:
+            r["spread"] = q.spread
+        if q.relative is not None and np.isfinite(q.relative):     # infinite at a reference of 0: absent
+            r["relative"] = q.relative
+        if q.warning:
+            r["warning"] = q.warning
+        quantities.append(r)
+    out = {"reference": spread.reference.label, "rules": [r.label for r in spread.rules],
+           "quantities": quantities, "notes": list(spread.notes), "warnings": spread.warnings,
+           "wall_time_s": spread.wall_time_s, "rule_times_s": list(spread.rule_times_s)}
+    if spread.force_nN is not None:
+        out |= {"force_nN": spread.force_nN, "approach_nm": spread.approach_nm}
+    return out
+
+
 def summary_of(curve: Curve) -> dict:
     """The JSON summary of a traced curve (docs/output.md)."""
     def brief(e):
         return event_record(e, profiles=False)
 
     ev, d, a = curve.events, curve.diagnostics, curve.assessment
+    spread = cast("ModelSpread | Missing | None", curve.spread)
+    spread_warnings = spread.warnings if spread is not None and not isinstance(spread, Missing) else []
     s = {**_common(curve),
          "pull_off": brief(curve.pull_off) if curve.pull_off else None,
          "folds": [brief(e) for e in ev if e.kind in ("snap_on", "snap_off")],
@@ -140,7 +175,9 @@ def summary_of(curve: Curve) -> dict:
          "wall_gap": d.wall_gap, "steps": d.steps, "rejected_steps": d.rejected_steps, "regrids": d.regrids,
          "guard_activations": d.guard_activations, "smallest_step": d.smallest_step,
          "most_newton_its": d.most_newton_its, "most_ksp_its": d.most_ksp_its, "stop_reason": d.stop_reason,
-         "grid_warning": a.grid_warning or "", "warnings": list(a.warnings), "complete": a.complete,
+         "grid_warning": a.grid_warning or "", "complete": a.complete,
+         # the spread's warnings among the run's, though they leave it complete (docs/model.md)
+         "warnings": list(a.warnings) + spread_warnings,
          "lambda_start": d.lambda_start, "wall_time_s": d.wall_time_s}
     if d.error_estimate is not None:
         est = d.error_estimate
@@ -148,6 +185,8 @@ def summary_of(curve: Curve) -> dict:
                                "levels": list(est.levels)}
     if curve.model.bodies is not None:
         s["physical"] = in_units(s, curve.model.bodies.describe())
+    if spread is not None:               # after physical: in_units reads the events, not the spread
+        s["model_spread"] = spread_record(spread)
     return _plain(s)
 
 

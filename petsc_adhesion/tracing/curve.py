@@ -243,7 +243,12 @@ class Curve:
     ``model``: the :class:`~petsc_adhesion.model.parameters.Model` it was computed for; ``program`` and
     ``grid`` records; ``branch``: the points (:class:`Branch`); ``events`` in the order found; ``pull_off``
     the most tensile load minimum (load control; None without one); ``rigid``: the cycle of a rigid machine;
-    ``spring``: behind a spring, its jumps and cycle (else None); ``diagnostics``; ``assessment``.
+    ``spring``: behind a spring, its jumps and cycle (else None); ``diagnostics``; ``assessment``;
+    ``spread``: the events under other roughness laws (:class:`~.model_spread.ModelSpread`), set by the
+    caller that computed it (``dataclasses.replace``; the command line does for every rough run), Missing
+    where it could not be, None where none was asked for (a smooth model, ``-adh_model_spread false``,
+    the library's :func:`~.trace.trace_curve` alone).  It is no part of the assessment: a law that moves an
+    event warns (:attr:`ModelSpread.warnings`) but leaves the curve complete.
     """
 
     model: object = field(repr=False)
@@ -256,6 +261,9 @@ class Curve:
     spring: SpringResult | None
     diagnostics: Diagnostics = field(repr=False)
     assessment: Assessment = field(repr=False)
+    # a ModelSpread | Missing | None, typed object: model_spread traces curves and imports this module, not
+    # the reverse (no import cycle, not even for the checker)
+    spread: object = field(default=None, repr=False)
 
     @property
     def complete(self) -> bool:

@@ -13,8 +13,9 @@ twice the points, and laws whose averages converge because their heights are bou
 above (the truncated Gaussian at K = 3 and 4, the reversed Weibull of skewness 0), or
 the rules the caller names; and returns a :class:`ModelSpread`: for every event
 quantity of the reference curve its value under each law, the largest distance from
-the reference, and a warning where that spread exceeds both ten error bars and 10 %
-of the value.  Events are matched by kind and order; a law with another set of events
+the reference, and a warning where that spread exceeds ten error bars or 10 % of
+the value (either: the bar alone then misleads, or the law moves the answer by more
+than the rms is usually known to).  Events are matched by kind and order; a law with another set of events
 (no hysteresis, say) is that spread itself, and is said so, not an error.
 
 A traced curve is read through one function, :func:`curve_values`, into
@@ -31,12 +32,12 @@ from .measured import Measured, Missing
 from .trace import CurveRequest, GridChoice, SolverChoice, trace_curve
 
 __all__ = ["Rule", "EventValues", "CurveValues", "Quantity", "ModelSpread", "curve_values", "parse_rules",
-           "default_rules", "model_spread", "report_lines", "WARN_BARS", "WARN_RELATIVE", "KINDS", "LAWS"]
+           "default_rules", "model_spread", "spread_quantity", "report_lines", "WARN_BARS", "WARN_RELATIVE", "KINDS", "LAWS"]
 
 #: A spread warns when it exceeds this many error bars of the reference value ...
 WARN_BARS = 10.0
-#: ... and this fraction of its magnitude: below it the law changes the answer by less than
-#: a surface's rms is usually known to, however small the numerical bar.
+#: ... or this fraction of its magnitude, however large the bar: beyond it the law changes the answer
+#: by more than a surface's rms is usually known to.
 WARN_RELATIVE = 0.1
 #: The event kinds compared, matched by kind and order (the pull-off, the most tensile F_min, apart).
 KINDS = ("snap_on", "snap_off", "equilibrium", "jump_in", "jump_off")
@@ -148,21 +149,15 @@ class CurveValues:
 
 
 def curve_values(curve) -> CurveValues:
-    """The values of a traced curve the spread compares: the one function that reads the curve's type.
-
-    Today's :class:`~.curve.Curve` holds an event's value and bar as ``lam``, ``lam_err``, ``F``,
-    ``F_err`` and the cycle's energy as ``curve.energy`` = (energy, bar).
-    """
+    """The values of a traced :class:`~.curve.Curve` the spread compares: the one function that reads the
+    curve's type (an event's ``lam`` and ``F`` are :class:`~.measured.Measured`, the rigid machine's cycle
+    energy Measured or Missing, completeness the curve's assessment)."""
     def values(e) -> EventValues:
-        return EventValues(e.kind, Measured(e.lam, e.lam_err, e.lam_grid, e.note),
-                           Measured(e.F, e.F_err, e.F_grid, e.note))
+        return EventValues(e.kind, e.lam, e.F)
 
-    energy, bar = curve.energy
     return CurveValues(events=tuple(values(e) for e in curve.events if e.kind in KINDS),
                        pull_off=None if curve.pull_off is None else values(curve.pull_off),
-                       energy=Measured(energy, bar) if energy is not None else
-                       Missing("the cycle of the rigid machine was not closed"),
-                       complete=curve.complete)
+                       energy=curve.rigid.energy, complete=curve.complete)
 
 
 @dataclass(frozen=True)
@@ -174,7 +169,7 @@ class Quantity:
     of :attr:`ModelSpread.rules`, in their order, Missing where the law's curve has no such event;
     ``spread``: the largest distance from the reference over the laws that have it (None: none has);
     ``relative``: that over the reference's magnitude (for lambda at least 1, epsilon: its zero is a
-    convention); ``warning``: one line where the spread exceeds both :data:`WARN_BARS` bars and
+    convention); ``warning``: one line where the spread exceeds :data:`WARN_BARS` bars or
     :data:`WARN_RELATIVE` of the value (None else).
     """
 
@@ -271,8 +266,9 @@ def _advice(reference: Rule) -> str:
             "measured heights (-adh_roughness measured -adh_roughness_file)")
 
 
-def _quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, reference: Rule) -> Quantity:
-    """The spread of one quantity (the distances of the laws that have it) and its warning."""
+def spread_quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, reference: Rule) -> Quantity:
+    """The spread of one quantity (the distances of the laws that have it) and its warning; also of a quantity
+    not of a curve (the work of adhesion of a pull-off fit, :mod:`~petsc_adhesion.fitting.pull_off`)."""
     dist = [(abs(v.value - ref.value), r) for v, r in zip(values, rules) if isinstance(v, Measured)]
     if not dist:
         return Quantity(name, unit, ref, values, None, None, None)
@@ -283,11 +279,12 @@ def _quantity(name: str, unit: str, ref: Measured, values: tuple, rules: tuple, 
     scale = max(abs(ref.value), 1.0) if unit == "lambda" else abs(ref.value)
     relative = spread / scale if scale else (0.0 if spread == 0 else math.inf)
     bar = ref.err if ref.err is not None and math.isfinite(ref.err) else 0.0    # no bar: the 10 % alone
-    limit = max(WARN_BARS * bar, WARN_RELATIVE * scale)
+    # either bar is reason to warn: past ten error bars the law matters more than the numerics (the bar
+    # alone would mislead), past 10 % it matters to a user who knows the rms to 10 % at best
     warning = None
-    if spread > limit:
+    if (bar > 0 and spread > WARN_BARS * bar) or spread > WARN_RELATIVE * scale:
         far_value = next(v for v, r in zip(values, rules) if r == far).value
-        size = [] if math.isinf(relative) else [f"{100 * relative:.0f}% of the value"]
+        size = [] if math.isinf(relative) else [f"{100 * relative:.3g}% of the value"]
         if bar:
             size.append(f"{spread / bar:.2g} times its error bar")
         warning = (f"the {name} is {ref.value:.6g} under {reference.label} and {far_value:.6g} under "
@@ -343,11 +340,11 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
         for attr, unit in fields:
             values = tuple(_missing(rule, alt, name) if pairs[i][1] is None else getattr(pairs[i][1], attr)
                            for rule, alt, pairs in zip(rules, alts, matched))
-            quantities.append(_quantity(f"{name} {unit}", unit, getattr(e, attr), values, rules, reference))
+            quantities.append(spread_quantity(f"{name} {unit}", unit, getattr(e, attr), values, rules, reference))
     if isinstance(ref.energy, Measured):
         values = tuple(Missing(f"{rule.label}: its curve could not be traced") if alt is None else alt.energy
                        for alt, rule in zip(alts, rules))
-        quantities.append(_quantity("energy of a cycle", "energy", ref.energy, values, rules, reference))
+        quantities.append(spread_quantity("energy of a cycle", "energy", ref.energy, values, rules, reference))
     bodies = model.bodies
     units = bodies.scales() if bodies is not None else None
     return ModelSpread(reference, rules, tuple(quantities), tuple(notes), wall, times,
