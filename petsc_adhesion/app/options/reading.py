@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import re
+from typing import Any
 
 import numpy as np
 from petsc4py import PETSc
@@ -280,7 +281,8 @@ def read_physical(opts: AppOptions) -> Bodies | None:
     # each input's share of log mu (eq. 9), against a 1 um polymer sphere: the option that moved mu most is named
     shares = {"phys_radius": math.log(bodies.R / 1e-6) / 3,
               ("phys_gamma" if "gamma" in given else "phys_hamaker"): 2 * math.log(bodies.work_of_adhesion / 0.05) / 3,
-              ("phys_young2" if bodies.young2 is not None and bodies.young2 < bodies.young1 else "phys_young1"):
+              ("phys_young2" if bodies.young1 is not None and bodies.young2 is not None and bodies.young2 < bodies.young1
+               else "phys_young1"):
                   -2 * math.log(bodies.E / 1e9) / 3,
               "phys_epsilon": -math.log(bodies.epsilon / 4e-10)}
     logmu = math.log(tabor(1e-6, 0.05, 1e9, 4e-10)) + sum(shares.values())
@@ -385,7 +387,8 @@ def read_petsc(opts: AppOptions, prefix: str) -> PetscSettings:
     the database, each marked read here.  An option no solver reads (misspelt, or for a PC not chosen) reaches
     the solver all the same and is left unread there (:func:`~.checks.check_unused` names it)."""
     others = tuple(p for p in ROLE_PREFIXES.values() if p and p != prefix)
-    kw, extra = {}, {}
+    kw: dict[str, Any] = {}
+    extra: dict[str, str | None] = {}
     for name in opts.db.getAll():
         bare = name[len(prefix):]
         if not name.startswith(prefix) or name in TABLE or (not prefix and name.startswith(others)) \
