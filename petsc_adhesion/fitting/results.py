@@ -23,11 +23,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..model.physical import Bodies
 from ..tracing.measured import Measured, Missing
+
+if TYPE_CHECKING:
+    from .curve_fit import FittedModel
 
 __all__ = ["Spring", "FitChoice", "Features", "FittedFeatures", "ClosedForm", "CurveFit", "PullOffFit",
            "BOUND_MARGIN", "MISFIT_P", "Z95", "NOISE_DOF_PER_DIFFERENCE", "misfit_p", "undetermined", "misfit"]
@@ -163,7 +167,7 @@ class CurveFit:
     wall_time_s: float = 0.0
     notes: tuple = ()
     warnings: tuple = ()
-    forward: object = field(default=None, repr=False)
+    forward: FittedModel | None = field(default=None, repr=False)
 
     @property
     def reduced_chi2(self) -> float:
@@ -199,7 +203,7 @@ class PullOffFit:
     closed_forms: tuple
     curves: int
     wall_time_s: float
-    bodies: Bodies = field(repr=False, default=None)
+    bodies: Bodies | None = field(repr=False, default=None)
     history: tuple = field(repr=False, default=())
     warnings: tuple = ()
 
