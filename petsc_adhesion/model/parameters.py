@@ -8,10 +8,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .roughness import NEAR_POINTS, Measured
+
+if TYPE_CHECKING:
+    from .physical import Bodies
 
 __all__ = ["Model", "tabor", "scales"]
 
@@ -66,7 +70,7 @@ class Model:
     heights: np.ndarray | None = field(default=None, repr=False, compare=False)  # measured, units of epsilon
     farfield: bool = True      # add the rigid sphere's attraction beyond r_m (the half-infinite model)
     #: the physical inputs that made mu (and sigma): results are reported in SI too (None: dimensionless only)
-    bodies: object = field(default=None, repr=False, compare=False)
+    bodies: Bodies | None = field(default=None, repr=False, compare=False)
 
     def with_parameter(self, name: str, value: float) -> Model:
         """This model with ``name`` (mu or sigma) set to ``value`` (and no physical inputs, which made the old
