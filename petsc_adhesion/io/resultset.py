@@ -274,7 +274,7 @@ class ResultSet:
         self.temps = {}
 
 
-def mark_done(e: Interrupted, files: ResultSet | None, status: int) -> None:
+def mark_done(e: Interrupted, files: ResultSet | None, status: int | None) -> None:
     """A signal that came once ``files`` were in place ends the run as done with ``status``
     (:attr:`~petsc_adhesion.errors.Interrupted.done`; the command line says so)."""
     if files is not None and files.committed:
