@@ -12,7 +12,7 @@ from petsc4py import PETSc
 from ...errors import InputError, printable
 from ...io.inputs import check_input
 from ...model.heights import HeightFileError, read_heights
-from ...model.parameters import Model
+from ...model.parameters import Model, PhysicalBodies
 from ...model.parameters import tabor
 from ...model.physical import Bodies
 from ...model.roughness import Measured
@@ -428,7 +428,7 @@ def read_solver(opts: AppOptions) -> SolverChoice:
                         **{role: read_petsc(opts, ROLE_PREFIXES[role]) for role in roles})
 
 
-def read_spring(opts: AppOptions, bodies: Bodies | None) -> float | None:
+def read_spring(opts: AppOptions, bodies: PhysicalBodies | None) -> float | None:
     """The stiffness K of the spring the approach is driven through (-afm_spring, or -phys_spring with the
     bodies: K = k epsilon / (2 pi R gamma)), or None for a rigid machine."""
     K, k = opts.real("afm_spring"), opts.real("phys_spring")
@@ -447,7 +447,7 @@ def read_spring(opts: AppOptions, bodies: Bodies | None) -> float | None:
 
 
 def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = False,
-                 bodies: Bodies | None = None) -> CurveRequest:
+                 bodies: PhysicalBodies | None = None) -> CurveRequest:
     """What a curve reports (-cont_lambda_start, -cont_at_lambda, -cont_event_tol, -cont_error_estimate,
     -target_error, -profiles, the spring of -afm_spring or -phys_spring with the ``bodies``); ``kinds`` and
     ``profiles`` as a study's case asks (behind a spring its jumps are reported with any kinds: they are
