@@ -110,7 +110,48 @@ def test_ordinary_curves_either_side_of_the_cusp(study, mu, sigma, pair):
         assert abs(on[0].lam.value - cusp["lambda_c"]) < 0.05 and abs(off[0].lam.value - cusp["lambda_c"]) < 0.05
 
 
+def test_solver_settings_reach_their_solvers_and_keep_the_cusp(study, tmp_path):
+    """-fold_ksp_rtol, -arc_ksp_type (not the defaults: 1e-12 and gmres) honoured: PETSc's own view of every
+    fold-system KSP and every arclength KSP shows them, and sigma_c stays within the default run's bar."""
+    summ, fold_view, arc_view = tmp_path / "c.json", tmp_path / "fold.txt", tmp_path / "arc.txt"
+    proc = run_cli("-study_compute", "critical", "-study_mu", "2", "-summary", summ, "-fold_ksp_rtol", "1e-13",
+                   "-arc_ksp_type", "bcgs", "-fold_ksp_view", f"ascii:{fold_view}", "-arc_ksp_view",
+                   f"ascii:{arc_view}", timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    for view, prefix, line in ((fold_view, "_fold_)", "relative=1e-13,"), (arc_view, "_arc_)", "type: bcgs")):
+        blocks = view.read_text().split("KSP Object: (")[1:]
+        assert len(blocks) > 10, (view, len(blocks))
+        for b in blocks:
+            head = b.split("\n", 1)[0]
+            assert prefix in head and line in b.split("PC Object")[0], b[:400]
+    mine, default = json.loads(summ.read_text())["critical_roughness"][0], study[1]["critical_roughness"][0]
+    assert abs(mine["sigma_c"] - default["sigma_c"]) <= default["sigma_c_err"], (mine["sigma_c"], default)
+
+
+def test_library_refuses_settings_it_cannot_honour():
+    """sigma_c and mu_c make no fixed-approach solve and build dense preconditioners: the rest is refused
+    before any work."""
+    from petsc_adhesion.tracing import critical
+    from petsc_adhesion.tracing.trace import PetscSettings, SolverChoice
+    from petsc_adhesion.model.parameters import Model
+
+    for solver, what in ((SolverChoice(fixed=PetscSettings(ksp_rtol=1e-3)), "solver.fixed"),
+                         (SolverChoice(pmat="band"), "solver.pmat"), ("dense", "solver: expected a SolverChoice")):
+        for call in (critical.sigma_c, critical.mu_c):
+            with pytest.raises(ValueError, match=f"^{what}"):
+                call(Model(rmax=10.0), 2.0, solver=solver)
+
+
 @pytest.mark.parametrize("args, line", [
+    (("-study_compute", "critical", "-study_mu", "2", "-ksp_type", "gmres"),
+     "-ksp_type: -study_compute critical makes no fixed-approach solve; use -nat_ksp_type"),
+    (("-study_compute", "critical", "-study_mu", "2", "-fold_ksp_foo", "3"), "-fold_ksp_foo: unknown option"),
+    (("-study_compute", "critical", "-study_mu", "2", "-arc_ksp_typ", "gmres"),
+     "-arc_ksp_typ: unknown option (did you mean -arc_ksp_type?)"),
+    (("-study_compute", "critical", "-study_mu", "2", "-fold_snes_rtol", "1e-3"),
+     "-fold_snes_rtol: the fold system's bordered solves have a KSP, no SNES"),
+    (("-study_compute", "critical", "-study_mu", "2", "-fold_ksp_rtol", "2"), "-fold_ksp_rtol: expected a real"),
+    (("-study_compute", "critical", "-study_mu", "2", "-adh_pmat", "band"), "-adh_pmat: not with -study_compute critical"),
     (("-study_compute", "critical", "-study_mu", "2", "-study_option", "adh_hermite_points", "-study_values", "8,16"),
      "-study_option: not with -study_compute critical"),
     (("-study_compute", "critical", "-study_mu", "2", "-study_plot", "curves"), "-study_plot: curves draws curves"),

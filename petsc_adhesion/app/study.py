@@ -48,8 +48,8 @@ from ..io.write import write_critical, write_study
 from ..tracing.curve import Program
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
-from .options.checks import check_unused
-from .options.reading import AppOptions, Given, read_model
+from .options.checks import check_petsc_values, check_unused
+from .options.reading import ROLE_PREFIXES, SOLVER_OPTIONS, AppOptions, Given, read_model, read_petsc
 from .options.table import TABLE
 from .optionsfile import options_files
 from .progress import clock
@@ -389,16 +389,25 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
     if opts.db.hasName("study_plot") and opts.choice("study_plot") != "critical":
         raise InputError(f"-study_plot: {opts.choice('study_plot')} draws curves; -study_compute critical "
                          f"draws 'critical'")
+    for name in ("adh_pmat", "adh_pmat_band", "adh_pc_reuse_its"):
+        if opts.db.hasName(name):
+            raise InputError(f"-{name}: not with -study_compute critical, whose preconditioners are dense (the "
+                             f"fold system borders the base problem's); remove it")
     model = collective(world, read_model, opts)
+    solver = collective(world, _critical_solver, opts)
+    collective(world, check_petsc_values, opts.db)
     todo = [Case(i, {name: v}) for i, (name, v) in enumerate((n, v) for n, vals in axes for v in vals)]
     targets, journal = _files(opts, argv, table=False)
+    # every solver made once and freed, before any work: an option nothing reads is refused here
+    from ..tracing.critical import configure_solvers
+    collective(world, configure_solvers, model, solver, world, check_unused)
     if helping:
         return 0
     files = None
     status: int | None = 0
     try:
         with journal.on_interrupt():
-            records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, comm), _cusp_brief,
+            records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, solver, comm), _cusp_brief,
                              journal)
             if mpi.Get_rank() == 0:
                 assert records is not None, "rank 0 holds every case's record"
@@ -423,13 +432,34 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
         raise
 
 
-def _cusp(c: Case, model, comm) -> dict | None:
-    """One case of a critical study: sigma_c at its mu, or mu_c at its sigma."""
+def _critical_solver(opts: AppOptions):
+    """The PETSc settings of a critical study's solvers (:func:`~.options.reading.read_petsc`): the
+    correctors' (-nat_, -arc_) and the fold system's (-fold_).  There is no fixed-approach solve: its
+    options (no prefix) are left unread, and refused as such."""
+    from ..tracing.trace import SolverChoice
+
+    fixed = next((n for n in opts.db.getAll() if n.startswith(SOLVER_OPTIONS)), None)
+    if fixed is not None:
+        raise InputError(f"-{fixed}: -study_compute critical makes no fixed-approach solve; use -nat_{fixed} for "
+                         f"the correctors' natural solves, -arc_{fixed} for their arclength solves, "
+                         f"-fold_{fixed} for the fold system's bordered solves")
+    roles = {role: read_petsc(opts, ROLE_PREFIXES[role]) for role in ("natural", "arclength", "fold")}
+    if roles["fold"].snes_given:
+        name = roles["fold"].snes_given[0]
+        raise InputError(f"-fold_{name}: the fold system's bordered solves have a KSP, no SNES; give its "
+                         f"-fold_ksp_ and -fold_pc_ options, or -nat_{name}, -arc_{name} for the correctors")
+    return SolverChoice(**roles)
+
+
+def _cusp(c: Case, model, solver, comm) -> dict | None:
+    """One case of a critical study: sigma_c at its mu, or mu_c at its sigma, its solvers with ``solver``'s
+    settings."""
     from ..tracing.critical import mu_c, sigma_c
 
     (name, value), = c.values.items()
     try:
-        out = sigma_c(model, value, comm=comm) if name == "adh_mu" else mu_c(model, value, comm=comm)
+        out = sigma_c(model, value, comm=comm, solver=solver) if name == "adh_mu" else \
+            mu_c(model, value, comm=comm, solver=solver)
     except ValueError as e:                        # no cusp in the range searched
         raise RuntimeError(str(e)) from None
     return {"case": c.index, "values": c.values, "kind": out.kind, **critical_record(out)} \

@@ -41,6 +41,14 @@ curve, and its fold event, the turning point of the fold curve in s, is the cusp
    gives the best value and its bar; the finest level once more on a domain
    twice as long adds the truncation's share to the bar.
 
+Every solver takes the PETSc settings of its role from one
+:class:`~petsc_adhesion.tracing.trace.SolverChoice`, as a curve's do: ``natural``
+and ``arclength`` the correctors of the ordinary curves and of the fold curve
+(the command line's ``-nat_``, ``-arc_``), ``fold`` the fold system's bordered
+solves of g (``-fold_``).  The preconditioners are dense (the fold system's is
+the base problem's, bordered), and there is no solve at a fixed approach: a
+choice of another preconditioner, or settings of the fixed role, are refused.
+
 Stage 1 relies on the fold pair being seen on an ordinary curve however narrow
 it is: :class:`~petsc_adhesion.core.events.EventFinder` walks again the steps where
 lambdadot dips toward zero (near the cusp the pair is far narrower than a step).
@@ -57,6 +65,7 @@ from petsc4py import PETSc
 from ..core.continuation import Continuation, Point, Settings
 from ..core.events import EventFinder, Fold, Found
 from ..core.fold import FoldSystem
+from ..core.newton import PC_REUSE_ITS, PetscSettings
 from ..discretization.influence import create_influence
 from ..discretization.preconditioning import Dense
 from ..discretization.problem import Problem, far_approach
@@ -64,13 +73,14 @@ from ..discretization.resolution import cohesive_zone
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
 from ..tracing import results
-from .edge_grids import BAND, grid_for
+from .edge_grids import BAND, RMAX, grid_for
 from .error_bars import extrapolate
 from .measured import Measured
+from .trace import SolverChoice
 from .tracer import Tracer, contact_radius, edge_of
 
 __all__ = ["Critical", "fold_system", "at_parameter", "ordinary_folds", "bracket", "trace_cusp", "sigma_c", "mu_c", "Cusp", "BRACKET",
-           "LEVELS", "SIGMA_START", "SIGMA_RANGE", "MU_START", "MU_RANGE", "FOLD_SETTINGS"]
+           "LEVELS", "SIGMA_START", "SIGMA_RANGE", "MU_START", "MU_RANGE", "FOLD_SETTINGS", "check_solver", "configure_solvers"]
 
 #: The bracket of stage 1 ends when its two values are within this ratio: the fold curve then travels
 #: a short way to the cusp, its contact edge within the fine band of the grid it started on.
@@ -89,14 +99,33 @@ def at_parameter(model, name: str, value: float):
     return model.with_parameter(name, value)
 
 
-def fold_system(model, r: np.ndarray, name: str, s0: float, comm=None) -> FoldSystem[Problem]:
+def check_solver(solver: SolverChoice, call: str = "sigma_c") -> None:
+    """ValueError, one line, for a :class:`~petsc_adhesion.tracing.trace.SolverChoice` the critical calls
+    cannot honour: another type, a preconditioner other than dense, a kept preconditioner's limit other than
+    the default, settings of the fixed-approach solve (a solver they do not make)."""
+    if not isinstance(solver, SolverChoice):
+        raise ValueError(f"solver: expected a SolverChoice, got {type(solver).__name__}")
+    if solver.pmat != "dense" or solver.band != SolverChoice().band:
+        raise ValueError(f"solver.pmat: {call} builds dense preconditioners (the fold system borders the base "
+                         f"problem's); leave pmat and band out")
+    if solver.pc_reuse_its != PC_REUSE_ITS:
+        raise ValueError(f"solver.pc_reuse_its: {call} keeps its preconditioners by the continuation's "
+                         f"Settings.pc_reuse_its; leave it out")
+    if solver.fixed != PetscSettings():
+        raise ValueError(f"solver.fixed: settings of a solver {call} does not make (it makes natural, arclength "
+                         f"and fold); leave them out")
+
+
+def fold_system(model, r: np.ndarray, name: str, s0: float, comm=None,
+                settings: PetscSettings = PetscSettings()) -> FoldSystem[Problem]:
     """The fold system of ``model`` at ``name`` = ``s0`` on the nodes r, continued in ``name``: the adhesion
     problem (:class:`~petsc_adhesion.discretization.problem.Problem`, dense PC) under
-    :class:`~petsc_adhesion.core.fold.FoldSystem`, with x = (H, lambda)."""
+    :class:`~petsc_adhesion.core.fold.FoldSystem`, with x = (H, lambda); ``settings``: the PETSc settings
+    of its bordered solves of g (the role ``fold``)."""
     comm = comm or PETSc.COMM_WORLD
     base = Problem(at_parameter(model, name, s0), r, create_influence(r, comm), Dense())
     try:
-        return FoldSystem(base, name)
+        return FoldSystem(base, name, settings)
     except BaseException:
         base.destroy()
         raise
@@ -126,16 +155,18 @@ def _edge(fs: FoldSystem[Problem], x: np.ndarray, s: float) -> tuple[float, floa
 # -- stage 1: the bracket from ordinary curves ---------------------------------------------
 
 
-def ordinary_folds(model, comm=None) -> list[dict]:
+def ordinary_folds(model, comm=None, solver: SolverChoice = SolverChoice()) -> list[dict]:
     """The turning points of the ordinary load-approach curve of ``model``, in the order of the curve.
 
     Traced as the program traces a curve (:class:`~petsc_adhesion.tracing.tracer.Tracer`, grids that
     follow the contact edge, from far apart) to equilibrium, without error bars.  Each fold is
     {kind (snap_on or snap_off), lambda, F, r, H} with the nodes and H of the grid it was located
-    on (whole, on every rank).  RuntimeError when the curve ends before equilibrium.
+    on (whole, on every rank); its correctors with the ``natural`` and ``arclength`` settings of
+    ``solver``.  RuntimeError when the curve ends before equilibrium.
     """
     settings = Settings(observable="F", observable_max=0.0)
-    tracer = Tracer(model, settings, results.curve_events(), pmat=Dense(), rmax=model.rmax, comm=comm)
+    tracer = Tracer(model, settings, results.curve_events(), pmat=Dense(), rmax=model.rmax, comm=comm,
+                    natural=solver.natural, arclength=solver.arclength)
     try:
         segments = tracer.run(far_approach(model))
         last = segments[-1].cont
@@ -156,7 +187,8 @@ def ordinary_folds(model, comm=None) -> list[dict]:
         tracer.destroy()
 
 
-def bracket(model, name: str, comm=None, ratio: float = BRACKET) -> tuple[float, float, list]:
+def bracket(model, name: str, comm=None, ratio: float = BRACKET,
+            solver: SolverChoice = SolverChoice()) -> tuple[float, float, list]:
     """Values (a, b) of the parameter ``name`` with folds at a and none at b, b/a or a/b within ``ratio``,
     and the folds at a (:func:`ordinary_folds`).
 
@@ -169,7 +201,7 @@ def bracket(model, name: str, comm=None, ratio: float = BRACKET) -> tuple[float,
     found = {}
 
     def probe(s: float) -> bool:
-        found[s] = ordinary_folds(at_parameter(model, name, s), comm)
+        found[s] = ordinary_folds(at_parameter(model, name, s), comm, solver)
         return bool(found[s])
 
     yes = no = None
@@ -244,17 +276,19 @@ def _to_cusp(fp: FoldSystem[Problem], cont: Continuation, start: Point):
 
 
 def trace_cusp(model, name: str, fold: dict, s0: float, direction: int, comm=None,
-               settings: Settings = FOLD_SETTINGS) -> Cusp:
+               settings: Settings = FOLD_SETTINGS, solver: SolverChoice = SolverChoice()) -> Cusp:
     """The cusp reached by continuing the ordinary fold ``fold`` (of :func:`ordinary_folds` at ``name`` =
-    ``s0``) in ``name`` toward ``direction`` (+1: increasing), on the grid it was located on."""
-    fp = fold_system(model, fold["r"], name, s0, comm)
+    ``s0``) in ``name`` toward ``direction`` (+1: increasing), on the grid it was located on; the fold
+    system's solves with the ``fold`` settings of ``solver``, its correctors with ``natural`` and
+    ``arclength``."""
+    fp = fold_system(model, fold["r"], name, s0, comm, solver.fold)
     cont = guess = None
     try:
         x = _state(fp, fold["r"], fold["H"], fold["lambda"])
         fp.adapt(x, s0, sweeps=2)
         guess = fp.create_vec()
         guess.setArray(x)
-        cont = Continuation(fp, settings)
+        cont = Continuation(fp, settings, natural=solver.natural, arclength=solver.arclength)
         start = cont.start(guess, s0, direction)
         return Cusp(fp, cont, _to_cusp(fp, cont, start))
     except BaseException:
@@ -280,7 +314,8 @@ def _design(model, name: str, cusp: Cusp):
     return replace(grid_for(at, peak, 0, model.rmax), band=band)
 
 
-def _relocate(cusp: Cusp, model, name: str, nodes: np.ndarray, direction: int, comm) -> Cusp | None:
+def _relocate(cusp: Cusp, model, name: str, nodes: np.ndarray, direction: int, comm,
+              solver: SolverChoice = SolverChoice()) -> Cusp | None:
     """The cusp of ``cusp`` located again on ``nodes``: from the start of the step that passed it (or an
     earlier point, if that fails), carried there and put on the new fold curve by a zero-length
     arclength correction, traced toward the cusp with steps no longer than that step.  Where the new
@@ -290,9 +325,9 @@ def _relocate(cusp: Cusp, model, name: str, nodes: np.ndarray, direction: int, c
     length = max(pts[j + 1].ds, 1e-3)
     settings = replace(FOLD_SETTINGS, ds=length / 2, ds_max=length, max_steps=40)
     for a in reversed(pts[max(0, j - 3):j + 1]):
-        fp, cont, guess, kept = fold_system(model, nodes, name, a.p, comm), None, None, False
+        fp, cont, guess, kept = fold_system(model, nodes, name, a.p, comm, solver.fold), None, None, False
         try:
-            cont = Continuation(fp, settings)
+            cont = Continuation(fp, settings, natural=solver.natural, arclength=solver.arclength)
             H, lam = _whole(src, a.x)
             Hdot, lamdot = _whole(src, a.xdot)
             x = _state(fp, src.base.r, H, lam)
@@ -356,16 +391,17 @@ class Critical:
         return "mu" if self.name == "sigma" else "sigma"
 
 
-def _critical(model, name: str, levels, comm) -> Critical:
-    """The cusp in ``name`` (sigma: hysteresis below it; mu: above it) of ``model``: stages 1-3."""
+def _critical(model, name: str, levels, comm, solver: SolverChoice) -> Critical:
+    """The cusp in ``name`` (sigma: hysteresis below it; mu: above it) of ``model``: stages 1-3, every
+    solver with its role's settings in ``solver``."""
     t0 = time.perf_counter()
     direction = 1 if name == "sigma" else -1
-    yes, no, folds = bracket(model, name, comm)
+    yes, no, folds = bracket(model, name, comm, solver=solver)
     cusps = []
     try:
         for fold in folds:
             if fold["kind"] == "snap_on":
-                cusps.append(trace_cusp(model, name, fold, yes, direction, comm))
+                cusps.append(trace_cusp(model, name, fold, yes, direction, comm, solver=solver))
         first = max(cusps, key=lambda c: direction * c.point.p)
         design = _design(model, name, first)
         at, src = {}, first
@@ -375,7 +411,7 @@ def _critical(model, name: str, levels, comm) -> Critical:
         for level, grid in [(k, replace(design, level=k)) for k in sorted(levels)] + \
                 [("domain", replace(design, level=max(levels), rmax=2 * design.rmax))]:
             nodes = grid.nodes()
-            found = _relocate(src, model, name, nodes, direction, comm)
+            found = _relocate(src, model, name, nodes, direction, comm, solver)
             if found is None:
                 raise RuntimeError(f"the cusp at {name} = {first.point.p:.6g} was not found again on "
                                    f"{'refinement level ' + str(level) if level != 'domain' else 'the longer domain'}"
@@ -406,7 +442,7 @@ def _critical(model, name: str, levels, comm) -> Critical:
                                                         f"[{lo:.6g}, {hi:.6g}] of the traced curves"))
 
 
-def sigma_c(model, mu: float, grid_refinements=LEVELS, comm=None) -> Critical:
+def sigma_c(model, mu: float, grid_refinements=LEVELS, comm=None, solver: SolverChoice = SolverChoice()) -> Critical:
     """The critical roughness at Tabor parameter ``mu``: the largest sigma with hysteresis, the cusp of the
     fold curve in (sigma, lambda), with its error bar.
 
@@ -421,6 +457,11 @@ def sigma_c(model, mu: float, grid_refinements=LEVELS, comm=None) -> Critical:
     comm : petsc4py.PETSc.Comm
         Communicator of every object (PETSc.COMM_WORLD by default): a study may run cases on
         subcommunicators.
+    solver : SolverChoice
+        The PETSc settings of the solvers by role: ``natural`` and ``arclength`` (the correctors of the
+        ordinary curves and of the fold curve), ``fold`` (the fold system's bordered solves).  Settings
+        of the ``fixed`` role, or a preconditioner other than dense, are refused (ValueError,
+        :func:`check_solver`).
 
     Returns
     -------
@@ -432,10 +473,11 @@ def sigma_c(model, mu: float, grid_refinements=LEVELS, comm=None) -> Critical:
         ``wall_time_s``; ``warning`` when the cusp lies outside the bracket.  ValueError when there is
         no hysteresis even at sigma = SIGMA_RANGE[0].
     """
-    return _critical(replace(model, mu=mu), "sigma", grid_refinements, comm or PETSc.COMM_WORLD)
+    check_solver(solver, "sigma_c")
+    return _critical(replace(model, mu=mu), "sigma", grid_refinements, comm or PETSc.COMM_WORLD, solver)
 
 
-def mu_c(model, sigma: float, grid_refinements=LEVELS, comm=None) -> Critical:
+def mu_c(model, sigma: float, grid_refinements=LEVELS, comm=None, solver: SolverChoice = SolverChoice()) -> Critical:
     """The critical Tabor parameter at roughness ``sigma``: the smallest mu with hysteresis, the cusp of the
     fold curve in (mu, lambda), with its error bar; at sigma = 0 the onset of hysteresis of a smooth
     sphere.
@@ -443,4 +485,39 @@ def mu_c(model, sigma: float, grid_refinements=LEVELS, comm=None) -> Critical:
     Parameters and result as :func:`sigma_c`, with mu and sigma exchanged.
     ValueError when there is no hysteresis up to mu = MU_RANGE[1].
     """
-    return _critical(at_parameter(model, "sigma", sigma), "mu", grid_refinements, comm or PETSc.COMM_WORLD)
+    check_solver(solver, "mu_c")
+    return _critical(at_parameter(model, "sigma", sigma), "mu", grid_refinements, comm or PETSc.COMM_WORLD,
+                     solver)
+
+
+def configure_solvers(model, solver: SolverChoice = SolverChoice(), comm=None, made=None) -> None:
+    """Make the solvers of a critical study once, solve with each once and free them again, before any
+    work: each reads its options under its own prefix (:class:`~petsc_adhesion.core.newton.SolverOptions`),
+    some of them only at its first solve, and ``made()`` (if given) is called while they live, so that an
+    option no solver reads can be named; with -help each prints those it reads.  They are those of
+    :func:`sigma_c` and :func:`mu_c`, on a small uniform grid at mu = MU_START and the far approach (what a solver reads does
+    not depend on the size or the state): a curve's natural corrector (its first point) and arclength
+    corrector (a zero-length correction there), and the fold system's bordered solves (its borders made
+    the null vectors there); the fold curve's correctors are of the same two roles."""
+    check_solver(solver, "-study_compute critical")
+    comm = comm or PETSc.COMM_WORLD
+    model = at_parameter(model, "mu", MU_START)   # a fold system continued in mu: any sigma, 0 too
+    r = np.linspace(0.0, model.rmax or RMAX, 33)
+    lam = far_approach(model)
+    problem = Problem(model, r, create_influence(r, comm), Dense())
+    cont = guess = fp = None
+    try:
+        cont = Continuation(problem, Settings(), natural=solver.natural, arclength=solver.arclength)
+        guess = problem.rigid(lam, problem.create_vec())
+        a = cont.start(guess, lam, 1)
+        if not cont.arclength(a, 0.0).converged:
+            raise RuntimeError(f"the arclength corrector did not converge at the far approach lambda = {lam:g}")
+        fp = fold_system(model, r, "mu", MU_START, comm, solver.fold)
+        fp.adapt(_state(fp, r, problem.gather(problem.separation(a.x)), lam), MU_START)
+        if made is not None:
+            made()
+    finally:
+        for obj in (fp, cont, guess):
+            if obj is not None:
+                obj.destroy()
+        problem.destroy()

@@ -112,8 +112,8 @@ class SolverChoice:
     settings of each solver by its role (:class:`~petsc_adhesion.core.newton.PetscSettings`): ``natural``
     (the natural corrector and the first point, the command line's ``-nat_``), ``arclength`` (the arclength
     corrector and its tangents, ``-arc_``), ``fixed`` (the solve at one approach, no prefix), ``fold`` (the
-    fold system's bordered solves, ``-fold_``; :class:`~petsc_adhesion.core.fold.FoldSystem` takes them, the
-    critical-roughness calls do not yet).  Settings not given keep each solver's defaults; settings of a
+    fold system's bordered solves, ``-fold_``; :class:`~petsc_adhesion.core.fold.FoldSystem` takes them from
+    the critical-roughness calls, :func:`~petsc_adhesion.tracing.critical.sigma_c` and ``mu_c``).  Settings not given keep each solver's defaults; settings of a
     solver the call does not make are refused (ValueError)."""
 
     pmat: str = "dense"
