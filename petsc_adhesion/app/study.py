@@ -448,7 +448,7 @@ def _critical_solver(opts: AppOptions):
         name = roles["fold"].snes_given[0]
         raise InputError(f"-fold_{name}: the fold system's bordered solves have a KSP, no SNES; give its "
                          f"-fold_ksp_ and -fold_pc_ options, or -nat_{name}, -arc_{name} for the correctors")
-    return SolverChoice(**roles)
+    return SolverChoice(natural=roles["natural"], arclength=roles["arclength"], fold=roles["fold"])
 
 
 def _cusp(c: Case, model, solver, comm) -> dict | None:
