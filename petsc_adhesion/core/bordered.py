@@ -69,7 +69,8 @@ class Bordered:
         self.xdot: np.ndarray | None = None
         self.p0, self.pdot, self.ds = 0.0, 1.0, 0.0
         self.p = 0.0
-        self.border: tuple[np.ndarray | None, float] = (None, 1.0)       # the (xdot, pdot) of the bottom row, as last set
+        # the (xdot, pdot) of the bottom row, as last set
+        self.border: tuple[np.ndarray | None, float] = (None, 1.0)
 
     # -- X = (x, p) --------------------------------------------------------------
     def split(self, X: PETSc.Vec):

@@ -307,7 +307,8 @@ class Tracer:
         computed).  :meth:`restore` on a tracer made alike goes on as this one would."""
         index = {id(seg.finder): k for k, seg in enumerate(self.segments)}
         return {"segments": [{"kind": seg.kind, "at": seg.grid.edge if seg.grid is not None else None,
-                              "band": seg.grid.band if seg.kind == "scaled" and seg.grid is not None else None, "zone": seg.zone,
+                              "band": seg.grid.band if seg.kind == "scaled" and seg.grid is not None else None,
+                              "zone": seg.zone,
                               "N": seg.problem.layout.N,
                               "guarded": seg.problem.guarded, "far": seg.far,
                               "continuation": seg.cont.state(solvers),

@@ -281,8 +281,8 @@ def read_physical(opts: AppOptions) -> Bodies | None:
     # each input's share of log mu (eq. 9), against a 1 um polymer sphere: the option that moved mu most is named
     shares = {"phys_radius": math.log(bodies.R / 1e-6) / 3,
               ("phys_gamma" if "gamma" in given else "phys_hamaker"): 2 * math.log(bodies.work_of_adhesion / 0.05) / 3,
-              ("phys_young2" if bodies.young1 is not None and bodies.young2 is not None and bodies.young2 < bodies.young1
-               else "phys_young1"):
+              ("phys_young2" if bodies.young1 is not None and bodies.young2 is not None
+               and bodies.young2 < bodies.young1 else "phys_young1"):
                   -2 * math.log(bodies.E / 1e9) / 3,
               "phys_epsilon": -math.log(bodies.epsilon / 4e-10)}
     logmu = math.log(tabor(1e-6, 0.05, 1e9, 4e-10)) + sum(shares.values())
