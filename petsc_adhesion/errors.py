@@ -59,8 +59,8 @@ class Interrupted(BaseException):
     def __init__(self, signum: int):
         super().__init__(signum)
         self.signum = signum
-        self.restart = None          # the checkpoint to go on from (-cont_restart), once one is saved
-        self.done = None             # the run's exit status when the signal came after its results were written
+        self.restart: str | None = None   # the checkpoint to go on from (-cont_restart), once one is saved
+        self.done: int | None = None      # the run's exit status when the signal came after its results were written
 
     def resumable(self, path: str) -> None:
         """Name the checkpoint saved before the signal, the one to go on from (-cont_restart)."""

@@ -142,7 +142,8 @@ def _run(given: dict):
         if name in PETSC_GLOBAL:
             raise InputError(f"-{name}: PETSc's own option of a program's start or end, not of one call; "
                              f"not in the Python API")
-    failed = result = None
+    failed: Exception | None = None
+    result = None
     with _ONE_AT_A_TIME:
         opts = AppOptions(Given(given))
         try:

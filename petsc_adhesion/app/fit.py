@@ -19,7 +19,7 @@ from petsc4py import PETSc
 
 from ..errors import InputError, collective, printable
 from ..fitting.curve_fit import CurveFitError, fit_curve, predict_curve
-from ..fitting.data import CurveFileError, read_curve
+from ..fitting.data import CurveFileError, MeasuredCurve, read_curve
 from ..fitting.pull_off import PullOffFitError, fit_pull_off
 from ..fitting.results import FitChoice, Spring
 from ..io.fit import fit_summary, fit_tree, report_fit
@@ -74,7 +74,7 @@ class FitRequest:
     bodies: Bodies              # radii, moduli (a curve's: where given), epsilon, rms
     P: float | None             # pull_off: the measured pull-off (N) and its bar
     P_err: float
-    data: object                # curve: the MeasuredCurve
+    data: MeasuredCurve | None  # curve: the MeasuredCurve
     spring: Spring | None       # curve: the cantilever
     choice: FitChoice | None    # curve: what is fitted
     targets: dict
@@ -110,9 +110,9 @@ def _moduli(opts: AppOptions, need: bool, what: str) -> float | None:
             raise InputError(f"-phys_young1: required with {what}, with -phys_poisson1 (the sphere's modulus; the "
                              f"flat's -phys_young2, -phys_poisson2, or a rigid flat)")
         return None
-    b = Bodies(radius=1.0, young1=have["phys_young1"], poisson1=have["phys_poisson1"], epsilon=1.0,
-               young2=have.get("phys_young2"), poisson2=have.get("phys_poisson2"))
-    E = b.E
+    bodies = Bodies(radius=1.0, young1=have["phys_young1"], poisson1=have["phys_poisson1"], epsilon=1.0,
+                    young2=have.get("phys_young2"), poisson2=have.get("phys_poisson2"))
+    E = bodies.E
     if not (math.isfinite(E) and E > 0):
         raise InputError("-phys_young1: with the other moduli gives no finite positive E* (eq. 2)")
     return E
@@ -217,8 +217,10 @@ def _fit(req: FitRequest, comm):
     """The library's fit of ``req``; InputError (one line naming the option) for what it cannot fit."""
     try:
         if req.kind == "pull_off":
+            assert req.P is not None, "a pull-off fit's request holds the measured pull-off"
             return fit_pull_off(req.P, req.bodies, req.P_err, model=req.model, grid=req.grid, solver=req.solver,
                                 comm=comm, spread_rules=req.spread_rules)
+        assert req.data is not None and req.spring is not None, "a curve fit's request holds the curve and spring"
         return fit_curve(req.data, req.bodies, req.spring, req.choice, model=req.model, grid=req.grid,
                          solver=req.solver, comm=comm)
     except PullOffFitError as e:

@@ -28,6 +28,7 @@ from ..io.resultset import PLOT_FORMATS, check_targets, mark_done, written
 from ..io.write import write_curve, write_solve
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
+from ..tracing.curve import Curve, Solution
 from ..tracing.model_spread import model_spread
 from ..tracing.trace import (
     CurveRequest,
@@ -131,6 +132,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     comm = PETSc.COMM_WORLD
     req = collective(comm, read, opts, comm, argv)
     ck = None
+    result: Curve | Solution
     if req.lam is None:
         ck = open_checkpoint(opts, req.targets, req.inputs, comm)
         shown = opts.flag("progress")
@@ -147,7 +149,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         result = solve_at(req.lam, req.model, req.grid, req.solver, guess=guess,
                           started=lambda: check_unused(db=opts.db))
     check_unused(db=opts.db)
-    status = 3 if req.lam is None and not result.complete else 0
+    status = 3 if isinstance(result, Curve) and not result.complete else 0     # a curve's (req.lam None)
     files = None
     try:
         if comm.getRank() == 0:
@@ -155,7 +157,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
             with ck.on_interrupt() if ck else nullcontext(), written(req.targets, ck.paths() if ck else ()) as files:
                 (write_curve if req.lam is None else write_solve)(result, given, files, commit=False)
                 if report:       # before the files go in place: a report that cannot be written fails the run
-                    (report_curve if req.lam is None else report_solve)(result)
+                    report_curve(result) if isinstance(result, Curve) else report_solve(result)
                 files.commit()
         PETSc.garbage_cleanup()
     except Interrupted as e:

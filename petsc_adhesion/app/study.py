@@ -35,6 +35,7 @@ import itertools
 import math
 import time
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from petsc4py import PETSc
 
@@ -52,7 +53,10 @@ from .options.reading import ROLE_PREFIXES, SOLVER_OPTIONS, AppOptions, Given, r
 from .options.table import TABLE
 from .optionsfile import options_files
 from .progress import clock
-from .run import read
+from .run import Request, read
+
+if TYPE_CHECKING:
+    from mpi4py import MPI
 
 __all__ = ["Case", "cases", "cost", "assign", "spread", "main", "KINDS"]
 
@@ -77,7 +81,7 @@ class Case:
     values: dict                                      # option name -> value
     error: str | None = field(default=None)          # why it cannot run, or None
     #: its options read into the library's objects (:class:`~petsc_adhesion.app.run.Request`), once
-    request: object = field(default=None, repr=False, compare=False)
+    request: tuple[Request, bool | None] | None = field(default=None, repr=False, compare=False)
 
     @property
     def label(self) -> str:
@@ -142,7 +146,8 @@ def cost(case: Case) -> float:
 
 def assign(todo: list[Case], groups: int) -> list[list[Case]]:
     """Longest first, each to the group with the least work so far (LPT scheduling)."""
-    load, out = [0.0] * groups, [[] for _ in range(groups)]
+    load = [0.0] * groups
+    out: list[list[Case]] = [[] for _ in range(groups)]
     for c in sorted(todo, key=lambda c: (-cost(c), c.index)):
         g = min(range(groups), key=lambda k: (load[k], k))
         out[g].append(c)
@@ -173,9 +178,10 @@ def _validate(todo: list[Case], study: dict, argv: list[str], compute: str = "cu
             c.error = str(e)
 
 
-def _run(c: Case, comm, keep: tuple) -> dict:
+def _run(c: Case, comm, keep: tuple) -> dict | None:
     """One case on ``comm``, from the objects its options were read into: its summary and result tree on the
     group's rank 0 (None elsewhere)."""
+    assert c.request is not None, "_validate has read every case that runs"
     req, profiles = c.request
     # the solvers' own options: one they leave unread (a sub-PC's without a block PC) is refused
     curve = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, comm=comm,
@@ -203,7 +209,8 @@ class _Progress:
 
     def __init__(self, comm, todo: list[Case], records: list[dict], journal):
         self.mpi, self.t0, self.total = comm.tompi4py(), time.perf_counter(), sum(cost(c) for c in todo)
-        self.done, self.count, self.n, self.sent = 0.0, len(records), len(records) + len(todo), []
+        self.done, self.count, self.n = 0.0, len(records), len(records) + len(todo)
+        self.sent: list[MPI.Request] = []
         self.records, self.journal = list(records), journal
 
     def finished(self, rec: dict, brief: dict) -> None:
@@ -282,13 +289,15 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
             say(f"case {c.index + 1} ({c.label}) left out: {c.error}")
     if helping:
         return 0
-    files, status = None, 0
+    files = None
+    status: int | None = 0
     try:
         with journal.on_interrupt():
             records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
                              lambda c, comm: _run(c, comm, keep), _brief, journal)
             if mpi.Get_rank() == 0:
-                failed = [_failure(c, c.error) for c in bad] + _failures(records)
+                assert records is not None, "rank 0 holds every case's record"
+                failed = [_failure(c, c.error) for c in bad if c.error is not None] + _failures(records)
                 done = [r for r in records if "error" not in r]
                 study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
                          "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
@@ -394,12 +403,14 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
     collective(world, configure_solvers, model, solver, world, check_unused)
     if helping:
         return 0
-    files, status = None, 0
+    files = None
+    status: int | None = 0
     try:
         with journal.on_interrupt():
             records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, solver, comm), _cusp_brief,
                              journal)
             if mpi.Get_rank() == 0:
+                assert records is not None, "rank 0 holds every case's record"
                 failed = _failures(records)
                 done = [r for r in records if "error" not in r]
                 study = {"compute": "critical", "axes": [n for n, _ in axes],
@@ -437,7 +448,7 @@ def _critical_solver(opts: AppOptions):
         name = roles["fold"].snes_given[0]
         raise InputError(f"-fold_{name}: the fold system's bordered solves have a KSP, no SNES; give its "
                          f"-fold_ksp_ and -fold_pc_ options, or -nat_{name}, -arc_{name} for the correctors")
-    return SolverChoice(**roles)
+    return SolverChoice(natural=roles["natural"], arclength=roles["arclength"], fold=roles["fold"])
 
 
 def _cusp(c: Case, model, solver, comm) -> dict | None:

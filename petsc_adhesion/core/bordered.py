@@ -54,7 +54,8 @@ class Bordered:
         self.K = PETSc.Mat().createNest([[pb.jacobian, self.column], [self.row, self.corner]], comm=comm)
         self.pmat = pb.create_pmat(1)
         self.reuse = PCReuse(pc_reuse_its)
-        self.snes = self.options = None
+        self.snes: PETSc.SNES = None      # made below; None only until then (destroy() skips it)
+        self.options = None
         try:
             self.snes, self.options = create_snes(comm, ARCLENGTH_PREFIX, self.form_function, self.R,
                                                   self.form_jacobian, self.K, self.pmat or self.K, pb.setup_pc,
@@ -64,9 +65,12 @@ class Bordered:
             self.destroy()
             raise
         # the hyperplane Q of eq. (24): through (x0, p0), normal (xdot, pdot), at distance ds
-        self.x0, self.p0, self.xdot, self.pdot, self.ds = None, 0.0, None, 1.0, 0.0
+        self.x0: np.ndarray | None = None
+        self.xdot: np.ndarray | None = None
+        self.p0, self.pdot, self.ds = 0.0, 1.0, 0.0
         self.p = 0.0
-        self.border = (None, 1.0)       # the (xdot, pdot) of the bottom row, as last set
+        # the (xdot, pdot) of the bottom row, as last set
+        self.border: tuple[np.ndarray | None, float] = (None, 1.0)
 
     # -- X = (x, p) --------------------------------------------------------------
     def split(self, X: PETSc.Vec):
@@ -100,6 +104,7 @@ class Bordered:
     def form_function(self, snes, X, R):
         """[G(x, p); Q(x, p)] with Q of eq. (24)."""
         x, p = self.split(X)
+        assert self.xdot is not None and self.x0 is not None, "solve() sets the hyperplane before SNES calls back"
         self.x.setArray(x)
         self.pb.residual(self.x, p, self.G)
         q = self.inner(self.xdot, x - self.x0) + self.pdot * (p - self.p0) - self.ds

@@ -322,6 +322,7 @@ class Continuation:
         if not sol.converged:
             return None
         x, p, xdot, pdot = sol.x, sol.p, sol.xdot, sol.pdot
+        assert x is not None and xdot is not None, "a converged correction holds its point and tangent"
         # the corrector's distance from the predictor grows as ds^2 times the curvature;
         # a step that had to travel far may have cut across a fold pair unseen
         dx = x - (a.x + ds * a.xdot)

@@ -150,8 +150,8 @@ class Found:
     point: Point
     segment: int
     before: float                 # the test function's value at the segment's start
-    landing: object = None        # for a fold: the point it jumps to (see jumps)
-    landing_by: object = None     # the EventFinder (segment) that located it
+    landing: Point | None = None  # for a fold: the point it jumps to (see jumps)
+    landing_by: EventFinder | None = None  # the EventFinder (segment) that located it
     landing_step: int = -1        # and the step of that segment it lies on
     estimate: dict | None = None  # best values and error bars, when asked for (error_estimate.event_errors)
     arc: tuple | None = None      # a fold: (point(s), s0, s, s1), the arc it was located on, s its place
@@ -204,7 +204,7 @@ class EventFinder:
             else cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p)
         correct = cont.arclength if arclength else cont.correct
         natural = cont.natural_ok(a) and not arclength
-        cache = {}
+        cache: dict[float, Point] = {}
 
         def point(s, tangent=tangent):
             if s not in cache or (tangent and cache[s].corrector != "event"):
@@ -239,7 +239,7 @@ class EventFinder:
             return f(point(s)) - level
 
         # p moves by at most |s| along a unit tangent, so xtol in s bounds the error in p
-        return brent.root(g, s0, s1, xtol=self.tol, rtol=4 * np.finfo(float).eps, maxiter=100) \
+        return brent.root(g, s0, s1, xtol=self.tol, rtol=float(4 * np.finfo(float).eps), maxiter=100) \
             if g(s0) * g(s1) < 0 else (s0 if g(s0) == 0 else s1)
 
     def _pairs(self, ev, steps) -> None:
@@ -294,7 +294,8 @@ class EventFinder:
             return d
 
         try:
-            brent.minimum(depth, *sorted((0.0, sb)), xatol=DIP_XTOL * abs(sb))
+            lo, hi = sorted((0.0, sb))
+            brent.minimum(depth, lo, hi, xatol=DIP_XTOL * abs(sb))
             return []
         except _Below as below:
             return [((point, below.s), 0.0), ((point, sb), below.s)]
@@ -312,6 +313,7 @@ class EventFinder:
         (before it), then, for a pair inside one step, from that arc's end to the step's end (from the step's
         start to the arc's start).  Found or not."""
         fold = ev.event
+        assert isinstance(fold, Fold), "a landing is a fold's (jumps() calls this for folds alone)"
         folds = [f for f in self.found if f.event is fold]
         k = next(i for i, f in enumerate(folds) if f is ev) + (1 if ev.before > 0 else -1)
         other = folds[k] if 0 <= k < len(folds) else None
@@ -320,7 +322,7 @@ class EventFinder:
         pts, cf = self.cont.points, fold.value(ev.point)
         point, s0, at, s1 = other.arc
         landing = ev.landing         # a landing located before stands; the finder it names is set anew
-        pieces = [(point, at, s1)] if ev.before > 0 else [(point, s0, at)]
+        pieces: list[tuple] = [(point, at, s1)] if ev.before > 0 else [(point, s0, at)]
         if other.segment == ev.segment:
             pieces.append((point(s1), pts[ev.segment + 1]) if ev.before > 0 else (pts[ev.segment], point(s0)))
         for piece in pieces:
@@ -331,7 +333,7 @@ class EventFinder:
                     landing = arc(self._root(arc, lo, hi, fold.value, cf), True)
             elif stable(piece[0]) and stable(piece[1]) and \
                     (fold.value(piece[0]) - cf) * (fold.value(piece[1]) - cf) <= 0:
-                landing = self.locate(*piece, fold.value, level=cf, tangent=False)
+                landing = self.locate(piece[0], piece[1], fold.value, level=cf, tangent=False)
             if landing is not None:
                 ev.land(landing, self, other.segment)
                 return True

@@ -318,10 +318,11 @@ class FoldSystem(Generic[Base]):
         self._u.setArray(xu)
         with python_errors():
             self.base.jacobian.mult(self._u, self._y)
-        g = self._dot(self.row, xu)
+        row, gp = self._linearized()
+        g = self._dot(row, xu)
         if self.g_p:
             g += self.g_p * xp
-        y.setArray(self.join(self._y.getArray(readonly=True) + xp * self.gp, g))
+        y.setArray(self.join(self._y.getArray(readonly=True) + xp * gp, g))
 
     def destroy(self) -> None:
         """Free the PETSc objects made here, the base problem's too."""

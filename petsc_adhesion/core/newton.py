@@ -265,7 +265,8 @@ class PCReuse:
     """
 
     def __init__(self, its: int = PC_REUSE_ITS):
-        self.its, self.stale, self.at = its, True, None
+        self.its, self.stale = its, True
+        self.at: tuple | None = None
 
     def expire(self) -> None:
         """Refill at the next linearization."""
@@ -381,7 +382,8 @@ class Newton:
 
     def __init__(self, problem, prefix: str = "", full_steps: bool = False, pc_reuse_its: int = PC_REUSE_ITS,
                  tol: Tolerances = Tolerances(), settings: PetscSettings = PetscSettings()):
-        self.pb, self.p, self.snes, self.options = problem, 0.0, None, None
+        self.pb, self.p, self.options = problem, 0.0, None
+        self.snes: PETSc.SNES = None      # made below; None only until then (destroy() skips it)
         self.pmat = problem.create_pmat(0)
         self.reuse = PCReuse(pc_reuse_its)
         self.work, residual = problem.create_vec(), problem.create_vec()

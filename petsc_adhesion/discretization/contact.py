@@ -89,7 +89,7 @@ def crossing(r: np.ndarray, H: np.ndarray, level: float) -> float:
     a, b = float(r[k - 1]), float(r[k])
     if g(a) * g(b) > 0:                         # cannot happen but for round-off at a node
         return a if abs(H[k - 1] - level) < abs(H[k] - level) else b
-    return brent.root(g, a, b, xtol=1e-15 * max(1.0, b), rtol=4 * np.finfo(float).eps, maxiter=100)
+    return brent.root(g, a, b, xtol=1e-15 * max(1.0, b), rtol=float(4 * np.finfo(float).eps), maxiter=100)
 
 
 def deformation_at(source, x: np.ndarray, r: np.ndarray) -> np.ndarray:

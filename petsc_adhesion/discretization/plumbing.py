@@ -43,8 +43,11 @@ class Plumbing:
         lo, hi = A.getOwnershipRange()
         self.layout = Layout(lo, hi, A.getSize()[0], self.comm.getRank() == self.comm.getSize() - 1)
         self._in, self._out = A.createVecs()         # what A multiplies, and its product
-        self._scatter = self._local = self._all = None
-        self._diagonal = None
+        # made at the first call of everywhere()
+        self._scatter: PETSc.Scatter = None
+        self._local: PETSc.Vec = None
+        self._all: PETSc.Vec = None
+        self._diagonal: np.ndarray | None = None
         self.jacobian = PETSc.Mat().createPython(self.layout.sizes(borders), _Shell(owner), comm=self.comm)
         self.jacobian.setUp()
 

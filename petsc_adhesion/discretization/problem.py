@@ -11,6 +11,8 @@ along the curve is the load F.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -22,6 +24,9 @@ from .contact import contact_radius, deformation_at, rate_at
 from .grid import l2_weights, load_weights
 from .plumbing import Plumbing
 from .preconditioning import Dense
+
+if TYPE_CHECKING:
+    from ..core.protocol import PressureLaw
 
 __all__ = ["Problem", "far_approach", "step_scale", "MU_SOFT", "norm_radius", "TO_WALL"]
 
@@ -95,7 +100,9 @@ class Problem:
         self.dp = np.zeros(self.hi - self.lo)
         self.pc = pmat if pmat is not None else Dense()
         self.guarded = 0                  # Newton steps the domain guard shortened
-        self._own_law, self._laws, self._second = self.law, {}, None
+        self._own_law = self.law
+        self._laws: dict[float, PressureLaw] = {}
+        self._second: tuple[str, float] | None = None     # the parameter set_parameter set, and its value
 
     # -- state ------------------------------------------------------------------
     def create_vec(self) -> PETSc.Vec:
@@ -313,6 +320,7 @@ class Problem:
 
         the sigma derivatives by :func:`~petsc_adhesion.model.pressure.sigma_rates` (``gap``: the smallest
         H - wall, which bounds its step)."""
+        assert self._second is not None, "set_parameter() before parameter_derivatives()"
         _, s = self._second
         if name == "sigma":
             c = self.c

@@ -36,6 +36,7 @@ import math
 import time
 import warnings
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,6 +48,9 @@ from .forward import APPROACH, RETRACT, ForwardCurve, curve_stop_reason
 from .pull_off import maugis_dugdale_gamma
 from .results import (BOUND_MARGIN, NOISE_DOF_PER_DIFFERENCE, CurveFit, Features, FitChoice, FittedFeatures,
                       Spring, misfit, misfit_p, undetermined)
+
+if TYPE_CHECKING:
+    from ..tracing.trace import GridChoice, SolverChoice
 
 __all__ = ["CurveFit", "CurveFitError", "FittedModel", "fit_curve", "features", "MU_BOUNDS", "SIGMA_MAX",
            "predict_curve"]
@@ -116,8 +120,8 @@ class _Problem:
     bodies: Bodies
     spring: Spring
     template: Model
-    grid: object
-    solver: object
+    grid: GridChoice
+    solver: SolverChoice
     comm: object
     E_fixed: float | None
     fit_sigma: bool
@@ -324,16 +328,17 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     sigma0 = 0.0 if bodies.rms is None else bodies.rms / eps
     if choice.roughness and bodies.rms is None:
         sigma0 = 0.3
-    pb = _Problem(data, bodies, spring, template, grid, solver, comm, None if choice.modulus else float(modulus),
+    pb = _Problem(data, bodies, spring, template, grid, solver, comm,
+                  None if choice.modulus or modulus is None else float(modulus),
                   choice.roughness, sigma0, noise, feat, float(data.F.max()))
     P = feat.pull_off_N
 
     def start(E: float) -> tuple[np.ndarray, float]:
         w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
         mu = min(max(tabor(R, w, E, eps), MU_BOUNDS[0] * 1.01), MU_BOUNDS[1] * 0.99)
-        x = ([] if not choice.modulus else [math.log(mu)]) + [math.log(w)] + \
+        x0 = ([] if not choice.modulus else [math.log(mu)]) + [math.log(w)] + \
             ([sigma0] if choice.roughness else []) + [0.0, feat.F0_N / noise]
-        x = np.array(x, dtype=float)
+        x = np.array(x0, dtype=float)
         x[-2] = _align(pb, x)
         return x, float(np.sum(pb.residuals(x) ** 2))
 
@@ -416,6 +421,7 @@ def _bounds(pb: _Problem, choice: FitChoice, modulus: float | None) -> tuple[np.
         elif name == "ln_gamma":
             lo[j], hi[j] = math.log(1e-6), math.log(100.0)
     if not choice.modulus:                          # mu's bounds through w at the held modulus
+        assert modulus is not None, "a held modulus is given (fit_curve refuses it otherwise)"
         E, R, eps = float(modulus), pb.R, pb.eps
         j = pb.names.index("ln_gamma")
         lo[j] = max(lo[j], math.log(math.sqrt(MU_BOUNDS[0]**3 * E**2 * eps**3 / R)))
@@ -530,4 +536,6 @@ class FittedModel:
 
 def predict_curve(fit: CurveFit, z: np.ndarray, leg: str) -> np.ndarray:
     """The fitted model's force (N) at piezo positions ``z`` on ``leg`` (approach or retract)."""
+    if fit.forward is None:
+        raise ValueError("the fit holds no model to predict from (fit_curve sets it)")
     return fit.forward.predict(z, leg)

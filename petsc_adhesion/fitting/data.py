@@ -195,10 +195,11 @@ def _plausible(raw: np.ndarray, scales: tuple, header: list | None, path: str) -
     naming the column and the unit its numbers are likely in."""
     with np.errstate(over="ignore", invalid="ignore"):
         sizes = (float(np.ptp(raw[:, 0])), float(np.max(np.abs(raw[:, 1]))))
-    checks = (("the piezo travels", "an AFM's piezo travels", PLAUSIBLE_TRAVEL_M, TYPICAL_TRAVEL_M, LENGTH_UNITS,
-               "m", {}),
-              ("the largest force is", "an AFM measures", PLAUSIBLE_FORCE_N, TYPICAL_FORCE_N, FORCE_UNITS, "N",
-               _FORCE_SHOWN))
+    checks: tuple[tuple[str, str, tuple[float, float], float, dict[str, float], str, dict[str, str]], ...] = \
+        (("the piezo travels", "an AFM's piezo travels", PLAUSIBLE_TRAVEL_M, TYPICAL_TRAVEL_M, LENGTH_UNITS,
+          "m", {}),
+         ("the largest force is", "an AFM measures", PLAUSIBLE_FORCE_N, TYPICAL_FORCE_N, FORCE_UNITS, "N",
+          _FORCE_SHOWN))
     for i, (what, afm, bounds, typical, units, si, shown) in enumerate(checks):
         value = sizes[i] * scales[i]
         if sizes[i] == 0 or bounds[0] <= value <= bounds[1]:
@@ -226,7 +227,8 @@ def _read_text(path: str) -> MeasuredCurve:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         text = raw.decode("latin-1")
-    rows, header, scale_z, scale_F = [], None, 1.0, 1.0
+    rows: list[list[float]] = []
+    header, scale_z, scale_F = None, 1.0, 1.0
     decimal_comma = None                     # decided on the first row of numbers with a comma, then held
     for number, line in enumerate(text.splitlines(), 1):
         stripped = line.strip()

@@ -68,7 +68,7 @@ def _spline(x: np.ndarray, y: np.ndarray, left: float | None, right: float | Non
 
     if x.size < 3:
         return lambda t: np.interp(t, x, y)
-    bc = ((1, left) if left is not None else "not-a-knot", (1, right) if right is not None else "not-a-knot")
+    bc: tuple = ((1, left) if left is not None else "not-a-knot", (1, right) if right is not None else "not-a-knot")
     if x.size == 3 and "not-a-knot" in bc:
         bc = tuple((2, 0.0) if b == "not-a-knot" else b for b in bc)
     return CubicSpline(x, y, bc_type=bc)
@@ -128,6 +128,7 @@ def pull_off_values(e) -> tuple[float, float | None, float]:
 def _value(e, key: str, K: float | None = None) -> float:
     """An event's value on its grid (its best value when it has none): lam, F, or Z = lam + F / K."""
     if key == "Z":
+        assert K is not None, "Z = lam + F / K is asked with the spring's K"
         return _value(e, "lam") + _value(e, "F") / K
     return event_value(e, key)
 
@@ -146,7 +147,7 @@ class ForwardCurve:
         self.K = float(K)
         self.notes: list[str] = []
         events = {k: curve_jumps(curve, k) for k in ("jump_in", "jump_off")}
-        used = set()
+        used: set[int] = set()
         raw = []
         for i0, i1 in _runs(stable):
             keep = np.arange(i0, i1 + 1)
@@ -238,7 +239,8 @@ class ForwardCurve:
     def _chain(self, first: int, link: str, step: int) -> tuple[list[int], np.ndarray]:
         """The pieces a leg follows and the Z at which it leaves each (increasing on the approach, decreasing on
         the retract)."""
-        chain, cuts, p = [first], [], first
+        chain, p = [first], first
+        cuts: list[float] = []
         while getattr(self.pieces[p], link) is not None and len(chain) <= len(self.pieces):
             nxt = getattr(self.pieces[p], link)
             cut = self.pieces[p].Z_hi if step > 0 else self.pieces[p].Z_lo

@@ -237,6 +237,7 @@ def _verdict(w: float, F: float, F_err: float | None, P: float, P_err: float, sl
     warnings that say so).  The bar: sqrt((F_err / F)^2 + (P_err / P)^2) / slope_w relative."""
     rel = math.hypot((F_err or 0.0) / abs(F), P_err / P) / slope_w
     err = w * rel if (F_err is not None or P_err > 0) else None
+    why: str | None
     lo, hi = (math.log(m) for m in MU_RANGE)
     if math.log(mu) - lo <= BOUND_MARGIN or hi - math.log(mu) <= BOUND_MARGIN:
         edge = MU_RANGE[0] if math.log(mu) - lo <= BOUND_MARGIN else MU_RANGE[1]

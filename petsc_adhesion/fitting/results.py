@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -43,6 +44,14 @@ Z95 = 1.959963984540054
 #: over sqrt 2) per difference: 2 / var(s^2 / sigma^2) measured on Gaussian noise, 0.30 to 0.32 for 30 to
 #: 1000 points (MAD's efficiency 0.37 times the loss of successive differences sharing a point).
 NOISE_DOF_PER_DIFFERENCE = 0.3
+
+
+class Predictor(Protocol):
+    """The fitted model a :class:`CurveFit` predicts from (:class:`~petsc_adhesion.fitting.curve_fit.FittedModel`,
+    named by its member here because that module imports this one)."""
+
+    def predict(self, z: np.ndarray, leg: str) -> np.ndarray:
+        """The force (N) at piezo positions ``z`` on ``leg`` (approach or retract)."""
 
 
 @dataclass(frozen=True)
@@ -163,7 +172,7 @@ class CurveFit:
     wall_time_s: float = 0.0
     notes: tuple = ()
     warnings: tuple = ()
-    forward: object = field(default=None, repr=False)
+    forward: Predictor | None = field(default=None, repr=False)
 
     @property
     def reduced_chi2(self) -> float:
@@ -201,7 +210,7 @@ class PullOffFit:
     closed_forms: tuple
     curves: int
     wall_time_s: float
-    bodies: Bodies = field(repr=False, default=None)
+    bodies: Bodies | None = field(repr=False, default=None)
     history: tuple = field(repr=False, default=())
     warnings: tuple = ()
     spread: object = field(repr=False, default=None)    # ModelSpread | Missing | None: gamma under other laws

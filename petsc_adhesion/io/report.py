@@ -57,6 +57,7 @@ def report_curve(curve: Curve) -> None:
     sp = curve.spring
     if sp is not None:
         for f in sp.jumps:
+            assert f.Z is not None, "a jump behind the spring has its Z"
             land = f.landing
             to = f"  -> lands at {_pm('lambda', land.lam)}  {_pm('F', land.F)}" if land else ""
             out.append(f"  {f.kind:<8} (K = {sp.K:.4g})  {_pm('Z', f.Z)}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}"
@@ -93,7 +94,7 @@ def _physical_lines(p: dict) -> list[str]:
                    f"{e['contact_radius_nm']:.4g} nm")
     for name, q in (("rigid machine", p), (f"spring k = {p['spring']['k_N_m']:.4g} N/m", p.get("spring")) if "spring" in p
                     else (None, None)):
-        if name and "energy_aJ" in q:
+        if name and q is not None and "energy_aJ" in q:
             out.append(f"    energy of a cycle, {name}: {_nm_nN(q, 'energy', 'aJ')}")
     return out
 

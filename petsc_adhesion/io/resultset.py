@@ -68,7 +68,7 @@ def check_targets(targets: dict, inputs: dict | None = None) -> None:
     list of paths the run reads (options files, guesses).  Tries creating a
     temporary beside each target.
     """
-    seen = {}
+    seen: dict[str, str] = {}
     for option, path in targets.items():
         name = printable(path)
         try:
@@ -182,7 +182,7 @@ class ResultSet:
     def __init__(self, targets: dict, drop=()):
         self.targets = {k: v for k, v in targets.items() if v}
         self.drop = [p for p in drop if p]         # what the set replaces: gone once it is in place
-        self.temps = {}
+        self.temps: dict[str, str] = {}
         self.committed = False
         self.recover()
 
@@ -228,7 +228,7 @@ class ResultSet:
     def commit(self) -> None:
         """Rename every written temporary into place, together (see the module's docstring)."""
         renames = [(self.temps[k], os.path.abspath(self.targets[k])) for k in self.targets if k in self.temps]
-        journals = {}                              # one beside the first output of each folder
+        journals: dict[str, str] = {}                              # one beside the first output of each folder
         for _, final in renames:
             journals.setdefault(os.path.dirname(final), _journal(final))
         for journal in journals.values():
@@ -274,7 +274,7 @@ class ResultSet:
         self.temps = {}
 
 
-def mark_done(e: Interrupted, files: ResultSet | None, status: int) -> None:
+def mark_done(e: Interrupted, files: ResultSet | None, status: int | None) -> None:
     """A signal that came once ``files`` were in place ends the run as done with ``status``
     (:attr:`~petsc_adhesion.errors.Interrupted.done`; the command line says so)."""
     if files is not None and files.committed:

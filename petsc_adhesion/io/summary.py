@@ -36,7 +36,7 @@ KEYS = {"lam": "lambda", "note": "error_note"}
 def event_record(obj, profiles: bool = True) -> dict:
     """An :class:`~petsc_adhesion.tracing.curve.Event` (or its landing) as the files hold it, read from its
     fields (see the module); ``profiles`` False leaves out r, H and P (a summary's, a study case's)."""
-    out = {}
+    out: dict[str, object] = {}
     for f in fields(obj):
         v, key = getattr(obj, f.name), KEYS.get(f.name, f.name)
         if v is None or (isinstance(v, tuple) and not v):
@@ -214,7 +214,7 @@ def critical_record(c: Critical) -> dict:
     levels and their nodes, the domain's share, the bracket, the edge and contact radius at the cusp, its
     roughness law, r_m, the wall time and any warning."""
     k = c.kind
-    out = {c.fixed_name: c.fixed, k: c.value.value, f"{k}_err": c.value.err, "lambda_c": c.lam.value,
+    out: dict[str, object] = {c.fixed_name: c.fixed, k: c.value.value, f"{k}_err": c.value.err, "lambda_c": c.lam.value,
            "lambda_c_err": c.lam.err, "F_c": c.F.value, "F_c_err": c.F.err, f"{k}_domain": c.domain,
            "levels": list(c.levels), "n_nodes": list(c.n_nodes), f"{k}_grid": list(c.value_grid),
            "lambda_c_grid": list(c.lam_grid), "F_c_grid": list(c.F_grid), "bracket": list(c.bracket),

@@ -31,6 +31,14 @@ __all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study"
 
 
 
+def _figure_format(path: str) -> str:
+    """The figure format -plot's file name ends in (check_targets has refused any other before the run)."""
+    fmt = plot_format(path)
+    if fmt is None:
+        raise ValueError(f"-plot: '{path}' ends in no figure format (check_targets refuses it before a run)")
+    return fmt
+
+
 def _describe(name: str, obj) -> None:
     key = "/".join("*" if part.isdigit() else part for part in name.split("/"))
     if key.startswith("cases/*/") and key not in DESCRIBE:     # a study's case holds a curve's layout
@@ -103,7 +111,7 @@ def write_curve(curve, options: dict, files: ResultSet, commit: bool = True) -> 
     if "plot" in files.targets:
         from .plot.curve import curve_figure
 
-        fmt = plot_format(files.targets["plot"])
+        fmt = _figure_format(files.targets["plot"])
         curve_figure(tree, files.temp("plot"), fmt)
     if "summary" in files.targets:
         write_json(files.temp("summary"), summary_of(curve))
@@ -124,7 +132,7 @@ def write_fit(tree: dict, summary: dict, files) -> None:
     if "plot" in files.targets:
         from .plot.fit import fit_figure
 
-        fit_figure(tree, files.temp("plot"), plot_format(files.targets["plot"]))
+        fit_figure(tree, files.temp("plot"), _figure_format(files.targets["plot"]))
     if "csv" in files.targets:
         write_fit_csv(files.temp("csv"), tree["fit"]["data"])
 
@@ -163,7 +171,7 @@ def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict]
     if "plot" in files.targets:
         from .plot.study import critical_figure
 
-        critical_figure(tree, files.temp("plot"), plot_format(files.targets["plot"]))
+        critical_figure(tree, files.temp("plot"), _figure_format(files.targets["plot"]))
     if "summary" in files.targets:
         write_json(files.temp("summary"), summ)
     files.commit()
@@ -189,7 +197,7 @@ def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], f
     if "plot" in files.targets:
         from .plot.study import study_figure
 
-        fmt = plot_format(files.targets["plot"])
+        fmt = _figure_format(files.targets["plot"])
         study_figure(tree, files.temp("plot"), study["plot"], fmt)
     if "summary" in files.targets:
         write_json(files.temp("summary"), summ)

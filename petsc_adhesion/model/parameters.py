@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Protocol
 
 import numpy as np
 
@@ -41,6 +42,21 @@ def scales(R: float, gamma: float, E: float, epsilon: float) -> dict:
             "pressure_Pa": 8 * gamma / (3 * epsilon)}
 
 
+class PhysicalBodies(Protocol):
+    """What a :class:`Model` made from physical inputs is asked of them: a
+    :class:`~petsc_adhesion.model.physical.Bodies`, named by its members here because that module imports
+    this one."""
+
+    def spring_stiffness(self, k: float) -> float:
+        """The dimensionless stiffness of a spring of k N/m."""
+
+    def scales(self) -> dict:
+        """The SI values of the model's units."""
+
+    def describe(self) -> dict:
+        """The inputs as given and what they make, in SI."""
+
+
 @dataclass(frozen=True)
 class Model:
     """The model of one curve: the Tabor parameter, the roughness and its average, the domain.
@@ -66,7 +82,7 @@ class Model:
     heights: np.ndarray | None = field(default=None, repr=False, compare=False)  # measured, units of epsilon
     farfield: bool = True      # add the rigid sphere's attraction beyond r_m (the half-infinite model)
     #: the physical inputs that made mu (and sigma): results are reported in SI too (None: dimensionless only)
-    bodies: object = field(default=None, repr=False, compare=False)
+    bodies: PhysicalBodies | None = field(default=None, repr=False, compare=False)
 
     def with_parameter(self, name: str, value: float) -> Model:
         """This model with ``name`` (mu or sigma) set to ``value`` (and no physical inputs, which made the old

@@ -54,6 +54,9 @@ class Bodies:
     @property
     def E(self) -> float:
         """The combined modulus, eq. (2) (a rigid counterface when E2 is not given)."""
+        if self.young1 is None or self.poisson1 is None:
+            # the TypeError None's arithmetic raised before, with its reason
+            raise TypeError("E* (eq. 2) is not defined: the sphere's modulus is not given (a fit finds it)")
         compliance = (1 - self.poisson1**2) / self.young1
         if self.young2 is not None:
             assert self.poisson2 is not None, "young2 without poisson2: the options' reading refuses it"

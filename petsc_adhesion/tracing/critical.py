@@ -70,6 +70,7 @@ from ..discretization.influence import create_influence
 from ..discretization.preconditioning import Dense
 from ..discretization.problem import Problem, far_approach
 from ..discretization.resolution import cohesive_zone
+from ..model.parameters import Model
 from ..model.pressure import pressure_law
 from ..tracing import results
 from .edge_grids import BAND, RMAX, grid_for
@@ -375,7 +376,7 @@ class Critical:
     bracket: tuple
     edge: float
     contact_radius: float
-    model: object = field(repr=False)
+    model: Model = field(repr=False)
     wall_time_s: float = 0.0
     warning: str | None = None
 

@@ -19,11 +19,15 @@ negative when tensile), r and contact radii in sqrt(epsilon R), P in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..version import __version__
 from .measured import Measured, Missing
+
+if TYPE_CHECKING:
+    from ..model.parameters import Model
 
 __all__ = ["Profile", "Landing", "Event", "Branch", "Cycle", "SpringResult", "ErrorEstimate", "Diagnostics",
            "Assessment", "Program", "GridRecord", "Curve", "Solution", "EVENT_KINDS"]
@@ -251,7 +255,7 @@ class Curve:
     event warns (:attr:`ModelSpread.warnings`) but leaves the curve complete.
     """
 
-    model: object = field(repr=False)
+    model: Model = field(repr=False)
     program: Program = field(repr=False)
     grid: GridRecord = field(repr=False)
     branch: Branch = field(repr=False)
@@ -326,6 +330,6 @@ class Solution:
     snes_iterations: int
     ksp_iterations: int
     wall_time_s: float
-    model: object = field(repr=False)
+    model: Model = field(repr=False)
     program: Program = field(repr=False)
     grid: GridRecord = field(repr=False)

@@ -38,10 +38,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
-from ..core.events import Fold
+from ..core.events import Fold, Found
+from ..core.protocol import Point
 
 __all__ = ["Node", "Loop", "cycle", "energy_bar", "hermite_integral"]
 
@@ -75,8 +77,8 @@ class Node:
 
     key: tuple
     seg: int
-    point: object
-    found: object = None
+    point: Point
+    found: Found | None = None
     landing: bool = False
 
 
@@ -120,7 +122,7 @@ class _Pieces:
 
     def __init__(self, segments, nodes: list[Node], weight: float, tol: float):
         self.segments, self.nodes, self.weight, self.tol = segments, nodes, weight, tol
-        self.arcs = {}
+        self.arcs: dict[tuple[int, int], Callable[..., Point]] = {}     # (segment, step) -> its arc
         self.solves = 0
 
     def _arc(self, k: int, j: int):
@@ -227,9 +229,10 @@ def cycle(segments, fold: Fold) -> Loop:
     if not fold.stable(nodes[-1].point) or not fold.stable(nodes[0].point):
         return Loop(None, "the curve does not end on a stable branch: no cycle to close")
     approach, retract = _walk(nodes, True), _walk(nodes, False)
-    for walk in (approach, retract):
-        if isinstance(walk, str):
-            return Loop(None, walk)
+    if isinstance(approach, str):
+        return Loop(None, approach)
+    if isinstance(retract, str):
+        return Loop(None, retract)
     m = np.zeros(len(nodes) - 1, dtype=int)
     np.add.at(m, approach[0], 1)
     np.add.at(m, retract[0], -1)

@@ -16,6 +16,7 @@ calibrated by the coverage study of docs/coverage.md).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -123,7 +124,7 @@ def _carry_start(old, new, pt):
     return carry(old, new, pt)
 
 
-def extrapolate(values: dict) -> tuple:
+def extrapolate(values: dict) -> tuple[float, float]:
     """(best value, error bar) from values at refinement levels {level: X}, the finest three used.
 
     With h = 2^-level, X + h^2 (A + B log h) through the three values is the
@@ -231,8 +232,8 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> Estim
         return {k: (p.p if key == "lambda" else fold.value(p) if key == "Z" else p.values[key])
                 for k, p in pts.items() if p is not None}
 
-    def bars():
-        out = {key: extrapolate(series(points, key)) for key in ("lambda", "F", "contact_radius")}
+    def bars() -> dict[str, Any]:
+        out: dict[str, Any] = {key: extrapolate(series(points, key)) for key in ("lambda", "F", "contact_radius")}
         if spring:
             out["Z"] = extrapolate(series(points, "Z"))
         land = {key: series(landing, key) for key in ("lambda", "F", "contact_radius")}
@@ -252,12 +253,15 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> Estim
             break
         est = bars()
     met = not target_error or largest(est) <= target_error
-    landing = None
+    # the landing's estimate (its points, ``landing`` above, are done with)
+    landed = None
     if "landing" in est:
-        land = est["landing"]
-        landing = LandingEstimate(F=Measured(*land["F"], grid=found.landing.values["F"]),
-                                  contact_radius=Measured(*land["contact_radius"]),
-                                  lam=Measured(*land["lambda"], grid=found.landing.p) if spring else None)
+        bar: dict[str, tuple[float, float]] = est["landing"]
+        point = found.landing
+        assert point is not None, "a landing's bars are of a located landing"
+        landed = LandingEstimate(F=Measured(*bar["F"], grid=point.values["F"]),
+                                 contact_radius=Measured(*bar["contact_radius"]),
+                                 lam=Measured(*bar["lambda"], grid=point.p) if spring else None)
     return Estimate(lam=Measured(*est["lambda"]), F=Measured(*est["F"]), contact_radius=Measured(*est["contact_radius"]),
                     levels=tuple(sorted(points)), target_met=met, Z=Measured(*est["Z"]) if "Z" in est else None,
-                    refinement=stop if stop and not met else None, landing=landing)
+                    refinement=stop if stop and not met else None, landing=landed)

@@ -122,7 +122,7 @@ def default_rules(model) -> tuple:
     3.24 rms), so that the shape of the tail, not only its end, is varied.
     """
     own = Rule.of(model)
-    rules = (Rule("hermite", 2 * model.hermite_points),) if own.law == "hermite" else ()
+    rules: tuple[Rule, ...] = (Rule("hermite", 2 * model.hermite_points),) if own.law == "hermite" else ()
     rules += (Rule("truncated_gaussian", 3.0), Rule("truncated_gaussian", 4.0), Rule("weibull", 0.0))
     return tuple(r for r in rules if r != own)
 
@@ -313,7 +313,9 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
     models = [r.model(model) for r in rules]
     quick = replace(request, error_bars=False, profiles=False, target_error=None)
     ref = curve_values(curve)
-    alts, notes, times = [], [], []
+    alts: list[CurveValues | None] = []
+    notes: list[str] = []
+    times: list[float] = []
     t0 = time.perf_counter()
     for rule, m in zip(rules, models):
         times.append(time.perf_counter())
@@ -330,7 +332,7 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
             notes.append(diff)
         alts.append(alt)
     wall = time.perf_counter() - t0
-    times = tuple(b - a for a, b in zip(times, [*times[1:], t0 + wall]))
+    spent = tuple(b - a for a, b in zip(times, [*times[1:], t0 + wall]))       # each law's wall time
     none = CurveValues((), None, Missing("not traced"), False)
     names, own = _matched(ref, none)
     matched = [_matched(ref, none if alt is None else alt)[1] for alt in alts]
@@ -347,7 +349,7 @@ def model_spread(curve, model, grid_choice: GridChoice = GridChoice(), solver: S
         quantities.append(spread_quantity("energy of a cycle", "energy", ref.energy, values, rules, reference))
     bodies = model.bodies
     units = bodies.scales() if bodies is not None else None
-    return ModelSpread(reference, rules, tuple(quantities), tuple(notes), wall, times,
+    return ModelSpread(reference, rules, tuple(quantities), tuple(notes), wall, spent,
                        None if units is None else units["force_N"] * 1e9,
                        None if units is None else units["approach_m"] * 1e9)
 

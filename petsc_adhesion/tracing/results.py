@@ -77,6 +77,11 @@ class _State:
     profile: Profile | None
 
 
+def _measured(value: float | None) -> Measured | None:
+    """A state's Z as an event holds it: None where the state has none (no spring)."""
+    return None if value is None else Measured(value)
+
+
 def _state(problem, pt, profiles: bool, spring=None) -> _State:
     """The state of a point on the grid it was located on (collective: H0 and the profiles gather)."""
     profile = None
@@ -110,10 +115,10 @@ def event_of(problem, found, estimate, profiles: bool) -> Event:
     if found.landing is not None:
         ld = _state(found.landing_by.cont.pb, found.landing, profiles, spring)
         landing = Landing(lam=Measured(ld.lam), F=Measured(ld.F), H0=ld.H0,
-                          Z=None if spring is None else Measured(ld.Z),
+                          Z=_measured(ld.Z),
                           contact_radius=Measured(ld.contact_radius), profile=ld.profile)
     ev = Event(kind=found.label, lam=Measured(at.lam), F=Measured(at.F), H0=at.H0,
-               Z=None if spring is None else Measured(at.Z), contact_radius=Measured(at.contact_radius),
+               Z=_measured(at.Z), contact_radius=Measured(at.contact_radius),
                stable=stable, landing=landing, profile=at.profile)
     if estimate is None:
         return ev
@@ -129,12 +134,15 @@ def event_of(problem, found, estimate, profiles: bool) -> Event:
         lam, F = Measured(est.lam.value, est.lam.err + beyond, at.lam), Measured(0.0, 0.0, at.F)
     else:
         lam, F = Measured(est.lam.value, est.lam.err + beyond, at.lam), Measured(est.F.value, est.F.err + beyond, at.F)
-    Z = None if spring is None else Measured(est.Z.value, est.Z.err + beyond * (1 + spring.weight), at.Z)
+    Z: Measured | None = None
+    if spring is not None:
+        assert est.Z is not None, "an estimate behind a spring holds Z's"
+        Z = Measured(est.Z.value, est.Z.err + beyond * (1 + spring.weight), at.Z)
     if landing is not None and est.landing is not None:
         land = est.landing
         landing = replace(landing, lam=Measured(lam.value), F=Measured(land.F.value, land.F.err + beyond, land.F.grid),
                           contact_radius=Measured(land.contact_radius.value, land.contact_radius.err))
-        if spring is not None:              # the same Z; lambda moves by the spring's extension
+        if Z is not None:                   # the same Z; lambda moves by the spring's extension (behind a spring)
             landing = replace(landing, lam=Measured(land.lam.value, land.lam.err + beyond, land.lam.grid),
                               Z=Measured(Z.value, Z.err))
     return replace(ev, lam=lam, F=F, Z=Z, landing=landing, levels=tuple(est.levels), target_met=est.target_met,
@@ -243,6 +251,7 @@ def _cycle(segments, fold, event_of_found, open_reason: str | None) -> Cycle:
         return Cycle(Missing(open_reason), None, K)
     loop = energy.cycle(segments, fold)
     if loop.energy is None:
+        assert loop.note is not None, "a cycle not walked says why"
         return Cycle(Missing(loop.note), None, K)
     return Cycle(Measured(loop.energy, energy.energy_bar(loop, fold, event_of_found)), loop.loops, K)
 

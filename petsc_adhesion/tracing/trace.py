@@ -35,7 +35,7 @@ import numpy as np
 from .. import brent
 from ..core.continuation import Continuation, Settings
 from ..core.start import start_petsc
-from ..core.events import EVENT_TOL, jumps
+from ..core.events import EVENT_TOL, Found, jumps
 from ..core.newton import PC_REUSE_ITS, Newton, PetscSettings
 from ..discretization import grid, preconditioning, resolution
 from ..discretization.influence import create_influence
@@ -45,7 +45,7 @@ from . import error_bars, results
 from .curve import Curve, Diagnostics, ErrorEstimate, GridRecord, Program, Solution, SpringResult
 from .measured import Missing
 from .edge_grids import MU_TRUNCATED, RMAX, grid_for
-from .tracer import Tracer
+from .tracer import Segment, Tracer
 
 __all__ = ["GridChoice", "SolverChoice", "PetscSettings", "check_inputs", "CurveRequest", "curve_settings", "trace_curve", "solve_at", "rigid_edge",
            "discretize", "configure_solvers", "expected_end", "F_MAX", "GRID_KINDS", "spring_start",
@@ -82,6 +82,7 @@ class GridChoice:
     def default_rmax(self) -> float:
         """r_m when the model leaves it to the grid: 150 for grids that follow the edge, 10 (the paper's) else."""
         if self.kind == "given":
+            assert self.r is not None, "a given grid holds its nodes (__post_init__)"
             return float(self.r[-1])
         return RMAX if self.kind == "edge" else grid.PAPER_RMAX
 
@@ -326,7 +327,7 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
     try:
         restored = checkpoint.restore(tracer) if checkpoint is not None else None
         phase, spent = restored or ("trace", {"trace": 0.0, "errors": 0.0})
-        bars = []
+        bars: list[tuple[Segment, Found]] = []
         estimates = {}          # id of a located event (the core's Found) -> its Estimate, or Missing
         if restored and progress is not None:
             progress.line(f"going on from the checkpoint {checkpoint.name} at lambda "
@@ -381,8 +382,11 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
         guard_activations=traced.guard_activations, smallest_step=traced.smallest_step,
         most_newton_its=traced.most_newton_its, most_ksp_its=traced.most_ksp_its, stop_reason=traced.stop_reason,
         wall_time_s=wall, lambda_start=lam0, wall_gap=traced.wall_gap, error_estimate=estimate)
-    spring = None if traced.spring is None else \
-        SpringResult(traced.spring.K, tuple(e for e in events if e.kind in ("jump_in", "jump_off")), traced.spring)
+    spring = None
+    if traced.spring is not None:
+        assert traced.spring.K is not None, "the cycle behind a spring holds its K"
+        spring = SpringResult(traced.spring.K, tuple(e for e in events if e.kind in ("jump_in", "jump_off")),
+                              traced.spring)
     curve = Curve(model=model, program=Program.of(comm),
                   grid=GridRecord(traced.r, traced.starts, traced.n_nodes, traced.edges), branch=traced.branch,
                   events=events, pull_off=traced.pull_off if kept("F_min") else None, rigid=traced.rigid,

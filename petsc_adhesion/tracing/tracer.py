@@ -35,7 +35,7 @@ from mpi4py import MPI
 from ..core.continuation import Continuation, Settings
 from ..core.newton import PetscSettings
 from ..core.events import EVENT_TOL, EventFinder
-from ..core.protocol import TracedProblem
+from ..core.protocol import Point, TracedProblem
 from ..discretization import grid
 from ..discretization.contact import contact_radius, crossing
 from ..discretization.edge_frame import EdgeFrameProblem
@@ -78,7 +78,7 @@ class Segment:
     """A stretch of the curve on one grid: its problem, continuation and events."""
 
     kind: str             # "fixed", "edge" or "scaled"
-    grid: object          # the EdgeGrid (None for a fixed grid)
+    grid: grid.EdgeGrid | None  # the EdgeGrid (None for a fixed grid)
     problem: TracedProblem
     cont: Continuation
     finder: EventFinder
@@ -111,7 +111,8 @@ class _Regrid:
     """The ``until`` criterion of a segment: the edge has travelled; the next segment, ready."""
 
     def __init__(self, tracer, seg: Segment):
-        self.tracer, self.seg, self.next = tracer, seg, None
+        self.tracer, self.seg = tracer, seg
+        self.next: tuple[Segment, Point] | None = None
         zone = _zone(seg.problem.model)
         half = band(seg.problem.model)
         self.travel = min(half / 2 + zone, REACH / 3)
@@ -120,6 +121,7 @@ class _Regrid:
     def target(self, b) -> tuple | None:
         """(kind, where, forced) of the next segment, or None to stay."""
         seg, tr = self.seg, self.tracer
+        assert seg.grid is not None, "a segment that regrids follows the edge on an EdgeGrid"
         edge = edge_of(seg.problem, b.x)
         if seg.kind == "scaled":
             a = seg.problem.radius(b.x)
@@ -177,7 +179,7 @@ class Tracer:
         self.natural, self.arclength = natural, arclength
         self.nodes, self.pmat, self.level, self.rmax = nodes, pmat, level, rmax
         self.segments: list[Segment] = []
-        self.sharp = None
+        self.sharp: bool | None = None
 
     def segment(self, kind: str, at: float | None = None, before: Segment | None = None,
                 level: int | None = None, settings: Settings | None = None, band: float | None = None,
@@ -189,12 +191,15 @@ class Tracer:
         level = self.level if level is None else level
         if kind == "fixed":
             nodes = grid.nested(self.nodes, level - self.level)
-            problem, design = Problem(self.model, nodes, create_influence(nodes, self.comm), self.pmat), None
+            problem: TracedProblem = Problem(self.model, nodes, create_influence(nodes, self.comm), self.pmat)
+            design = None
         elif kind == "edge":
+            assert at is not None, "an edge segment is centred on a given edge"
             design = grid_for(self.model, at, level, self.rmax)
             r = design.nodes()
             problem = Problem(self.model, r, create_influence(r, self.comm), self.pmat)
         else:
+            assert at is not None, "a scaled segment is centred on a given contact radius"
             design = scaled_grid_for(self.model, at, level, self.rmax, band, zone)
             rho = design.nodes() / at
             problem = EdgeFrameProblem(self.model, rho, create_influence(rho, self.comm), at, self.pmat)
@@ -231,7 +236,9 @@ class Tracer:
         if not self.segments:
             seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)
             self.segments.append(seg)
-            x = seg.problem.rigid(lam0, seg.problem.create_vec())
+            first = seg.problem
+            assert isinstance(first, Problem), "the first segment is on a fixed or an edge grid (a Problem)"
+            x = first.rigid(lam0, first.create_vec())
             try:
                 start = seg.cont.start(x, lam0)
             except RuntimeError as e:
@@ -281,10 +288,12 @@ class Tracer:
         except BaseException:
             seg.destroy()
             raise
-        if seg.cont.stop[0] != "p_min":
+        stop = seg.cont.stop
+        assert stop is not None, "a run ends with its reason"
+        if stop[0] != "p_min":
             seg.destroy()
             raise RuntimeError(f"the far branch could not be traced back to lambda = {p_min:.6g} "
-                               f"({seg.cont.stop[0]} at lambda = {seg.cont.points[-1].p:.6g})")
+                               f"({stop[0]} at lambda = {seg.cont.points[-1].p:.6g})")
         # in the curve's order; "far" marks its steps so that an event search on one takes its distance
         # along the tangent of the point before it (Continuation.turn_around)
         seg.cont.turn_around("far")
@@ -298,7 +307,8 @@ class Tracer:
         computed).  :meth:`restore` on a tracer made alike goes on as this one would."""
         index = {id(seg.finder): k for k, seg in enumerate(self.segments)}
         return {"segments": [{"kind": seg.kind, "at": seg.grid.edge if seg.grid is not None else None,
-                              "band": seg.grid.band if seg.kind == "scaled" else None, "zone": seg.zone,
+                              "band": seg.grid.band if seg.kind == "scaled" and seg.grid is not None else None,
+                              "zone": seg.zone,
                               "N": seg.problem.layout.N,
                               "guarded": seg.problem.guarded, "far": seg.far,
                               "continuation": seg.cont.state(solvers),

@@ -130,13 +130,13 @@ def _mapped_bytes() -> float:
     return 0.0
 
 
-def memory_limits(cgroups=CGROUP_MEMORY) -> list:
+def memory_limits(cgroups=CGROUP_MEMORY) -> list[tuple[float, float | None, str, bool]]:
     """Each limit on the memory this process may still take, as (bytes left, bytes of the limit or None, its
     name, whether what the process holds now is counted in it already): the machine's available memory
     (MemAvailable), the address-space limit (RLIMIT_AS, as ``ulimit -v`` sets it) less what the process maps
     already, and the control group's limit less what the group uses.  A limit that is not set (unlimited,
     'max', a v1 group's near 2^63) is left out."""
-    out = []
+    out: list[tuple[float, float | None, str, bool]] = []
     machine = _mem_available()
     if machine is not None:
         out.append((machine, None, "this machine has", False))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import re
+from typing import Any
 
 import numpy as np
 from petsc4py import PETSc
@@ -11,7 +12,7 @@ from petsc4py import PETSc
 from ...errors import InputError, printable
 from ...io.inputs import check_input
 from ...model.heights import HeightFileError, read_heights
-from ...model.parameters import Model
+from ...model.parameters import Model, PhysicalBodies
 from ...model.parameters import tabor
 from ...model.physical import Bodies
 from ...model.roughness import Measured
@@ -280,7 +281,8 @@ def read_physical(opts: AppOptions) -> Bodies | None:
     # each input's share of log mu (eq. 9), against a 1 um polymer sphere: the option that moved mu most is named
     shares = {"phys_radius": math.log(bodies.R / 1e-6) / 3,
               ("phys_gamma" if "gamma" in given else "phys_hamaker"): 2 * math.log(bodies.work_of_adhesion / 0.05) / 3,
-              ("phys_young2" if bodies.young2 is not None and bodies.young2 < bodies.young1 else "phys_young1"):
+              ("phys_young2" if bodies.young1 is not None and bodies.young2 is not None
+               and bodies.young2 < bodies.young1 else "phys_young1"):
                   -2 * math.log(bodies.E / 1e9) / 3,
               "phys_epsilon": -math.log(bodies.epsilon / 4e-10)}
     logmu = math.log(tabor(1e-6, 0.05, 1e9, 4e-10)) + sum(shares.values())
@@ -385,7 +387,8 @@ def read_petsc(opts: AppOptions, prefix: str) -> PetscSettings:
     the database, each marked read here.  An option no solver reads (misspelt, or for a PC not chosen) reaches
     the solver all the same and is left unread there (:func:`~.checks.check_unused` names it)."""
     others = tuple(p for p in ROLE_PREFIXES.values() if p and p != prefix)
-    kw, extra = {}, {}
+    kw: dict[str, Any] = {}
+    extra: dict[str, str | None] = {}
     for name in opts.db.getAll():
         bare = name[len(prefix):]
         if not name.startswith(prefix) or name in TABLE or (not prefix and name.startswith(others)) \
@@ -425,7 +428,7 @@ def read_solver(opts: AppOptions) -> SolverChoice:
                         **{role: read_petsc(opts, ROLE_PREFIXES[role]) for role in roles})
 
 
-def read_spring(opts: AppOptions, bodies: Bodies | None) -> float | None:
+def read_spring(opts: AppOptions, bodies: PhysicalBodies | None) -> float | None:
     """The stiffness K of the spring the approach is driven through (-afm_spring, or -phys_spring with the
     bodies: K = k epsilon / (2 pi R gamma)), or None for a rigid machine."""
     K, k = opts.real("afm_spring"), opts.real("phys_spring")
@@ -444,7 +447,7 @@ def read_spring(opts: AppOptions, bodies: Bodies | None) -> float | None:
 
 
 def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = False,
-                 bodies: Bodies | None = None) -> CurveRequest:
+                 bodies: PhysicalBodies | None = None) -> CurveRequest:
     """What a curve reports (-cont_lambda_start, -cont_at_lambda, -cont_event_tol, -cont_error_estimate,
     -target_error, -profiles, the spring of -afm_spring or -phys_spring with the ``bodies``); ``kinds`` and
     ``profiles`` as a study's case asks (behind a spring its jumps are reported with any kinds: they are

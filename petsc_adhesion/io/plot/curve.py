@@ -70,10 +70,10 @@ def _solid_dashed(ax, x, y, stable, label=None, joints=(), **style):
                     ys.append(y[i + 1])
                     solid.append(False)
                     dashed.append(True)
-    xs, ys, solid, dashed = np.array(xs), np.array(ys), np.array(solid), np.array(dashed)
-    line, = ax.plot(np.where(solid, xs, np.nan), np.where(solid, ys, np.nan), label=label, **style)
-    if dashed.any():
-        ax.plot(np.where(dashed, xs, np.nan), np.where(dashed, ys, np.nan), "--", color=line.get_color(),
+    X, Y, on, off = np.array(xs), np.array(ys), np.array(solid), np.array(dashed)
+    line, = ax.plot(np.where(on, X, np.nan), np.where(on, Y, np.nan), label=label, **style)
+    if off.any():
+        ax.plot(np.where(off, X, np.nan), np.where(off, Y, np.nan), "--", color=line.get_color(),
                 lw=line.get_linewidth())
     return line
 
@@ -189,6 +189,7 @@ def curve_figure(source, out: str, fmt: str = "png") -> None:
     load_approach(ax, res)
     legend(ax, fontsize=8)
     if spring:
+        assert ax_z is not None and ax_a is not None, "the spring's axes are made above"
         force_distance(ax_z, res)
         ax_z.set_xlabel("base of the spring Z = lambda + F / K")
         ax_z.set_ylabel("load F / (2 pi R gamma)")

@@ -60,7 +60,7 @@ def _kind(e: dict) -> str:
 def pull_offs(table: dict) -> dict:
     """Each case's pull-off from the event table: case -> (F, F_err, lambda, lambda_err); the most
     tensile load minimum (NaN bars where a case has none)."""
-    out = {}
+    out: dict[int, tuple[float, float, float, float]] = {}
     for i, kind, F, Fe, lam, le in zip(table["case"], table["kind"], table["F"], table["F_err"], table["lambda"],
                                        table["lambda_err"]):
         kind = kind.decode() if isinstance(kind, bytes) else str(kind)
