@@ -97,13 +97,9 @@ def test_jacobi_preconditioner_on_the_shell():
     H0 = ref.rigid(-2.0, ref.create_vec())
     assert newton.solve(-2.0, H0)
     pb, _ = make_problem(mu=1.0, pmat="shell")
-    from petsc_adhesion.core.newton import Newton
-    opts = PETSc.Options()
-    opts.setValue("jacobitest_pc_type", "jacobi")
-    try:
-        newton = Newton(pb, "jacobitest_")
-    finally:
-        opts.delValue("jacobitest_pc_type")
+    from petsc_adhesion.core.newton import Newton, PetscSettings
+    # the solver's settings are values now, applied under a prefix of its own
+    newton = Newton(pb, "jacobitest_", settings=PetscSettings(pc_type="jacobi"))
     assert newton.snes.getKSP().getPC().getType() == "jacobi"
     H = pb.rigid(-2.0, pb.create_vec())
     assert newton.solve(-2.0, H)

@@ -122,7 +122,8 @@ def refinement(mu: float, lam_max: float = math.inf, steps: int | None = None, s
                         values[level] = relocate(tracer, seg, found, level)
                 for key in ("lambda", "F"):
                     got = {k: (p.p if key == "lambda" else p.values["F"]) for k, p in values.items() if p is not None}
-                    out.append((found.label, key, got, est.get(key), est.get(f"{key}_err")))
+                    m = None if est is None else (est.lam if key == "lambda" else est.F)
+                    out.append((found.label, key, got, None if m is None else m.value, None if m is None else m.err))
     finally:
         tracer.destroy()
     return out
