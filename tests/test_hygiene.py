@@ -34,7 +34,8 @@ from petsc_adhesion.discretization.problem import Problem
 from petsc_adhesion.model.parameters import Model
 from petsc_adhesion.tracing import tracer as tracing_tracer
 from petsc_adhesion.tracing.critical import fold_system
-from petsc_adhesion.tracing.trace import GridChoice, solve_at, trace_curve
+from petsc_adhesion.core.newton import PetscSettings
+from petsc_adhesion.tracing.trace import GridChoice, SolverChoice, solve_at, trace_curve
 
 out = {"before": live()}
 
@@ -59,21 +60,18 @@ pb.destroy()
 out["diagonals"] = live()
 
 # the fold system, its KSP refused
-PETSc.Options().setValue("fold_ksp_type", "nonesuch")
 try:
-    fold_system(Model(mu=2.0, sigma=0.2, rmax=10.0), grid.uniform(51, 10.0), "sigma", 0.2)
+    fold_system(Model(mu=2.0, sigma=0.2, rmax=10.0), grid.uniform(51, 10.0), "sigma", 0.2,
+                settings=PetscSettings(options={"ksp_type": "nonesuch"}))
 except PETSc.Error:
     out["fold refused"] = True
-PETSc.Options().delValue("fold_ksp_type")
 out["fold"] = live()
 
 # a fixed-approach solve whose Newton fails: its guess vector too
-PETSc.Options().setValue("snes_max_it", "1")
 try:
-    solve_at(-2.0, Model(mu=1.0), GridChoice("uniform", n=101))
+    solve_at(-2.0, Model(mu=1.0), GridChoice("uniform", n=101), SolverChoice(fixed=PetscSettings(snes_max_it=1)))
 except RuntimeError:
     out["solve failed"] = True
-PETSc.Options().delValue("snes_max_it")
 out["solve"] = live()
 
 # a curve whose change of grid fails: the new segment and every other
