@@ -401,7 +401,9 @@ class Generator:
             name = self.pick(self.app)
             if kind == "misspelt":
                 bad, value = self.misspelt(name), self.value(TABLE[name])
-                if not (bad in TABLE and self.costly(TABLE[bad], value)):      # a "misspelling" may be right
+                # a "misspelling" may be right; one that names an output would be an output the oracle
+                # does not know of (the misspelling of an option whose name is one letter from -out)
+                if bad not in OUTPUTS and not (bad in TABLE and self.costly(TABLE[bad], value)):
                     case.add(f"-{bad}", *([] if self.chance(0.3) else [value]))
             elif kind == "random":
                 n = int(self.rng.integers(1, 20))
