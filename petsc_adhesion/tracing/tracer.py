@@ -27,6 +27,7 @@ close to an event), unless the old grid no longer resolves the edge.
 from __future__ import annotations
 
 import math
+from typing import Any
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -236,8 +237,9 @@ class Tracer:
         if not self.segments:
             seg = self.segment("fixed" if self.nodes is not None else "edge", 0.0)
             self.segments.append(seg)
-            first = seg.problem
-            assert isinstance(first, Problem), "the first segment is on a fixed or an edge grid (a Problem)"
+            # the first segment is on a fixed or an edge grid, a physical-frame problem with the rigid state
+            # (eq. 27); the tracer asks it by that method, not by its class
+            first: Any = seg.problem
             x = first.rigid(lam0, first.create_vec())
             try:
                 start = seg.cont.start(x, lam0)
