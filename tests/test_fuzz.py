@@ -1124,7 +1124,8 @@ def test_fuzz_in_process(tmp_path, assets):
     if code not in (0, None):
         failures.append(f"the worker ended with status {code} after its last case (see {tmp_path}/worker*.log)")
     print(f"\nfuzz, seed {SEED}: {len(cases)} cases in {time.perf_counter() - t0:.1f} s\n" + _summary(stats))
-    assert not failures, f"{len(failures)} of {len(cases)} cases failed:\n" + "\n".join(failures[:30])
+    report = f"{len(failures)} of {len(cases)} cases failed:\n" + "\n".join(failures[:30])
+    assert not failures, report.encode("utf-8", "backslashreplace").decode("utf-8")   # surrogate escapes: see below
 
 
 # -- the command line: real processes, some under mpiexec -n 2 ------------------------------------------
@@ -1183,7 +1184,9 @@ def test_fuzz_command_line(tmp_path, assets):
                             + "\n    ".join(problems) + f"\n    stderr: {err[-400:]!r}")
     print(f"\ncommand-line fuzz, seed {SEED + 1}: {len(cases)} cases in {time.perf_counter() - t0:.1f} s\n"
           + _summary(stats))
-    assert not failures, f"{len(failures)} of {len(cases)} cases failed:\n" + "\n".join(failures)
+    # the cases' arguments hold undecodable bytes (surrogate escapes): a report that pytest-xdist's workers can send
+    report = (f"{len(failures)} of {len(cases)} cases failed:\n" + "\n".join(failures))
+    assert not failures, report.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 # ======================================================================================================
