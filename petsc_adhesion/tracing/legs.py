@@ -301,3 +301,35 @@ def instrument_curve(branch: Branch, jumps, K: float, trigger: float | None) -> 
     if finite and not reached:
         notes.append(f"the approach ends at F = {approach.F[-1]:.6g}, short of the trigger {trigger:.6g}")
     return InstrumentCurve(K, approach, retract, float(trigger) if finite else None, reached, tuple(notes))
+
+
+def rigid_pull_off(model) -> float:
+    """The pull-off of the rigid sphere under ``model``'s pressure law (its roughness average included): the
+    least of its load F(H0) = (8/3) integral from H0 to infinity of P(H) dH (eqs. 26, 27: -1 smooth, DMT's),
+    reached where P(H0) = 0.  An estimate of a curve's pull-off before it is traced: its DMT end (mu -> 0);
+    a soft sphere's is smaller in magnitude, down to 3/4 of it (JKR's)."""
+    from ..model.pressure import pressure_law
+
+    law = pressure_law(model)
+    H = law.wall + np.geomspace(1e-6, 1e4, 4001)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        P = np.asarray(law(H)[0], dtype=float)
+    attract = np.flatnonzero(np.isfinite(P) & (P < 0))
+    if not attract.size:
+        raise ValueError("the pressure law attracts nowhere")
+    i = int(attract[0])                 # P turns attractive between H[i - 1] and H[i]: the load is least there
+    if i > 0 and np.isfinite(P[i - 1]):
+        H0 = H[i - 1] + (H[i] - H[i - 1]) * P[i - 1] / (P[i - 1] - P[i])
+        Ht, Pt = np.r_[H0, H[i:]], np.r_[0.0, P[i:]]
+    else:
+        Ht, Pt = H[i:], P[i:]
+    tail = Pt[-1] * Ht[-1] / 2.0        # P ~ -H^-3 far out: the rest of the integral
+    return float(8.0 / 3.0 * (np.sum(np.diff(Ht) * (Pt[1:] + Pt[:-1]) / 2.0) + tail))
+
+
+def default_trigger(model) -> tuple[float, float]:
+    """(the trigger, the pull-off it is made from) of a run behind a spring with physical inputs and no stop
+    load given: :data:`TRIGGER_FACTOR` times the magnitude of the rigid sphere's pull-off
+    (:func:`rigid_pull_off`), an instrument's setpoint of a few times the adhesion."""
+    pull = rigid_pull_off(model)
+    return TRIGGER_FACTOR * abs(pull), pull
