@@ -235,9 +235,11 @@ TABLE = {o.name: o for o in [
     Option("summary", "string", None, "JSON summary file"),
     Option("profiles", "flag", False, "store H(r) and P(r) at every event"),
     Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
-    Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, Z and stable_spring "
-           "behind a spring, contact radius, stable (0/1), and in nm and nN with -phys_ inputs; a study: its table "
-           "of events; not with -adh_lambda"),
+    Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, contact radius, "
+           "stable (0/1); behind a spring the approach and the retract its cantilever follows instead: leg, base "
+           "Z, tip-sample separation, deflection, F, lambda, contact radius, jump (1: the tip jumps at constant Z "
+           "to the next row); in nm and nN too with -phys_ inputs; a study: its table of events; not with "
+           "-adh_lambda"),
     Option("csv_events", "string", None, "CSV of the curve's events, a row each: kind, best values, error bars, "
            "landing, single-grid values (in nm and nN too with -phys_ inputs); not with -adh_lambda nor in a study"),
     Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "
