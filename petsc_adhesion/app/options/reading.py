@@ -483,7 +483,9 @@ def read_trigger(opts: AppOptions, model: Model) -> float | None:
                          "approach; without one, -cont_F_max stops the curve")
     if t is not None:
         bodies = model.bodies
-        assert bodies is not None, "a spring of -phys_spring has its bodies (read_spring)"
+        if bodies is None:
+            raise InputError("-phys_trigger: needs the bodies' -phys_ options (radius, young1, poisson1, gamma or "
+                             "hamaker, epsilon) to make the force in units of 2 pi R gamma; or give -afm_trigger")
         T = _finite(lambda: t / bodies.scales()["force_N"])
         if not 0 < T <= TABLE["afm_trigger"].hi:
             raise InputError(f"-phys_trigger: gives the trigger F = {T:.3g} x 2 pi R gamma, outside "
