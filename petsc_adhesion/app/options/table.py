@@ -234,7 +234,9 @@ TABLE = {o.name: o for o in [
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
     Option("profiles", "flag", False, "store H(r) and P(r) at every event"),
-    Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
+    Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles); behind a "
+           "spring led by the approach and retract its cantilever follows (force in nN against piezo in nm with "
+           "-phys_ inputs)"),
     Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, contact radius, "
            "stable (0/1); behind a spring the approach and the retract its cantilever follows instead: leg, base "
            "Z, tip-sample separation, deflection, F, lambda, contact radius, jump (1: the tip jumps at constant Z "

@@ -8,11 +8,14 @@ events marked, unstable branches dashed, and the profiles at the events when the
 file holds them), a fixed-approach solve (H and P), a study (its own kind of
 figure) or a critical study (the boundary of hysteresis); with physical inputs,
 a curve gets axes in nm and nN beside the dimensionless ones.  A curve traced behind
-a spring (``-afm_spring``, ``-phys_spring``: the file's curve has ``Z``) gets two more
-panels: the load against the spring's base Z (the force-distance curve of an AFM,
-stable parts solid, the jumps drawn at constant Z from each jump-in and jump-off to
-its landing) and the contact radius against the load along the curve.  It reads HDF5
-only: neither MPI nor PETSc is started.
+a spring (``-afm_spring``, ``-phys_spring``: the file has the group ``instrument``) is led
+by the force curve as the instrument records it (:func:`instrument_panel`: force in nN
+against piezo displacement in nm with physical inputs, approach and retract in two
+colours, the jumps at constant Z, the jump-in, pull-off and jump-off labelled with their
+bars, the energy of the cycle shaded and stated, after the fit's figure,
+:mod:`~petsc_adhesion.io.plot.fit`), with the rigid machine's load-approach curve and the
+contact radius against the load beside it.  It reads HDF5 only: neither MPI nor PETSc is
+started.
 """
 from __future__ import annotations
 
