@@ -127,12 +127,13 @@ def legs_csv_columns(legs: dict, physical: dict | None = None) -> list:
     """The columns of the legs' CSV (header name, unit, values), from the HDF5 group ``instrument``
     (:func:`~petsc_adhesion.io.summary.legs_record`): a row per point, the approach's then the retract's,
     ``leg`` naming which, ``jump`` 1 at a turning point the tip jumps from (to the next row, at the same Z)."""
-    names, jump = [], []
+    names: list[str] = []
+    jump: list[bool] = []
     for leg in ("approach", "retract"):
         n, at = len(legs[leg]["Z"]), set(int(i) for i in legs[leg]["jumps"])
         names += [leg] * n
         jump += [i in at for i in range(n)]
-    cols = [("leg", None, names)]
+    cols: list[tuple[str, str | None, list]] = [("leg", None, names)]
     cols += [(k, unit, [float(v) for leg in ("approach", "retract") for v in legs[leg][k]])
              for k, unit in LEG_COLUMNS]
     return _with_physical(cols + [("jump", None, jump)], physical)

@@ -70,8 +70,8 @@ def event_value(e, key: str, K: float | None = None) -> float:
 
 @dataclass(frozen=True)
 class Piece:
-    """One piece stable behind the spring: its traced points in order (lambda, Z and F growing... Z
-    non-decreasing), the turning point it starts at (``start``, a jump_off) and ends at (``end``, a
+    """One piece stable behind the spring: its traced points in order (lambda and Z growing), the turning
+    point it starts at (``start``, a jump_off) and ends at (``end``, a
     jump_in) put at its ends at their grid values, None where the piece starts or ends with the curve."""
 
     lam: np.ndarray = field(repr=False)
@@ -265,14 +265,10 @@ def _leg(name: str, pieces, order: list[int], step: int, K: float, notes: list) 
             for c, v in zip(cols, entry):
                 c.append(v)
             idx = idx[(p.Z[idx] - entry[0]) * step > 0]
-        last = k + 1 < len(order)
-        if last:                         # up to the turning point it leaves at (the piece's end, put there)
-            fold = p.end if step > 0 else p.start
-            stop = p.Z.size - 1 if step > 0 else 0
-            idx = idx[(idx <= stop) if step > 0 else (idx >= stop)]
         for c, a in zip(cols, (p.Z, p.F, p.lam, p.contact_radius)):
             c.extend(float(v) for v in a[idx])
-        if last:
+        if k + 1 < len(order):           # it leaves at the turning point its last point is (put there)
+            fold = p.end if step > 0 else p.start
             entry = _landing_point(pieces, order[k + 1], fold, K, notes)
     Z, F, lam, radius = (np.array(c, dtype=float) for c in cols)
     return Leg(name, K, Z, F, lam, radius, tuple(jumps))
@@ -296,11 +292,11 @@ def instrument_curve(branch: Branch, jumps, K: float, trigger: float | None) -> 
     down, _ = chain(pieces, starts, len(pieces) - 1, -1)
     approach = _leg(APPROACH, pieces, up, +1, K, notes)
     retract = _leg(RETRACT, pieces, down, -1, K, notes)
-    finite = trigger is not None and np.isfinite(trigger)
-    reached = bool(finite and approach.F[-1] >= trigger and up[-1] == len(pieces) - 1)
-    if finite and not reached:
-        notes.append(f"the approach ends at F = {approach.F[-1]:.6g}, short of the trigger {trigger:.6g}")
-    return InstrumentCurve(K, approach, retract, float(trigger) if finite else None, reached, tuple(notes))
+    stop = float(trigger) if trigger is not None and np.isfinite(trigger) else None
+    reached = bool(stop is not None and approach.F[-1] >= stop and up[-1] == len(pieces) - 1)
+    if stop is not None and not reached:
+        notes.append(f"the approach ends at F = {approach.F[-1]:.6g}, short of the trigger {stop:.6g}")
+    return InstrumentCurve(K, approach, retract, stop, reached, tuple(notes))
 
 
 def rigid_pull_off(model) -> float:

@@ -503,6 +503,7 @@ def read_settings(opts: AppOptions, model: Model | None = None):
     trigger = None if model is None else read_trigger(opts, model)
     stop, dF = opts.real("cont_F_max"), opts.real("cont_dF_max")
     if trigger is not None:
+        assert model is not None, "a trigger is read with its model"
         stop, dF = trigger, min(dF, figure_step(trigger, rigid_pull_off(model)))
     return curve_settings(1.0 if model is None else step_scale(model), corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                           ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),

@@ -176,12 +176,10 @@ def instrument_panel(ax, res: dict) -> None:
         if land:
             marks.append((joff, float(land["F"]), ">", "jump-off",
                           f"jump-off: Z = {_pm(float(joff['Z']), joff.get('Z_err'), sz, uz)}"))
-    for ev, F, marker, _, text in marks:
-        Z = float(ev["Z"])
-        colour = "k"
-        ax.errorbar(sz * Z, sf * F, xerr=sz * float(ev.get("Z_err", 0.0) or 0.0),
-                    yerr=sf * float(ev.get("F_err", 0.0) or 0.0) if F == float(ev["F"]) else None,
-                    fmt=marker, color=colour, ms=7, mfc="none", capsize=3, label=text)
+    for ev, at, marker, _, text in marks:
+        bar_F = sf * float(ev.get("F_err", 0.0) or 0.0) if at == float(ev["F"]) else None   # a landing: no F bar
+        ax.errorbar(sz * float(ev["Z"]), sf * at, xerr=sz * float(ev.get("Z_err", 0.0) or 0.0), yerr=bar_F,
+                    fmt=marker, color="k", ms=7, mfc="none", capsize=3, label=text)
     ax.set_xlabel("piezo displacement Z (nm)" if phys else "base of the spring Z / epsilon")
     ax.set_ylabel("force (nN)" if phys else "force F / (2 pi R gamma)")
     K = float(legs["K"])
