@@ -229,3 +229,18 @@ def test_contradictions_are_one_line(tmp_path, args, line):
     lines = proc.stderr.splitlines()
     assert proc.returncode == 2 and len(lines) == 1 and lines[0].startswith(PREFIX + line), proc.stderr
     assert os.listdir(tmp_path) == []
+
+
+def test_a_trigger_in_newtons(tmp_path):
+    """-phys_trigger 5 nN on the 20 nm tip: 5e-9 / (2 pi R gamma) = 5e-9 / 6.2832e-9 N by hand; the approach
+    ends there, within one step of the load (1/50 of the range from the rigid pull-off, -1, to it)."""
+    proc = run_cli(*TIP, "-phys_trigger", "5e-9", "-cont_error_estimate", "false", "-out", tmp_path / "n.h5")
+    assert proc.returncode == 0, proc.stderr
+    unit = 2 * np.pi * 20e-9 * 0.05
+    with h5py.File(tmp_path / "n.h5", "r") as f:
+        trigger, last = f["instrument"].attrs["trigger"], f["instrument/approach/F"][-1]
+        force_nN = f["physical"].attrs["force_nN"]
+    assert trigger == pytest.approx(5e-9 / unit, rel=1e-12)
+    assert force_nN == pytest.approx(unit / 1e-9, rel=1e-12)
+    step = (trigger + 1.0) / 50
+    assert trigger <= last <= trigger + step
