@@ -41,7 +41,7 @@ def test_the_plot_of_a_spring_run_has_its_force_distance_and_contact_panels(tmp_
     labels = _panels(out)
     assert len(labels) == 3, labels
     assert any(lab.startswith("approach lambda") for lab in labels)
-    assert any("base of the spring Z" in lab and "load F" in lab for lab in labels)
+    assert any("base of the spring Z" in lab and "force F" in lab for lab in labels)    # the instrument's legs
     assert any("contact radius" in lab for lab in labels)
     # the run's -plot and the plot command draw it
     proc = run_cli("plot", out, "-o", tmp_path / "again.png")
@@ -58,8 +58,8 @@ def test_a_cantilever_in_si_gets_nm_and_nn_on_its_force_distance_panel(tmp_path)
                    "-out", out)
     assert proc.returncode == 0, proc.stderr
     labels = _panels(out)
-    z = next(lab for lab in labels if "base of the spring Z" in lab)
-    assert "Z (nm)" in z and "load (nN)" in z
+    # the instrument's legs on the main axes in nm and nN (no second axes there)
+    assert "piezo displacement Z (nm)|force (nN)" in labels, labels
     assert any("contact radius (nm)" in lab for lab in labels)
 
 
@@ -156,8 +156,13 @@ def test_the_closed_forms_of_the_figures():
 def test_afm_md_names_its_figures_and_commands():
     text = open(os.path.join(ROOT, "docs", "afm.md")).read()
     pngs = re.findall(r"\(figures/(afm_\w+)\.png\)", text)
-    assert sorted(pngs) == ["afm_example", "afm_radius", "afm_stiffness"]
-    for png in pngs:
+    assert sorted(pngs) == ["afm_example", "afm_probe", "afm_radius", "afm_stiffness", "afm_tip"]
+    for png in ("afm_probe", "afm_tip"):        # the program's own figure: made by the command shown beside it
+        assert os.path.exists(os.path.join(ROOT, "docs", "figures", f"{png}.png"))
+        command = text.split(f"-plot docs/figures/{png}.png")[0].rsplit("```sh", 1)[1]
+        assert "petsc-adhesion" in command and "-phys_spring" in command
+        assert text.index(f"-plot docs/figures/{png}.png") < text.index(f"(figures/{png}.png)")
+    for png in ("afm_example", "afm_radius", "afm_stiffness"):
         assert os.path.exists(os.path.join(ROOT, "docs", "figures", f"{png}.png"))
         table = open(os.path.join(ROOT, "docs", "figures", f"{png}.md")).read()
         what = png.split("_", 1)[1]
@@ -165,7 +170,8 @@ def test_afm_md_names_its_figures_and_commands():
         assert f"python -m petsc_adhesion.benchmarks.afm {what}" in text or \
             "python -m petsc_adhesion.benchmarks.afm`" in text
     for needle in ("options/afm_map.opts", "CurveRequest(spring=", "curve.spring", "curve.rigid.energy",
-                   "curve.contact_radius", "-afm_spring", "-phys_spring"):
+                   "curve.contact_radius", "-afm_spring", "-phys_spring", "-phys_trigger", "-afm_trigger",
+                   "curve.instrument"):
         assert needle in text, needle
 
 

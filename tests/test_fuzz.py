@@ -860,15 +860,15 @@ def check_h5(path: str) -> tuple[list, dict]:
 
 
 def check_csv(path: str, opt: str) -> list:
-    """A CSV export: its header's first column (lambda for -csv, kind for -csv_events), every row as long as
-    the header, every number finite."""
+    """A CSV export: its header's first column (lambda for -csv, leg for -csv behind a spring: its legs; kind
+    for -csv_events), every row as long as the header, every number finite."""
     import csv
     try:
         with open(path, newline="", encoding="utf-8") as f:
             rows = list(csv.reader(f))
     except (OSError, UnicodeDecodeError, csv.Error) as e:
         return [f"{path}: not a CSV file ({e})"]
-    first = "kind" if opt == "csv_events" else "lambda"
+    first = ("kind",) if opt == "csv_events" else ("lambda", "leg")
     if not rows or not rows[0] or not rows[0][0].startswith(first):
         return [f"{path}: -{opt} has no header starting with {first} ({rows[:1]!r})"]
     bad = [f"{path}: row {i} has {len(r)} cells, the header {len(rows[0])}" for i, r in enumerate(rows[1:], 1)

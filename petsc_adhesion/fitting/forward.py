@@ -21,6 +21,11 @@ On each piece, Z(lambda) and F(lambda) are cubic splines through the traced
 points in lambda (which grows on a piece), with the turning point's own values
 at a folded end and its slopes there, dZ/dlambda = 0 and dF/dlambda = -K; F(Z)
 is read off a table of 8 evaluations between two traced points.
+
+The pieces, the pieces their jumps land on and the chains of pieces each leg
+follows are the instrument's legs' own (:mod:`petsc_adhesion.tracing.legs`: one
+implementation); this module adds F(Z) between the traced points and beyond the
+curve's ends, for a fit's residuals at the measured Z.
 """
 from __future__ import annotations
 
@@ -29,12 +34,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.reference.rigid import rigid_load
+from ..tracing.legs import APPROACH, RETRACT, chain, event_value, landing_piece, stable_pieces
 
-__all__ = ["Piece", "ForwardCurve", "APPROACH", "RETRACT", "curve_branch", "curve_stop_reason", "curve_jumps",
-           "event_landing", "event_value",
+__all__ = ["Piece", "ForwardCurve", "APPROACH", "RETRACT", "curve_stop_reason", "curve_jumps",
+           "event_value",
            "pull_off_values"]
 
-APPROACH, RETRACT = "approach", "retract"
 #: Table entries per interval between two traced points.
 _SUBDIVIDE = 8
 
@@ -74,29 +79,7 @@ def _spline(x: np.ndarray, y: np.ndarray, left: float | None, right: float | Non
     return CubicSpline(x, y, bc_type=bc)
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """The maximal runs [i0, i1] of True in ``mask``."""
-    out, i, n = [], 0, mask.size
-    while i < n:
-        if mask[i]:
-            j = i
-            while j + 1 < n and mask[j + 1]:
-                j += 1
-            out.append((i, j))
-            i = j + 1
-        else:
-            i += 1
-    return out
-
-
 # -- what fitting/ reads of a traced Curve: these functions alone ---------------------------------------------
-def curve_branch(curve) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(lambda, Z, F, stable behind the spring) at every computed point of a curve traced behind a spring."""
-    b = curve.branch
-    lam, Z, F = (np.asarray(a, dtype=float) for a in (b.lam, b.Z, b.F))
-    return lam, Z, F, np.asarray(b.stable_spring, dtype=bool)
-
-
 def curve_stop_reason(curve) -> str:
     """Why the traced curve ended."""
     return str(curve.diagnostics.stop_reason)
@@ -105,17 +88,6 @@ def curve_stop_reason(curve) -> str:
 def curve_jumps(curve, kind: str) -> list:
     """The events of ``kind`` (jump_in or jump_off) of a curve traced behind a spring."""
     return [e for e in curve.events if e.kind == kind]
-
-
-def event_landing(e):
-    """The state a jump lands on (an event), None where the library found none."""
-    return getattr(e, "landing", None)
-
-
-def event_value(e, key: str) -> float:
-    """An event's ``key`` (lam or F) on its grid (its best value when it has none)."""
-    m = getattr(e, key)                 # a Measured
-    return float(m.grid if m.grid is not None else m.value)
 
 
 def pull_off_values(e) -> tuple[float, float | None, float]:
@@ -127,10 +99,7 @@ def pull_off_values(e) -> tuple[float, float | None, float]:
 
 def _value(e, key: str, K: float | None = None) -> float:
     """An event's value on its grid (its best value when it has none): lam, F, or Z = lam + F / K."""
-    if key == "Z":
-        assert K is not None, "Z = lam + F / K is asked with the spring's K"
-        return _value(e, "lam") + _value(e, "F") / K
-    return event_value(e, key)
+    return event_value(e, key, K)
 
 
 class ForwardCurve:
@@ -143,52 +112,24 @@ class ForwardCurve:
     """
 
     def __init__(self, curve, K: float):
-        lam, Z, F, stable = curve_branch(curve)
         self.K = float(K)
-        self.notes: list[str] = []
-        events = {k: curve_jumps(curve, k) for k in ("jump_in", "jump_off")}
-        used: set[int] = set()
-        raw = []
-        for i0, i1 in _runs(stable):
-            keep = np.arange(i0, i1 + 1)
-            pl, pz, pf = lam[keep], Z[keep], F[keep]
-            start = self._match(events["jump_off"], used, pl[0], pz[0], K) if i0 > 0 else None
-            end = self._match(events["jump_in"], used, pl[-1], pz[-1], K) if i1 < lam.size - 1 else None
-            if start is not None:
-                pl, pz, pf = np.r_[_value(start, "lam"), pl], np.r_[_value(start, "Z", K), pz], np.r_[_value(start, "F"), pf]
-            if end is not None:
-                pl, pz, pf = np.r_[pl, _value(end, "lam")], np.r_[pz, _value(end, "Z", K)], np.r_[pf, _value(end, "F")]
-            raw.append((pl, pz, pf, start, end))
-        if not raw:
-            raise ValueError("the traced curve has no state stable behind the spring")
-        self.pieces = [self._piece(*r) for r in raw]
-        for kind, evs in events.items():
-            left = [e for e in evs if id(e) not in used]
-            if left:
-                self.notes.append(f"{len(left)} {kind} inside one step of the curve left out (a hysteresis loop "
-                                  f"narrower than a step)")
-        for i, (_, _, _, start, end) in enumerate(raw):
-            p = self.pieces[i]
-            if start is not None:
-                p.start_to = self._landing(start, i, -1)
-            if end is not None:
-                p.end_to = self._landing(end, i, +1)
+        shared, notes = stable_pieces(curve.branch, curve_jumps(curve, "jump_in") + curve_jumps(curve, "jump_off"),
+                                      self.K)
+        self.notes: list[str] = list(notes)
+        self.pieces = [self._piece(p.lam, p.Z, p.F, p.start, p.end) for p in shared]
+        for i, p in enumerate(shared):
+            if p.start is not None:
+                self.pieces[i].start_to = self._landing(p.start, i, -1)
+            if p.end is not None:
+                self.pieces[i].end_to = self._landing(p.end, i, +1)
         first = self.pieces[0]
         self._lam0, self._F0 = float(first.lam[0]), float(first.F[0])
         rigid0 = float(rigid_load(self._lam0))
         self._far_factor = self._F0 / rigid0 if rigid0 < 0 and self._F0 < 0 else 1.0
-        self.chains = {APPROACH: self._chain(0, "end_to", +1), RETRACT: self._chain(len(self.pieces) - 1, "start_to", -1)}
+        self.chains = {APPROACH: chain(self.pieces, [p.end_to for p in self.pieces], 0, +1),
+                       RETRACT: chain(self.pieces, [p.start_to for p in self.pieces], len(self.pieces) - 1, -1)}
 
     # -- construction ---------------------------------------------------------------
-    @staticmethod
-    def _match(events: list, used: set, lam: float, Z: float, K: float):
-        """The turning point (of ``events``, not yet used) nearest to the end (lam, Z) of a run."""
-        best = min((e for e in events if id(e) not in used),
-                   key=lambda e: abs(_value(e, "lam") - lam) + abs(_value(e, "Z", K) - Z), default=None)
-        if best is not None:
-            used.add(id(best))
-        return best
-
     def _piece(self, lam, Z, F, start, end) -> Piece:
         order = np.argsort(lam, kind="stable")
         lam, Z, F = lam[order], Z[order], F[order]
@@ -216,40 +157,13 @@ class ForwardCurve:
         return Piece(dense, Zd, Fd, start_fold=start is not None, end_fold=end is not None)
 
     def _landing(self, event, i: int, step: int) -> int | None:
-        """The piece the jump of ``event`` at an end of piece ``i`` lands on: the library's landing, else the
-        next piece in the jump's direction that holds its Z."""
-        Zf = _value(event, "Z", self.K)
-        land = event_landing(event)
-        others = range(i + step, len(self.pieces) if step > 0 else -1, step)
-        if land is not None:
-            lam_l = _value(land, "lam")
-            for j in others:
-                p = self.pieces[j]
-                span = max(p.lam[-1] - p.lam[0], 1.0)
-                if p.lam[0] - 1e-6 * span <= lam_l <= p.lam[-1] + 1e-6 * span:
-                    return j
-        for j in others:
-            p = self.pieces[j]
-            if p.Z_lo <= Zf <= p.Z_hi or (step > 0 and j == len(self.pieces) - 1 and Zf >= p.Z_lo) or \
-                    (step < 0 and j == 0 and Zf <= p.Z_hi):
-                return j
-        self.notes.append(f"the jump at Z = {Zf:.6g} lands on no traced piece; the piece before it is continued")
-        return None
-
-    def _chain(self, first: int, link: str, step: int) -> tuple[list[int], np.ndarray]:
-        """The pieces a leg follows and the Z at which it leaves each (increasing on the approach, decreasing on
-        the retract)."""
-        chain, p = [first], first
-        cuts: list[float] = []
-        while getattr(self.pieces[p], link) is not None and len(chain) <= len(self.pieces):
-            nxt = getattr(self.pieces[p], link)
-            cut = self.pieces[p].Z_hi if step > 0 else self.pieces[p].Z_lo
-            if nxt in chain or (cuts and (cut - cuts[-1]) * step <= 0):
-                break
-            chain.append(nxt)
-            cuts.append(cut)
-            p = nxt
-        return chain, np.array(cuts, dtype=float)
+        """The piece the jump of ``event`` at an end of piece ``i`` lands on (:func:`landing_piece`), None with
+        a note where none holds it (the piece before it is then continued)."""
+        j = landing_piece(self.pieces, i, event, step, self.K)
+        if j is None:
+            self.notes.append(f"the jump at Z = {_value(event, 'Z', self.K):.6g} lands on no traced piece; the "
+                              f"piece before it is continued")
+        return j
 
     # -- predictions ----------------------------------------------------------------
     @property

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .summary import branch_record, event_record, head_of, solve_record, spread_record, summary_of
+from .summary import branch_record, event_record, head_of, legs_record, solve_record, spread_record, summary_of
 
 __all__ = ["DESCRIBE", "curve_tree", "study_table", "CRITICAL_KEYS", "critical_table", "with_options", "case_tree", "solve_tree",
            "spread_tree"]
@@ -58,6 +58,22 @@ DESCRIBE = {
     "curve/newton_its": ("", "Newton iterations of the corrector"),
     "curve/ksp_its": ("", "Krylov iterations of the corrector and the tangent"),
     "curve/corrector": ("", "start, natural (eq. 21-22) or arclength (eq. 24-25)"),
+    "instrument": (f"K: {_LOAD} / {_EPS}; trigger: {_LOAD}", "behind a spring: the approach and the retract "
+                   "its cantilever follows (tracing/legs.py), the stable branches with the jumps vertical at constant "
+                   "Z, made of the solver's points (the traced points, the turning points and their landings at "
+                   "their grid values); trigger: the load the approach was to end at, reached: whether it did; "
+                   "missing: why there are no legs"),
+    "instrument/*": ("", "one leg (approach or retract), its points in the order the instrument records them"),
+    "instrument/*/Z": (_EPS, "base (piezo) position Z = lambda + F / K, growing toward the flat"),
+    "instrument/*/separation": (_EPS, "tip-sample separation as an instrument computes it, -(Z - F / K) = "
+                                "-lambda: 0 where the undeformed sphere sits at epsilon from the flat, negative "
+                                "an indentation"),
+    "instrument/*/deflection": (_EPS, "deflection of the cantilever F / K, positive pushed away from the flat"),
+    "instrument/*/F": (_LOAD, "force (eq. 26), negative when tensile"),
+    "instrument/*/lambda": (_EPS, "approach lambda of the tip (the sphere)"),
+    "instrument/*/contact_radius": (_RAD, "contact radius (NaN at a landing the solver gave none)"),
+    "instrument/*/jumps": ("", "indices i (from 0) at which the tip jumps at constant Z from point i, a turning "
+                           "point, to point i + 1, its landing"),
     "events": ("", "events located on the curve, in the order found"),
     "events/*": (f"{_STATE}; {_ERRORS}", "one event: kind (snap_on, snap_off, F_min, F_max, equilibrium, "
                  "lambda; behind a spring jump_in, jump_off), its state, stability, error estimates"),
@@ -139,6 +155,8 @@ def curve_tree(curve, options: dict) -> dict:
     points, the events, the summary and the model spread (when computed)."""
     tree = {**with_options(head_of(curve), options), "kind": "curve", "curve": branch_record(curve),
             "events": [event_record(e) for e in curve.events], "summary": _h5_summary(summary_of(curve))}
+    if curve.instrument is not None:
+        tree["instrument"] = legs_record(curve.instrument)
     if curve.spread is not None:
         tree["model_spread"] = spread_tree(curve.spread)
     return tree

@@ -27,7 +27,7 @@ if TYPE_CHECKING:                    # tracing.critical loads PETSc, which a fil
     from ..tracing.model_spread import ModelSpread
 
 __all__ = ["event_record", "branch_record", "program_record", "model_record", "head_of", "summary_of",
-           "solve_summary", "cycle_summary", "critical_record", "spread_record", "KEYS"]
+           "solve_summary", "cycle_summary", "critical_record", "spread_record", "legs_record", "LEG_KEYS", "KEYS"]
 
 #: A field's name -> the key the files have always used for it.
 KEYS = {"lam": "lambda", "note": "error_note"}
@@ -65,6 +65,28 @@ def branch_record(curve: Curve) -> dict:
     """The points of a curve as the HDF5 group ``curve`` holds them (Z and stable_spring behind a spring)."""
     b = curve.branch
     return {_BRANCH.get(f.name, f.name): getattr(b, f.name) for f in fields(b) if getattr(b, f.name) is not None}
+
+
+#: A leg's arrays as the HDF5 group ``instrument/approach`` (``retract``) holds them, in the CSV's order.
+LEG_KEYS = ("Z", "separation", "deflection", "F", "lambda", "contact_radius")
+
+
+def legs_record(legs) -> dict:
+    """The instrument's legs (:class:`~petsc_adhesion.tracing.legs.InstrumentCurve`) as the HDF5 group
+    ``instrument`` holds them: K, the trigger (absent without one) and whether the approach reached it, the
+    notes, and a group per leg with its arrays and the indices of its jumps; a Missing: its reason alone."""
+    if isinstance(legs, Missing):
+        return {"missing": legs.reason}
+    out: dict[str, object] = {"K": legs.K, "reached": legs.reached}
+    if legs.trigger is not None:
+        out["trigger"] = legs.trigger
+    if legs.notes:
+        out["notes"] = list(legs.notes)
+    for leg in legs.legs:
+        out[leg.name] = {"Z": leg.Z, "separation": leg.separation, "deflection": leg.deflection, "F": leg.F,
+                         "lambda": leg.lam, "contact_radius": leg.contact_radius,
+                         "jumps": np.asarray(leg.jumps, dtype=np.int64)}
+    return out
 
 
 def program_record(p: Program) -> dict:
@@ -154,6 +176,13 @@ def spread_record(spread: ModelSpread | Missing) -> dict:
     return out
 
 
+def _trigger(legs) -> dict:
+    """The trigger of the instrument's legs and whether the approach reached it (nothing without one)."""
+    if legs is None or isinstance(legs, Missing) or legs.trigger is None:
+        return {}
+    return {"trigger": legs.trigger, "trigger_reached": legs.reached}
+
+
 def summary_of(curve: Curve) -> dict:
     """The JSON summary of a traced curve (docs/output.md)."""
     def brief(e):
@@ -171,7 +200,8 @@ def summary_of(curve: Curve) -> dict:
          "at_lambda": [brief(e) for e in ev if e.kind == "lambda"],
          **cycle_summary(curve.rigid),
          **({"spring": {"K": curve.spring.K, "jumps": [brief(e) for e in curve.spring.jumps],
-                        **cycle_summary(curve.spring.cycle)}} if curve.spring is not None else {}),
+                        **cycle_summary(curve.spring.cycle), **_trigger(curve.spring.legs)}}
+            if curve.spring is not None else {}),
          "wall_gap": d.wall_gap, "steps": d.steps, "rejected_steps": d.rejected_steps, "regrids": d.regrids,
          "guard_activations": d.guard_activations, "smallest_step": d.smallest_step,
          "most_newton_its": d.most_newton_its, "most_ksp_its": d.most_ksp_its, "stop_reason": d.stop_reason,

@@ -4,7 +4,8 @@ Each file has one header line, every column named with its unit in brackets (non
 0/1 flags), then one row per point or event.  Numbers are written as ``repr`` writes them, the shortest
 text that reads back to the same double; a cell is empty where the value does not exist (no error bar,
 no landing, no spring; NaN in the HDF5 table of a study).  With physical inputs each dimensionless column
-has a twin in nm or nN (the value times the scale of the ``physical`` group).
+has a twin in nm or nN (the value times the scale of the ``physical`` group).  Behind a spring the curve's
+CSV holds the two legs the cantilever follows (approach, then retract; the traced points are the HDF5 file's).
 """
 from __future__ import annotations
 
@@ -14,9 +15,10 @@ import math
 import numpy as np
 
 from .layout import _EPS, _LOAD, _RAD
-from .summary import branch_record, event_record
+from ..tracing.measured import Missing
+from .summary import branch_record, event_record, legs_record
 
-__all__ = ["CURVE_COLUMNS", "EVENT_COLUMNS", "curve_csv_columns", "event_csv_columns", "table_csv_columns",
+__all__ = ["CURVE_COLUMNS", "EVENT_COLUMNS", "LEG_COLUMNS", "curve_csv_columns", "legs_csv_columns", "event_csv_columns", "table_csv_columns",
            "write_csv", "write_curve_csv", "write_events_csv", "write_table_csv"]
 
 #: unit of a dimensionless column -> (the suffix of its physical twin, its unit, the scale in the physical group)
@@ -25,6 +27,11 @@ _PHYSICAL = {_EPS: ("nm", "nm", "approach_nm"), _LOAD: ("nN", "nN", "force_nN"),
 #: The curve's columns: (key of the HDF5 group curve, unit or None); Z and stable_spring only behind a spring.
 CURVE_COLUMNS = (("lambda", _EPS), ("F", _LOAD), ("Z", _EPS), ("contact_radius", _RAD), ("stable", None),
                  ("stable_spring", None))
+
+#: The legs' columns after ``leg`` (approach or retract), and a ``jump`` flag last: (key of a leg's group in
+#: the HDF5 group instrument, unit).
+LEG_COLUMNS = (("Z", _EPS), ("separation", _EPS), ("deflection", _EPS), ("F", _LOAD), ("lambda", _EPS),
+               ("contact_radius", _RAD))
 
 #: The events' columns: (name, unit or None); ``landing_X`` is X of the fold's landing.
 EVENT_COLUMNS = (("kind", None), ("lambda", _EPS), ("lambda_err", _EPS), ("F", _LOAD), ("F_err", _LOAD),
@@ -116,8 +123,29 @@ def _physical(curve) -> dict | None:
     return None if curve.model.bodies is None else curve.model.bodies.describe()
 
 
+def legs_csv_columns(legs: dict, physical: dict | None = None) -> list:
+    """The columns of the legs' CSV (header name, unit, values), from the HDF5 group ``instrument``
+    (:func:`~petsc_adhesion.io.summary.legs_record`): a row per point, the approach's then the retract's,
+    ``leg`` naming which, ``jump`` 1 at a turning point the tip jumps from (to the next row, at the same Z)."""
+    names: list[str] = []
+    jump: list[bool] = []
+    for leg in ("approach", "retract"):
+        n, at = len(legs[leg]["Z"]), set(int(i) for i in legs[leg]["jumps"])
+        names += [leg] * n
+        jump += [i in at for i in range(n)]
+    cols: list[tuple[str, str | None, list]] = [("leg", None, names)]
+    cols += [(k, unit, [float(v) for leg in ("approach", "retract") for v in legs[leg][k]])
+             for k, unit in LEG_COLUMNS]
+    return _with_physical(cols + [("jump", None, jump)], physical)
+
+
 def write_curve_csv(path: str, curve) -> None:
-    """The points of a :class:`~petsc_adhesion.tracing.curve.Curve` as CSV, in traced order."""
+    """The points of a :class:`~petsc_adhesion.tracing.curve.Curve` as CSV, in traced order; behind a spring
+    the two legs its cantilever follows (:func:`legs_csv_columns`), the traced points being the HDF5 file's."""
+    legs = curve.instrument
+    if legs is not None and not isinstance(legs, Missing):
+        write_csv(path, legs_csv_columns(legs_record(legs), _physical(curve)))
+        return
     write_csv(path, curve_csv_columns(branch_record(curve), _physical(curve)))
 
 

@@ -47,6 +47,9 @@ def _describe(name: str, obj) -> None:
         key = key.split("/")[0]
     elif key.startswith(("table/", "critical_roughness/", "critical_mu/")):
         key = key.split("/")[0] + "/*"
+    elif key.startswith("instrument/"):                        # its legs, approach and retract: alike
+        parts = key.split("/")
+        key = "/".join(["instrument", "*", *parts[2:]])
     elif key.startswith("fit/"):                               # a fit's groups: described by their branch
         key = "/".join(key.split("/")[:2])
     units, text = DESCRIBE[key] if key in DESCRIBE else DESCRIBE_FIT[key]

@@ -149,11 +149,15 @@ class Cycle:
 @dataclass(frozen=True)
 class SpringResult:
     """Behind a spring of stiffness ``K`` (units 2 pi R gamma / epsilon): its jumps (jump_in, jump_off, in the
-    order found) and its cycle."""
+    order found), its cycle and the ``legs`` the instrument records (an
+    :class:`~.legs.InstrumentCurve`: approach and retract; Missing with its reason where the curve has no
+    state stable behind the spring; None where not made)."""
 
     K: float
     jumps: tuple[Event, ...]
     cycle: Cycle
+    # an InstrumentCurve | Missing | None, typed object: legs.py builds on this module, not the reverse
+    legs: object = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)
@@ -312,6 +316,12 @@ class Curve:
     def Z(self) -> np.ndarray | None:
         """Behind a spring, its base position Z = lambda + F / K at every computed point (else None)."""
         return self.branch.Z
+
+    @property
+    def instrument(self):
+        """Behind a spring, the approach and the retract its cantilever follows
+        (:class:`~.legs.InstrumentCurve`, or Missing with the reason); None without a spring."""
+        return None if self.spring is None else self.spring.legs
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,7 @@ from ..discretization.influence import create_influence
 from ..discretization.problem import Problem, far_approach, step_scale
 from ..model.reference.jkr import jkr_approach, jkr_load
 from . import error_bars, results
+from .legs import instrument_curve
 from .curve import Curve, Diagnostics, ErrorEstimate, GridRecord, Program, Solution, SpringResult
 from .measured import Missing
 from .edge_grids import MU_TRUNCATED, RMAX, grid_for
@@ -385,8 +386,9 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
     spring = None
     if traced.spring is not None:
         assert traced.spring.K is not None, "the cycle behind a spring holds its K"
-        spring = SpringResult(traced.spring.K, tuple(e for e in events if e.kind in ("jump_in", "jump_off")),
-                              traced.spring)
+        jumps_ = tuple(e for e in events if e.kind in ("jump_in", "jump_off"))
+        spring = SpringResult(traced.spring.K, jumps_, traced.spring,
+                              _instrument(traced.branch, jumps_, traced.spring.K, settings.observable_max))
     curve = Curve(model=model, program=Program.of(comm),
                   grid=GridRecord(traced.r, traced.starts, traced.n_nodes, traced.edges), branch=traced.branch,
                   events=events, pull_off=traced.pull_off if kept("F_min") else None, rigid=traced.rigid,
@@ -438,6 +440,15 @@ def solve_at(lam: float, model, grid_choice: GridChoice = GridChoice(), solver: 
             if obj is not None:
                 obj.destroy()
     return solution
+
+
+def _instrument(branch, jumps, K: float, trigger: float):
+    """The approach and retract a cantilever follows (:func:`~.legs.instrument_curve`), or Missing with the
+    reason where the curve has none."""
+    try:
+        return instrument_curve(branch, jumps, K, trigger if math.isfinite(trigger) else None)
+    except ValueError as e:
+        return Missing(str(e))
 
 
 def spring_start(K: float) -> float:

@@ -20,13 +20,14 @@ from ...core.bordered import ARCLENGTH_PREFIX
 from ...core.continuation import NATURAL_PREFIX
 from ...core.fold import FOLD_PREFIX
 from ...core.newton import PetscSettings
+from ...tracing.legs import default_trigger, figure_step, rigid_pull_off
 from ...tracing.model_spread import Rule, default_rules, parse_rules
 from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, step_scale
 from .table import TABLE, Option
 
 __all__ = ["AppOptions", "Given", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
            "read_petsc", "ROLE_PREFIXES", "SOLVER_OPTIONS",
-           "read_request", "read_settings", "read_spring", "read_model_spread"]
+           "read_request", "read_settings", "read_spring", "read_trigger", "read_model_spread"]
 
 
 #: The smallest positive Tabor parameter: below it the coupling mu^(3/2) of eq. (12) and the JKR scales
@@ -461,14 +462,53 @@ def read_request(opts: AppOptions, kinds: tuple | None = None, profiles: bool = 
                         kinds=kinds, spring=spring)
 
 
+def read_trigger(opts: AppOptions, model: Model) -> float | None:
+    """The load the approach ends at behind a spring, an instrument's trigger (-afm_trigger in 2 pi R gamma,
+    or -phys_trigger in N with the bodies), or None where -cont_F_max stops the curve: by default, with a
+    spring and physical inputs and no -cont_F_max, :func:`~petsc_adhesion.tracing.legs.default_trigger`
+    (3 times the rigid sphere's pull-off).  One line for a contradiction."""
+    T, t = opts.real("afm_trigger"), opts.real("phys_trigger")
+    if T is not None and t is not None:
+        raise InputError("-phys_trigger: not with -afm_trigger; give one of them (the trigger force)")
+    name = "phys_trigger" if t is not None else "afm_trigger"
+    stop_given = opts.db.hasName("cont_F_max")
+    spring = read_spring(opts, model.bodies)
+    if T is None and t is None:
+        return default_trigger(model)[0] if spring is not None and model.bodies is not None and not stop_given \
+            else None
+    if stop_given:
+        raise InputError(f"-cont_F_max: not with -{name}; the trigger ends the approach (give one of them)")
+    if spring is None:
+        raise InputError(f"-{name}: needs a spring (-afm_spring or -phys_spring): a trigger ends an instrument's "
+                         "approach; without one, -cont_F_max stops the curve")
+    if t is not None:
+        bodies = model.bodies
+        if bodies is None:
+            raise InputError("-phys_trigger: needs the bodies' -phys_ options (radius, young1, poisson1, gamma or "
+                             "hamaker, epsilon) to make the force in units of 2 pi R gamma; or give -afm_trigger")
+        T = _finite(lambda: t / bodies.scales()["force_N"])
+        if not 0 < T <= TABLE["afm_trigger"].hi:
+            raise InputError(f"-phys_trigger: gives the trigger F = {T:.3g} x 2 pi R gamma, outside "
+                             f"(0, {TABLE['afm_trigger'].hi:g}]")
+    return T
+
+
 def read_settings(opts: AppOptions, model: Model | None = None):
     """The continuation's step control and stops; the load F is the observable watched; the step lengths
-    in units of ``model``'s :func:`~petsc_adhesion.tracing.trace.step_scale` (1 without a model)."""
+    in units of ``model``'s :func:`~petsc_adhesion.tracing.trace.step_scale` (1 without a model).  Behind a
+    spring with a trigger (:func:`read_trigger`) the curve stops there, and its steps of the load are also at
+    most :func:`~petsc_adhesion.tracing.legs.figure_step` (50 between the rigid sphere's pull-off and the
+    trigger), so that the legs bend smoothly however large -cont_dF_max."""
     lam_max = opts.real("cont_lambda_max")
+    trigger = None if model is None else read_trigger(opts, model)
+    stop, dF = opts.real("cont_F_max"), opts.real("cont_dF_max")
+    if trigger is not None:
+        assert model is not None, "a trigger is read with its model"
+        stop, dF = trigger, min(dF, figure_step(trigger, rigid_pull_off(model)))
     return curve_settings(1.0 if model is None else step_scale(model), corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                           ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
                           max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
-                          observable_step=opts.real("cont_dF_max"), observable_max=opts.real("cont_F_max"),
+                          observable_step=dF, observable_max=stop,
                           p_max=math.inf if lam_max is None else lam_max, max_steps=opts.int("cont_max_steps"),
                           pc_reuse_its=opts.int("adh_pc_reuse_its"), monitor=opts.flag("cont_monitor"))
 

@@ -150,7 +150,8 @@ TABLE = {o.name: o for o in [
            "or one kind", choices=CORRECTORS),
     Option("cont_lambda_start", "real", None, "first approach (default: below the reach of the forces)", -1e3, 1e3),
     Option("cont_lambda_max", "real", None, "stop at this approach (default: past equilibrium)", -1e3, 1e3),
-    Option("cont_F_max", "real", F_MAX, "stop at this compressive load", -_INF, 1e6),
+    Option("cont_F_max", "real", F_MAX, "stop at this compressive load (behind a spring with -phys_ inputs the "
+           "default is -afm_trigger's)", -_INF, 1e6),
     Option("cont_max_steps", "int", _S.max_steps, "stop after this many accepted steps", 1, 10**7),
     Option("cont_dF_max", "real", _S.observable_step, "largest change of the load in one step, relative above "
            "|F| = 1", 0.0, 1e6, lo_open=True),
@@ -186,6 +187,14 @@ TABLE = {o.name: o for o in [
            "reported with their landings and the energy of a cycle (default: a rigid machine only)", 1e-12, 1e12),
     Option("phys_spring", "real", None, "spring constant k of the cantilever (N/m), with the other -phys_ "
            "options: K = k epsilon / (2 pi R gamma), as -afm_spring", 1e-6, 1e9),
+    # an instrument's trigger: the approach ends at this load and the retract follows (tracing/legs.py)
+    Option("afm_trigger", "real", None, "behind a spring: end the approach at this compressive load (units 2 pi "
+           "R gamma), an instrument's trigger, the retract following; the load's steps are then at most 1/50 of "
+           "the range from the pull-off to it (default with -phys_ inputs and -phys_spring: 3 times the rigid "
+           "sphere's pull-off, its roughness included; not with -cont_F_max, which stops the curve otherwise)",
+           0.0, 1e6, lo_open=True),
+    Option("phys_trigger", "real", None, "behind a spring: the trigger force (N) with the other -phys_ options, "
+           "as -afm_trigger", 0.0, 1.0, lo_open=True),
     # studies: a sweep over cases (petsc_adhesion.app.study)
     Option("study_mu", "sweep", (), "study: the Tabor parameters of its cases (eq. 9)", 0.0, 1000.0),
     Option("study_sigma", "sweep", (), "study: the roughness sigma of its cases", 0.0, 5.0),
@@ -225,10 +234,14 @@ TABLE = {o.name: o for o in [
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
     Option("profiles", "flag", False, "store H(r) and P(r) at every event"),
-    Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles)"),
-    Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, Z and stable_spring "
-           "behind a spring, contact radius, stable (0/1), and in nm and nN with -phys_ inputs; a study: its table "
-           "of events; not with -adh_lambda"),
+    Option("plot", "string", None, "PNG of the load-approach curve (and the profiles with -profiles); behind a "
+           "spring led by the approach and retract its cantilever follows (force in nN against piezo in nm with "
+           "-phys_ inputs)"),
+    Option("csv", "string", None, "CSV of the load-approach curve, a row per point: lambda, F, contact radius, "
+           "stable (0/1); behind a spring the approach and the retract its cantilever follows instead: leg, base "
+           "Z, tip-sample separation, deflection, F, lambda, contact radius, jump (1: the tip jumps at constant Z "
+           "to the next row); in nm and nN too with -phys_ inputs; a study: its table of events; not with "
+           "-adh_lambda"),
     Option("csv_events", "string", None, "CSV of the curve's events, a row each: kind, best values, error bars, "
            "landing, single-grid values (in nm and nN too with -phys_ inputs); not with -adh_lambda nor in a study"),
     Option("progress", "flag", None, "a line on stderr every -progress_interval seconds: lambda reached, steps, "

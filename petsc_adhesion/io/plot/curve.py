@@ -8,11 +8,14 @@ events marked, unstable branches dashed, and the profiles at the events when the
 file holds them), a fixed-approach solve (H and P), a study (its own kind of
 figure) or a critical study (the boundary of hysteresis); with physical inputs,
 a curve gets axes in nm and nN beside the dimensionless ones.  A curve traced behind
-a spring (``-afm_spring``, ``-phys_spring``: the file's curve has ``Z``) gets two more
-panels: the load against the spring's base Z (the force-distance curve of an AFM,
-stable parts solid, the jumps drawn at constant Z from each jump-in and jump-off to
-its landing) and the contact radius against the load along the curve.  It reads HDF5
-only: neither MPI nor PETSc is started.
+a spring (``-afm_spring``, ``-phys_spring``: the file has the group ``instrument``) is led
+by the force curve as the instrument records it (:func:`instrument_panel`: force in nN
+against piezo displacement in nm with physical inputs, approach and retract in two
+colours, the jumps at constant Z, the jump-in, pull-off and jump-off labelled with their
+bars, the energy of the cycle shaded and stated, after the fit's figure,
+:mod:`~petsc_adhesion.io.plot.fit`), with the rigid machine's load-approach curve and the
+contact radius against the load beside it.  It reads HDF5 only: neither MPI nor PETSc is
+started.
 """
 from __future__ import annotations
 
@@ -22,7 +25,7 @@ import numpy as np
 from .read import figure, from_tree, legend, read
 
 __all__ = ["load_approach", "profiles", "force_distance", "contact_load", "curve_figure", "solve_figure", "MARK",
-           "stiffness"]
+           "stiffness", "instrument_panel", "LEG_COLOURS"]
 
 
 MARK = {"snap_on": ("v", "snap-on"), "snap_off": ("^", "snap-off"), "F_min": ("o", "load extremum"),
@@ -112,6 +115,78 @@ def force_distance(ax, res: dict, label: str | None = None, scale: tuple = (1.0,
     ax.axhline(0.0, color="0.7", lw=0.5)
 
 
+#: The legs' colours (as the fit's figure, io/plot/fit.py).
+LEG_COLOURS = {"approach": "tab:blue", "retract": "tab:red"}
+
+
+def _pm(value: float, err, scale: float, unit: str) -> str:
+    """``value +- bar unit`` in units of ``scale`` (no bar: the value alone)."""
+    text = f"{value * scale:.4g}"
+    if err is not None and not isinstance(err, (str, bytes)) and np.isfinite(err):
+        text += f" +- {abs(err * scale):.2g}"
+    return f"{text} {unit}".rstrip()
+
+
+def _primary(res: dict, kind: str) -> dict | None:
+    """The primary jump of ``kind``: the jump-in reached first on approach (largest Z), the jump-off reached
+    last on retraction (smallest Z)."""
+    evs = [e for e in res["events"] if _kind(e) == kind and "Z" in e]
+    if not evs:
+        return None
+    return (max if kind == "jump_in" else min)(evs, key=lambda e: float(e["Z"]))
+
+
+def instrument_panel(ax, res: dict) -> None:
+    """The force curve as the instrument records it (the file's ``instrument`` group): force against the
+    base (piezo) position, the approach and the retract in two colours with their jumps at constant Z, the
+    energy of the cycle shaded between them and stated, the primary jump-in, the pull-off (the force the
+    retract leaves the contact at) and the jump-off marked and labelled with their best values and bars; in nN
+    and nm with physical inputs, else in the model's units."""
+    legs, phys, spring = res["instrument"], res.get("physical"), res.get("spring") or {}
+    sz, sf = (float(phys["approach_nm"]), float(phys["force_nN"])) if phys else (1.0, 1.0)
+    uz, uf = ("nm", "nN") if phys else ("", "")
+    Zs, Fs = [], []
+    for name in ("approach", "retract"):
+        leg = legs[name]
+        Z, F = sz * np.asarray(leg["Z"], float), sf * np.asarray(leg["F"], float)
+        Zs.append(Z)
+        Fs.append(F)
+        ax.plot(Z, F, "-", lw=1.4, color=LEG_COLOURS[name], label=name, marker=".", ms=2.5)
+        for i in np.asarray(leg["jumps"], int):
+            ax.annotate("", xy=(Z[i + 1], F[i + 1]), xytext=(Z[i], F[i]),
+                        arrowprops={"arrowstyle": "->", "color": LEG_COLOURS[name], "lw": 1.2})
+    energy = spring.get("energy")
+    if energy is not None and not isinstance(energy, (str, bytes)):
+        scale, unit = (float(phys["work_aJ"]), "aJ") if phys else (1.0, "x 2 pi R gamma epsilon")
+        ax.fill(np.r_[Zs[0], Zs[1]], np.r_[Fs[0], Fs[1]], color="0.6", alpha=0.3, lw=0,
+                label=f"energy of a cycle {_pm(float(energy), spring.get('energy_err'), scale, unit)}")
+    if "trigger" in legs:
+        ax.axhline(sf * float(legs["trigger"]), color="0.5", lw=0.8, ls=":",
+                   label=f"trigger {_pm(float(legs['trigger']), None, sf, uf)}")
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    jin, joff = _primary(res, "jump_in"), _primary(res, "jump_off")
+    marks = []
+    if jin is not None:
+        marks.append((jin, float(jin["F"]), "<", "jump-in", f"jump-in: Z = {_pm(float(jin['Z']), jin.get('Z_err'), sz, uz)}, "
+                      f"F = {_pm(float(jin['F']), jin.get('F_err'), sf, uf)}"))
+    if joff is not None:
+        marks.append((joff, float(joff["F"]), "v", "pull-off",
+                      f"pull-off: F = {_pm(float(joff['F']), joff.get('F_err'), sf, uf)}"))
+        land = joff.get("landing")
+        if land:
+            marks.append((joff, float(land["F"]), ">", "jump-off",
+                          f"jump-off: Z = {_pm(float(joff['Z']), joff.get('Z_err'), sz, uz)}"))
+    for ev, at, marker, _, text in marks:
+        bar_F = sf * float(ev.get("F_err", 0.0) or 0.0) if at == float(ev["F"]) else None   # a landing: no F bar
+        ax.errorbar(sz * float(ev["Z"]), sf * at, xerr=sz * float(ev.get("Z_err", 0.0) or 0.0), yerr=bar_F,
+                    fmt=marker, color="k", ms=7, mfc="none", capsize=3, label=text)
+    ax.set_xlabel("piezo displacement Z (nm)" if phys else "base of the spring Z / epsilon")
+    ax.set_ylabel("force (nN)" if phys else "force F / (2 pi R gamma)")
+    K = float(legs["K"])
+    lever = f"k = {K * sf / sz:.3g} N/m" if phys else f"K = {K:.4g}"
+    ax.set_title(f"approach and retract behind the cantilever ({lever}): jumps at constant Z", fontsize=10)
+
+
 def contact_load(ax, res: dict, label: str | None = None, **style) -> None:
     """The contact radius against the load along the curve: solid where stable (behind a spring, under it),
     the jumps of a spring (or the snaps of a rigid machine) drawn as arrows to their landings."""
@@ -162,20 +237,28 @@ def profiles(ax_h, ax_p, r: np.ndarray, H: np.ndarray, P: np.ndarray, label: str
 
 def curve_figure(source, out: str, fmt: str = "png") -> None:
     """The load-approach curve of a result file or tree, with its event profiles when stored; behind a
-    spring, beside it the load against the spring's base Z and the contact radius against the load."""
+    spring, the force curve as the instrument records it first and largest (:func:`instrument_panel`), beside
+    it the rigid machine's load-approach curve and the contact radius against the load."""
     res = read(source) if isinstance(source, str) else from_tree(source)
     with_profiles = [e for e in res["events"] if "H" in e]
     spring = "Z" in res["curve"] and "stable_spring" in res["curve"]
-    ax_z = ax_a = ax_p = None
+    legs = res.get("instrument")
+    legs = legs if legs and "approach" in legs else None
+    ax_z = ax_a = ax_p = ax_i = None
     if spring:
-        rows = 3 if with_profiles else 1
-        fig = figure(figsize=(12.8, 9.6) if with_profiles else (16.0, 4.8))
-        grid = fig.add_gridspec(rows, 2 if with_profiles else 3)
-        ax = fig.add_subplot(grid[0, 0])
-        ax_z = fig.add_subplot(grid[0, 1])
-        ax_a = fig.add_subplot(grid[1, 1] if with_profiles else grid[0, 2])
+        rows = 3 if with_profiles else 2
+        fig = figure(figsize=(14.0, 10.5) if with_profiles else (14.0, 7.0))
+        grid = fig.add_gridspec(rows, 3)
+        if legs is not None:
+            ax_i = fig.add_subplot(grid[:2, :2])
+            ax = fig.add_subplot(grid[0, 2])
+            ax_a = fig.add_subplot(grid[1, 2])
+        else:                            # no legs (no state stable behind the spring): the traced curve
+            ax_z = fig.add_subplot(grid[:2, :2])
+            ax = fig.add_subplot(grid[0, 2])
+            ax_a = fig.add_subplot(grid[1, 2])
         if with_profiles:
-            ax_h, ax_p = fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[2, 0])
+            ax_h, ax_p = fig.add_subplot(grid[2, 0]), fig.add_subplot(grid[2, 1])
     elif with_profiles:
         fig = figure(figsize=(6.4, 9.6))
         ax, ax_h, ax_p = fig.subplots(3, 1)
@@ -189,12 +272,18 @@ def curve_figure(source, out: str, fmt: str = "png") -> None:
     load_approach(ax, res)
     legend(ax, fontsize=8)
     if spring:
-        assert ax_z is not None and ax_a is not None, "the spring's axes are made above"
-        force_distance(ax_z, res)
-        ax_z.set_xlabel("base of the spring Z = lambda + F / K")
-        ax_z.set_ylabel("load F / (2 pi R gamma)")
-        ax_z.set_title("behind the spring: jumps at constant Z (arrows)", fontsize=9)
-        legend(ax_z, fontsize=8)
+        assert ax_a is not None, "the spring's axes are made above"
+        ax.set_title("the rigid machine (load against approach)", fontsize=9)
+        if ax_i is not None:
+            instrument_panel(ax_i, res)
+            legend(ax_i, fontsize=8, loc="best")
+        else:
+            assert ax_z is not None, "the traced curve's axes without legs"
+            force_distance(ax_z, res)
+            ax_z.set_xlabel("base of the spring Z = lambda + F / K")
+            ax_z.set_ylabel("load F / (2 pi R gamma)")
+            ax_z.set_title("behind the spring: jumps at constant Z (arrows)", fontsize=9)
+            legend(ax_z, fontsize=8)
         if "contact_radius" in res["curve"]:
             contact_load(ax_a, res)
         else:

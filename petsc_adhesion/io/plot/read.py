@@ -38,7 +38,8 @@ def legend(ax, **kw) -> None:
 def from_tree(tree: dict) -> dict:
     """The layout of :func:`read` from a result tree of :mod:`petsc_adhesion.io.write` (before it is a file)."""
     return {"mu": tree["model"]["mu"], "sigma": tree["model"]["sigma"], "r": tree["grid"]["r"],
-            "curve": tree["curve"], "events": tree["events"], "physical": tree.get("physical")}
+            "curve": tree["curve"], "events": tree["events"], "physical": tree.get("physical"),
+            "instrument": tree.get("instrument"), "spring": tree.get("summary", {}).get("spring")}
 
 
 def read(path: str) -> dict:
@@ -47,11 +48,18 @@ def read(path: str) -> dict:
         return read_group(f)
 
 
+def _legs(g) -> dict:
+    """The group ``instrument`` (the legs behind a spring): its attributes and a dict of arrays per leg."""
+    return dict(g.attrs) | {name: {k: v[()] for k, v in g[name].items()} for name in g}
+
+
 def read_group(f) -> dict:
     """A curve's layout from an HDF5 group (a curve file's root, or a study's case)."""
     out = {"mu": f["model"].attrs["mu"], "sigma": f["model"].attrs["sigma"], "r": f["grid/r"][()],
            "curve": {k: v[()] for k, v in f["curve"].items()}, "events": [],
-           "physical": dict(f["physical"].attrs) if "physical" in f else None}
+           "physical": dict(f["physical"].attrs) if "physical" in f else None,
+           "instrument": _legs(f["instrument"]) if "instrument" in f else None,
+           "spring": dict(f["summary/spring"].attrs) if "summary/spring" in f else None}
     for name in sorted(f["events"]) if "events" in f else []:
         g = f["events"][name]
         ev = dict(g.attrs)
