@@ -47,18 +47,20 @@ from .data import MeasuredCurve
 from .forward import APPROACH, RETRACT, ForwardCurve, curve_stop_reason
 from .pull_off import maugis_dugdale_gamma
 from .results import (BOUND_MARGIN, NOISE_DOF_PER_DIFFERENCE, CurveFit, Features, FitChoice, FittedFeatures,
-                      Spring, misfit, misfit_p, undetermined)
+                      Instrument, Spring, misfit, misfit_p, undetermined)
 
 if TYPE_CHECKING:
     from ..tracing.trace import GridChoice, SolverChoice
 
-__all__ = ["CurveFit", "CurveFitError", "FittedModel", "fit_curve", "features", "MU_BOUNDS", "SIGMA_MAX",
+__all__ = ["CurveFit", "CurveFitError", "OutsideDomain", "FitProgress", "FittedModel", "domain_reasons", "fit_curve", "features", "MU_BOUNDS", "SIGMA_MAX",
            "predict_curve"]
 
 #: The Tabor parameters a fit may reach (the model's range; below 1e-3 the sphere is rigid to 1e-4 in its load).
 MU_BOUNDS = (1e-3, 50.0)
 #: The largest roughness sigma = rms / eps fitted.
 SIGMA_MAX = 3.0
+#: The fitted sensitivity's scale and spring constant stay within this factor of the stated.
+INSTRUMENT_FACTOR = 5.0
 #: Relative step of the Jacobian's differences in ln mu, ln w (and the step in sigma).
 _STEP = 2e-3
 #: The points before each measured jump always left out of the fit.
@@ -72,6 +74,22 @@ _LINEAR = 1e-9
 
 class CurveFitError(ValueError):
     """A curve the fit cannot use; one line."""
+
+
+class OutsideDomain(ValueError):
+    """A curve outside the model's domain (docs/fitting.md, "Where the model applies"), refused before the fit;
+    one line, the reasons after each other."""
+
+
+@dataclass(frozen=True)
+class FitProgress:
+    """How far a fit has gone: least-squares ``evaluations``, curves ``traces``d, the best reduced chi^2 so far
+    and the seconds ``elapsed``."""
+
+    evaluations: int
+    traces: int
+    best_reduced_chi2: float
+    elapsed: float
 
 
 def features(data: MeasuredCurve) -> Features:
@@ -105,11 +123,20 @@ def features(data: MeasuredCurve) -> Features:
     i_in = int(np.argmin(drops)) if drops.size else 0
     drop = float(-drops[i_in]) if drops.size else 0.0
     rise = float(rises[i_off])
+    # the contact's slope over the upper half of the approach's rise, against the travel towards the surface
+    upper = Fa >= F0 + 0.5 * (float(Fa.max()) - F0)
+    slope = float(np.polyfit(s * za[upper], Fa[upper], 1)[0]) if np.count_nonzero(upper) >= 3 else None
+    pull = float(F0 - Fr.min())
+    # a step is a run of successive large rises: a jump spread over a few samples (the lever's and the
+    # detector's response) is one
+    big = (rises > max(10 * noise, 0.1 * pull)) if pull > 0 else np.zeros(rises.size, bool)
+    steps = int(np.count_nonzero(big[1:] & ~big[:-1]) + big[:1].sum())
     return Features(F0_N=F0, noise_N=noise, noise_dof=NOISE_DOF_PER_DIFFERENCE * max(d.size, 1),
                     contact_N=float(Fa.max() - F0), pull_off_N=float(F0 - Fr.min()), pull_off_z_m=float(zr[i_off]),
                     pull_off_at_N=float(Fr[i_off]), jump_in_z_m=float(za[i_in]), jump_in_drop_N=drop,
                     jump_off_rise_N=rise, contact_from=i_in + 1 if drop > 10 * noise else None,
-                    free_from=i_off + 1 if rise > 10 * noise else None, noise_note=note)
+                    free_from=i_off + 1 if rise > 10 * noise else None, noise_note=note,
+                    contact_slope_N_m=slope, retract_steps=steps)
 
 
 @dataclass
@@ -129,9 +156,14 @@ class _Problem:
     noise: float
     feat: Features
     Fmax_data: float
+    choice: FitChoice = field(default_factory=FitChoice)
     cache: dict = field(default_factory=dict)
     traces: int = 0
     notes: list = field(default_factory=list)
+    evaluations: int = 0
+    best_chi2: float = math.inf
+    progress: object = None             # called with a FitProgress after each evaluation (None: silent)
+    t0: float = field(default_factory=time.perf_counter)
 
     def __post_init__(self):
         self.legs = np.r_[np.zeros(self.data.turn, int), np.ones(self.data.z.size - self.data.turn, int)]
@@ -145,9 +177,19 @@ class _Problem:
             self.labels[:turn] = np.arange(turn) >= feat.contact_from
         if feat.free_from is not None:
             self.labels[turn:] = np.arange(n - turn) < feat.free_from
-        self.weight = np.ones(n)
+        # the points fitted: the legs of the segment asked for, within the piezo range asked for
+        ch = self.choice
+        self.mask = np.ones(n)
+        if ch.segment != "both":
+            self.mask[self.legs != (0 if ch.segment == APPROACH else 1)] = 0.0
+        if ch.z_range is not None:
+            self.mask[(self.data.z < ch.z_range[0]) | (self.data.z > ch.z_range[1])] = 0.0
+        self.weight = self.mask.copy()
         self.names = (() if self.E_fixed is not None else ("ln_mu",)) + ("ln_gamma",) + \
-            (("sigma",) if self.fit_sigma else ()) + ("z0", "F0")
+            (("sigma",) if self.fit_sigma else ()) + ("z0", "F0") + \
+            (("ln_invols",) if ch.invols_fitted else ()) + (("ln_k",) if ch.spring_err is not None else ()) + \
+            (("slope",) if ch.virtual_deflection else ()) + (("drag",) if ch.drag else ())
+        self.invols_held = ch.invols_scale
         self.jumps = self.measured_jumps()
 
     def leave_out_edges(self, x) -> None:
@@ -159,7 +201,7 @@ class _Problem:
         fc = self.forward(p)
         Z = self.Z(p)
         turn, n = self.data.turn, self.data.z.size
-        self.weight = np.ones(n)
+        self.weight = self.mask.copy()
         i = self.feat.contact_from
         if i is not None:
             jump = 0.5 * (Z[i - 1] + Z[i])
@@ -184,15 +226,21 @@ class _Problem:
             E = self.E_fixed
             mu = tabor(self.R, w, E, self.eps)
         sigma = x["sigma"] if self.fit_sigma else self.sigma_fixed
-        return {"w": w, "E": E, "mu": mu, "sigma": max(sigma, 0.0), "K": self.spring.K(self.bodies, w),
-                "z0": x["z0"] * self.eps, "F0": x["F0"] * self.noise}
+        c = math.exp(x["ln_invols"]) if "ln_invols" in x else self.invols_held
+        k = self.spring.k * math.exp(x["ln_k"]) if "ln_k" in x else self.spring.k
+        # the file's force is the stated k times the file's deflection; the true force is the true k times the
+        # true deflection, c times the file's: F_file = F_true k_stated / (k c)
+        return {"w": w, "E": E, "mu": mu, "sigma": max(sigma, 0.0), "K": k * self.eps / (2 * math.pi * self.R * w),
+                "z0": x["z0"] * self.eps, "F0": x["F0"] * self.noise, "c": c, "k": k,
+                "gain": self.spring.k / (k * c), "slope": x.get("slope", 0.0) * self.noise / self.eps,
+                "drag": x.get("drag", 0.0) * self.noise}
 
     def forward(self, p: dict) -> ForwardCurve:
         key = (round(p["mu"], 12), round(math.log(p["K"]), 12), round(p["sigma"], 12))
         if key not in self.cache:
             from ..tracing.trace import CurveRequest, curve_settings, trace_curve
 
-            f_max = max(1.3 * (self.Fmax_data - p["F0"]) / (2 * math.pi * self.R * p["w"]) + 0.3, 0.5)
+            f_max = max(1.3 * (self.Fmax_data - p["F0"]) / (p["gain"] * 2 * math.pi * self.R * p["w"]) + 0.3, 0.5)
             model = replace(self.template, mu=p["mu"], sigma=p["sigma"], bodies=None)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
@@ -227,7 +275,10 @@ class _Problem:
         Z = self.Z(p)
         if pieces is None:
             pieces = self.assign(fc, Z)
-        return p["F0"] + 2 * math.pi * self.R * p["w"] * fc.evaluate(Z, pieces), pieces
+        # the baseline: F0 at the contact point, sloped in z by the virtual deflection, the retract's offset by
+        # the drag; the model's force as the file measures it (its gain: the sensitivity's and spring's errors)
+        base = p["F0"] + p["slope"] * (self.data.z - p["z0"]) + p["drag"] * self.legs
+        return base + p["gain"] * 2 * math.pi * self.R * p["w"] * fc.evaluate(Z, pieces), pieces
 
     def measured_jumps(self) -> list[tuple[str, float, float]]:
         """The jumps the curve shows: (leg, piezo position between the two points about it, its uncertainty: the
@@ -236,9 +287,16 @@ class _Problem:
         for leg, i in ((APPROACH, self.feat.contact_from), (RETRACT, self.feat.free_from)):
             if i is not None:
                 j = i if leg == APPROACH else turn + i
+                if not (self.mask[j - 1] and self.mask[j]):
+                    continue                    # a jump outside the segment or the range fitted
                 a, b = self.data.z[j - 1], self.data.z[j]
                 out.append((leg, 0.5 * (a + b), abs(b - a) / math.sqrt(12.0)))
         return out
+
+    @property
+    def points(self) -> int:
+        """The residuals that are data: the points fitted, the measured jumps, the spring constant's prior."""
+        return int(np.count_nonzero(self.weight)) + len(self.jumps) + ("ln_k" in self.names)
 
     def _all(self, p: dict, pieces: np.ndarray | None = None, fc: ForwardCurve | None = None):
         """(the residuals: the forces' in units of the noise, then each measured jump's position against the
@@ -251,10 +309,19 @@ class _Problem:
             cuts = fc.jumps[leg]
             model = p["z0"] + self.data.direction * self.eps * cuts[0] if cuts else z
             rJ.append((model - z) / dz)
+        if "ln_k" in self.names:            # the spring constant's stated uncertainty: a Gaussian prior
+            assert self.choice.spring_err is not None, "ln_k is fitted with a stated uncertainty"
+            rJ.append((p["k"] - self.spring.k) / self.choice.spring_err)
         return np.r_[rF, rJ], pieces
 
     def residuals(self, x) -> np.ndarray:
-        return self._all(self.unpack(x))[0]
+        r = self._all(self.unpack(x))[0]
+        self.evaluations += 1
+        self.best_chi2 = min(self.best_chi2, float(r @ r))
+        if self.progress is not None:
+            self.progress(FitProgress(self.evaluations, self.traces, self.best_chi2 / max(self.points - len(self.names), 1),
+                                      time.perf_counter() - self.t0))
+        return r
 
     def jacobian(self, x) -> np.ndarray:
         """Forward differences, every point kept on its piece (see the module)."""
@@ -264,7 +331,7 @@ class _Problem:
         J = np.empty((base.size, len(self.names)))
         n_pieces = len(self.forward(p).pieces)
         for j, name in enumerate(self.names):
-            h = 1e-4 if name == "z0" else 1.0 if name == "F0" else _STEP
+            h = 1e-4 if name == "z0" else 1.0 if name in ("F0", "slope", "drag") else _STEP
             xh = x.copy()
             xh[j] += h
             q = self.unpack(xh)
@@ -275,7 +342,8 @@ class _Problem:
 
 
 def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitChoice | None = None,
-              model: Model | None = None, grid=None, solver=None, comm=None) -> CurveFit:
+              model: Model | None = None, grid=None, solver=None, comm=None, progress=None,
+              spread_rules: tuple | None = None) -> CurveFit:
     """Fit the model to a measured force-distance curve (see the module for the model and the method).
 
     Parameters
@@ -288,17 +356,25 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         gamma where given (the start of w; default from the measured pull-off by Maugis-Dugdale); the rms
         roughness where given (the start with ``choice.roughness``, else held; default smooth).
     spring : Spring
-        The cantilever's spring constant k (N/m).
+        The cantilever's spring constant k (N/m) the file's force was converted with.
     choice : FitChoice
-        What is fitted (default: w and E*, with the noise of the far baseline).
+        What is fitted (default: w and E*, with the noise of the far baseline), the instrument's nuisance
+        parameters, the segment and the piezo range, the cap on evaluations, what is done outside the domain.
     model : Model
         The roughness average and the domain (its mu, sigma and bodies are replaced).
     grid, solver, comm
         As :func:`~petsc_adhesion.tracing.trace.trace_curve`'s.
+    progress : callable
+        Called with a :class:`FitProgress` after every evaluation of the least squares (None: silent).
+    spread_rules : tuple
+        The roughness laws (:class:`~petsc_adhesion.tracing.model_spread.Rule`) the optimum is moved to, the
+        model spread of w and E* (None: none; a rough model only).
 
     Returns the :class:`~petsc_adhesion.fitting.results.CurveFit`, its ``warnings`` saying where it does not
-    hold (a parameter at a bound or undetermined, Missing then; a misfit).  Raises :class:`CurveFitError`
-    (one line) for a curve with no contact, no adhesion, or no force-distance relation.
+    hold (a parameter at a bound or undetermined, Missing then; a misfit; the cap on evaluations reached; a
+    curve outside the domain with ``choice.outside_domain`` "warn").  Raises :class:`CurveFitError` (one line)
+    for a curve with no contact, no adhesion, or no force-distance relation, :class:`OutsideDomain` for one
+    outside the model's domain (``choice.outside_domain`` "refuse").
     """
     from scipy.optimize import least_squares
 
@@ -324,23 +400,41 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     if feat.pull_off_N < signal:
         raise CurveFitError(f"no adhesion: the retract falls at most {feat.pull_off_N:.3g} N below the baseline "
                             f"(noise {noise:.2g} N): no pull-off, so the work of adhesion is undetermined")
+    _refuse_empty(data, choice)
+    base = _baselines(data)
+    notes: list[str] = []
+    if choice.calibrate_invols:
+        c = calibrated_invols(feat, spring, base[1])
+        notes.append(f"the sensitivity calibrated on the contact as on a hard substrate: its slope "
+                     f"{feat.contact_slope_N_m:.4g} N/m less the baseline's {base[1]:.3g} N/m against the lever's "
+                     f"{spring.k:.4g} N/m, scale c = {c:.4g}" + (" (the fit's start)" if choice.invols_fitted else
+                                                                 " (held)"))
+        choice = replace(choice, invols_scale=c)
+    reasons = domain_reasons(data, feat, bodies, spring, choice, base[1])
+    if reasons and choice.outside_domain == "refuse":
+        raise OutsideDomain("; ".join(reasons))
     R, eps = bodies.R, bodies.epsilon
     sigma0 = 0.0 if bodies.rms is None else bodies.rms / eps
     if choice.roughness and bodies.rms is None:
         sigma0 = 0.3
     pb = _Problem(data, bodies, spring, template, grid, solver, comm,
                   None if choice.modulus or modulus is None else float(modulus),
-                  choice.roughness, sigma0, noise, feat, float(data.F.max()))
-    P = feat.pull_off_N
+                  choice.roughness, sigma0, noise, feat, float(data.F.max()), choice=choice, progress=progress)
+    pb.notes += notes
+    P = feat.pull_off_N * choice.invols_scale        # the pull-off as the true sensitivity makes it
+    names = pb.names
 
     def start(E: float) -> tuple[np.ndarray, float]:
         w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
         mu = min(max(tabor(R, w, E, eps), MU_BOUNDS[0] * 1.01), MU_BOUNDS[1] * 0.99)
-        x0 = ([] if not choice.modulus else [math.log(mu)]) + [math.log(w)] + \
-            ([sigma0] if choice.roughness else []) + [0.0, feat.F0_N / noise]
-        x = np.array(x0, dtype=float)
-        x[-2] = _align(pb, x)
-        return x, float(np.sum(pb.residuals(x) ** 2))
+        given = {"ln_mu": math.log(mu), "ln_gamma": math.log(w), "sigma": sigma0, "z0": 0.0,
+                 "F0": (base[0] + base[1] * feat.pull_off_z_m) / noise, "ln_invols": math.log(choice.invols_scale),
+                 "ln_k": 0.0, "slope": base[1] * eps / noise, "drag": base[2] / noise}
+        x = np.array([given[n_] for n_ in names], dtype=float)
+        j = names.index("z0")
+        x[j] = _align(pb, x)
+        x[names.index("F0")] = (base[0] + base[1] * x[j] * eps) / noise    # the baseline at the contact point
+        return x, float(np.sum(pb._all(pb.unpack(x))[0] ** 2))
 
     if modulus is not None:
         x0, _ = start(float(modulus))
@@ -351,26 +445,24 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     pb.leave_out_edges(x0)
     lo, hi = _bounds(pb, choice, modulus)
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo if np.all(np.isfinite(hi - lo)) else 1), hi - 1e-9)
+    pb.evaluations = 0
     res = least_squares(pb.residuals, x0, jac=pb.jacobian, bounds=(lo, hi), method="trf", x_scale="jac",
                         ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=choice.max_evaluations)
     x = res.x
     p = pb.unpack(x)
-    r = pb.residuals(x)
+    r, _ = pb._all(p)
     J = pb.jacobian(x)
-    n, m = int(np.count_nonzero(pb.weight)) + len(pb.jumps), x.size
+    n, m = pb.points, x.size
     chi2 = float(r @ r)
     s2 = chi2 / max(n - m, 1)
     try:
-        cov = np.linalg.inv(J.T @ J) * s2
+        JtJ_inv = np.linalg.inv(J.T @ J)
+        cov = JtJ_inv * s2
     except np.linalg.LinAlgError:
+        JtJ_inv = None
         cov = np.full((m, m), np.nan)
     # to (ln E*, ln w): ln E* = ln w - 1.5 ln mu + const
-    names = list(pb.names)
-    A = np.eye(m)
-    if "ln_mu" in names:
-        i, j = names.index("ln_mu"), names.index("ln_gamma")
-        A[i, :] = 0.0
-        A[i, i], A[i, j] = -1.5, 1.0
+    A = _to_moduli(names)
     cov_p = A @ cov @ A.T
     var = np.diag(cov_p)
     sd = np.where(np.isfinite(var) & (var >= 0), np.sqrt(np.abs(var)), np.nan)
@@ -379,21 +471,263 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     Fm, pieces = pb.model_force(p)
     fc = pb.forward(p)
     quantities, warned = _verdicts(pb, choice, x, lo, hi, p, get, modulus)
+    instrument, warned_i = _instrument(pb, choice, x, lo, hi, p, get)
+    warned += warned_i
     noise_dof = None if choice.noise is not None else feat.noise_dof
     bad = misfit(chi2, n - m, noise_dof)
     if bad:
         warned.append(bad)
     if feat.noise_note and choice.noise is None:
         warned.append(feat.noise_note)
+    if res.status == 0:
+        warned.append(f"the fit stopped at its cap of {choice.max_evaluations} evaluations (-fit_max_evals) before "
+                      f"it converged: its numbers are where it stopped, not an optimum")
+    if choice.invols_fitted:            # the indentation and the contact at the fitted scale
+        reasons += [why for why in domain_reasons(data, feat, bodies, Spring(p["k"]), choice, p["slope"], p["c"])
+                    if why not in reasons]
+    warned += [f"outside the model's domain: {why}" for why in reasons]
+    spread = None
+    if spread_rules is not None:
+        spread = _curve_spread(pb, x, r, J, JtJ_inv, quantities, A, spread_rules)
+    used = pb.weight > 0
     return CurveFit(**quantities, mu=p["mu"], sigma=p["sigma"], K=p["K"], chi2=chi2, dof=n - m, noise_N=noise,
                     noise_stated=choice.noise is not None, p_value=misfit_p(chi2, n - m, noise_dof),
-                    residual_rms_N=float(np.sqrt(np.mean((Fm - data.F)[pb.weight > 0] ** 2))),
-                    parameters=out_names, covariance=cov_p, data=data, F_fit=Fm, used=pb.weight > 0, leg=pb.legs,
+                    residual_rms_N=float(np.sqrt(np.mean((Fm - data.F)[used] ** 2))),
+                    parameters=out_names, covariance=cov_p, data=data, F_fit=Fm, used=used, leg=pb.legs,
                     branch=pb.labels, measured=feat, fitted=_fitted_features(pb, p, fc), bodies=bodies,
                     spring=spring, choice=choice, traces=pb.traces, iterations=int(res.nfev),
                     status=str(res.message), wall_time_s=time.perf_counter() - t0,
                     notes=tuple(dict.fromkeys(pb.notes + fc.notes)), warnings=tuple(warned),
-                    forward=FittedModel(fc, p["z0"], p["F0"], 2 * math.pi * R * p["w"], eps, data.direction))
+                    forward=FittedModel(fc, p["z0"], p["F0"], p["gain"] * 2 * math.pi * R * p["w"], eps,
+                                        data.direction, p["slope"], p["drag"]),
+                    instrument=instrument, segment=choice.segment, z_range=choice.z_range, spread=spread)
+
+
+def _to_moduli(names: tuple) -> np.ndarray:
+    """The linear map of the fitted coordinates to (ln E*, ln w, ...): ln E* = ln w - 1.5 ln mu + const
+    (eq. 9), the others as they are."""
+    m = len(names)
+    A = np.eye(m)
+    if "ln_mu" in names:
+        i, j = names.index("ln_mu"), names.index("ln_gamma")
+        A[i, :] = 0.0
+        A[i, i], A[i, j] = -1.5, 1.0
+    return A
+
+
+def _baselines(data: MeasuredCurve) -> tuple[float, float, float]:
+    """Each leg's baseline on its far part (the farthest 30% of its travel from the surface): the approach's
+    line a + b z (N, N/m: the virtual deflection b) and the retract's offset from it (N: the drag), the
+    median of its far part less the approach's line there."""
+    z, F, s = data.z, data.F, data.direction
+    out = []
+    for sl in (data.approach, data.retract):
+        zz, FF = z[sl], F[sl]
+        depth = s * (zz - zz.min() if s > 0 else zz - zz.max())
+        far = depth <= 0.3 * depth.max()
+        if far.sum() < 5:
+            far = np.argsort(depth)[:5]
+        out.append((zz[far], FF[far]))
+    (za, Fa), (zr, Fr) = out
+    b, a = np.polyfit(za, Fa, 1) if np.ptp(za) > 0 else (0.0, float(np.median(Fa)))
+    drag = float(np.median(Fr - (a + b * zr)))
+    return float(a), float(b), drag
+
+
+def calibrated_invols(feat: Features, spring: Spring, baseline_slope: float = 0.0) -> float:
+    """The scale c of the deflection sensitivity that makes the approach's contact as stiff as the lever, as on
+    a hard substrate (there the piezo's travel is the lever's deflection, so the true slope is k):
+    c = k / (S - b), S the measured contact slope and b the baseline's.  CurveFitError where the curve shows
+    no contact slope."""
+    S = feat.contact_slope_N_m
+    if S is None or not math.isfinite(S) or S - baseline_slope <= 0:
+        raise CurveFitError("the sensitivity cannot be calibrated: the approach shows no rising contact slope")
+    return spring.k / (S - baseline_slope)
+
+
+#: The deepest indentation a small-strain half-space model of a sphere describes, over its radius: the
+#: contact radius sqrt(R delta) is then a third of R, where the paraboloid departs from the sphere by 2.5%.
+INDENTATION_MAX = 0.1
+#: A contact slope above the lever's by more than this share (no series of springs makes it).
+SLOPE_ABOVE = 0.1
+#: A reach of the retract's adhesion beyond the model's, over the larger of this many epsilon and ...
+REACH_EPS = 30.0
+#: ... this share of the tip's radius: long-range or tether adhesion.
+REACH_R = 0.1
+
+
+def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: Spring, choice: FitChoice,
+                   baseline_slope: float = 0.0, scale: float | None = None) -> list[str]:
+    """Why the curve is outside the model's domain (docs/fitting.md, "Where the model applies"), one line
+    each; empty where it is inside.  With the deflection's scale c (``scale``, else ``choice.invols_scale``)
+    the true deflection is c (F - F0) / k.  Where c is fitted and not yet known (``choice.invols_fitted``
+    without ``scale``) the indentation and the contact's slope say nothing (any indentation is some c's) and
+    are checked after the fit, at its c:
+
+    - the indentation (the travel in contact less the deflection's rise) deeper than INDENTATION_MAX R;
+    - a contact steeper than the lever (by SLOPE_ABOVE): the piezo's travel less than the deflection, which no
+      elastic contact makes (the sensitivity or the spring constant is off), unless its scale is fitted;
+    - the mu a compliant contact asks for (E* by Hertz over the indentation, w by JKR from the pull-off) above
+      the model's range;
+    - a retract that lets go in several steps, or whose adhesion reaches farther than the lever's stretch at
+      the pull-off plus REACH_EPS epsilon or REACH_R of R: tethers or long-range forces the Lennard-Jones
+      sphere does not make."""
+    out = []
+    s, z, F = data.direction, data.z, data.F
+    R, eps = bodies.R, bodies.epsilon
+    c, k = scale or choice.invols_scale, spring.k
+    unknown = choice.invols_fitted and scale is None
+    za, Fa = z[data.approach], F[data.approach]
+    F0 = feat.F0_N
+    top = int(np.argmax(Fa))
+    # the contact's start: the point after the jump-in, else where the force last leaves the baseline's noise
+    if feat.contact_from is not None:
+        i_c = feat.contact_from
+    else:
+        low = np.flatnonzero(Fa[:top + 1] <= F0 + 5 * feat.noise_N)
+        i_c = int(low[-1]) if low.size else 0
+    travel = s * (za[top] - za[i_c])
+    rise = c * (Fa[top] - Fa[i_c]) / k
+    delta = travel - rise
+    if delta > INDENTATION_MAX * R and not unknown:
+        out.append(f"the indentation reaches {delta * 1e9:.3g} nm, {delta / R:.2g} of the tip's radius "
+                   f"{R * 1e9:.3g} nm (the travel in contact {travel * 1e9:.3g} nm less the deflection's rise "
+                   f"{rise * 1e9:.3g} nm): a small-strain half-space model of a sphere holds below "
+                   f"{INDENTATION_MAX:g} R; fit a shallower range (-fit_z_range) or a larger tip")
+    S = feat.contact_slope_N_m
+    if S is not None and not unknown:
+        ratio = c * (S - baseline_slope) / k
+        if ratio > 1 + SLOPE_ABOVE:
+            out.append(f"the contact rises at {ratio:.3g} times the lever's stiffness, steeper than any elastic "
+                       f"contact behind the lever: the deflection sensitivity or the spring constant is off "
+                       f"(-fit_calibrate_invols, -fit_invols_scale, -fit_spring_err)")
+        elif 0 < ratio < 1 and delta > 0 and feat.pull_off_N > 0:
+            # Hertz with JKR's offset: F + 2 P = (4/3) E* sqrt(R) delta^1.5 at the top; w = P / (1.5 pi R)
+            P = c * feat.pull_off_N
+            E = 0.75 * (c * (Fa[top] - F0) + 2 * P) / (math.sqrt(R) * delta ** 1.5)
+            w = P / (1.5 * math.pi * R)
+            mu = tabor(R, w, E, eps)
+            if mu > MU_BOUNDS[1]:
+                out.append(f"the contact rises at {ratio:.2g} of the lever's stiffness: a compliant sample, E* about "
+                           f"{E:.3g} Pa by Hertz over its indentation {delta * 1e9:.3g} nm, which with w about "
+                           f"{w:.3g} J/m^2 (JKR, from the pull-off) makes mu about {mu:.3g}, above the model's "
+                           f"range (mu <= {MU_BOUNDS[1]:g})")
+    if feat.retract_steps > 1:
+        out.append(f"the retract lets go in {feat.retract_steps} steps: several bonds or a tether, which one "
+                   f"sphere's Lennard-Jones adhesion does not make")
+    if feat.free_from is not None:
+        zr = z[data.retract]
+        # the approach's contact point (where its force leaves the baseline) to where the retract lets go
+        reach = s * (za[i_c] - zr[feat.free_from])
+        stretch = c * feat.pull_off_N / k
+        allowed = stretch + max(REACH_EPS * eps, REACH_R * R)
+        if reach > allowed:
+            out.append(f"the retract holds on {reach * 1e9:.3g} nm behind the contact, beyond the lever's stretch "
+                       f"at the pull-off {stretch * 1e9:.3g} nm and the model's reach: long-range or tether "
+                       f"adhesion, which the Lennard-Jones sphere does not make")
+    return out
+
+
+def _refuse_empty(data: MeasuredCurve, choice: FitChoice) -> None:
+    """CurveFitError where the segment and the piezo range asked for leave too few points of the curve."""
+    legs = {"approach": data.approach, "retract": data.retract}
+    wanted = (APPROACH, RETRACT) if choice.segment == "both" else (choice.segment,)
+    for leg in wanted:
+        z = data.z[legs[leg]]
+        inside = np.ones(z.size, bool) if choice.z_range is None else \
+            (z >= choice.z_range[0]) & (z <= choice.z_range[1])
+        if np.count_nonzero(inside) < 10:
+            where = "" if choice.z_range is None else \
+                f" within z in [{choice.z_range[0]:.4g}, {choice.z_range[1]:.4g}] m"
+            raise CurveFitError(f"the {leg} has {int(np.count_nonzero(inside))} points{where}; a fit needs 10 at "
+                                f"least (the curve's z runs over [{data.z.min():.4g}, {data.z.max():.4g}] m)")
+
+
+def _curve_spread(pb: _Problem, x, r, J, JtJ_inv, quantities: dict, A, rules: tuple):
+    """w's and E*'s model spread: the optimum moved to each roughness law of ``rules`` by one Gauss-Newton
+    step from the fit's, dx = -(J^T J)^-1 J^T r_law, r_law the residuals under that law at the optimum and J
+    the fit's Jacobian (one curve traced per law; a linear estimate of the refit, exact where the law's
+    change is small against the curvature of chi^2)."""
+    from ..tracing.model_spread import ModelSpread, Rule, spread_quantity
+
+    model = replace(pb.template, sigma=pb.unpack(x)["sigma"])
+    reference = Rule.of(model)
+    if model.roughness == "none" or model.sigma == 0:
+        return Missing("a smooth surface (sigma = 0): there is no roughness law to vary")
+    if reference in rules:
+        raise ValueError(f"{reference.label}: the reference's own law, not an alternative to it")
+    if JtJ_inv is None:
+        return Missing("the fit's covariance is singular: its optimum cannot be moved to another law")
+    names = pb.names
+    i_w = names.index("ln_gamma")
+    moved_w: list[Measured | Missing] = []
+    moved_E: list[Measured | Missing] = []
+    notes, times = [], []
+    t0 = time.perf_counter()
+    for rule in rules:
+        t = time.perf_counter()
+        alt = replace(pb, template=rule.model(pb.template), cache={}, progress=None)
+        alt.weight = pb.weight.copy()
+        try:
+            r_law, _ = alt._all(alt.unpack(x))
+            dx = -JtJ_inv @ (J.T @ r_law)
+            y = A @ (x + dx)
+            moved_w.append(Measured(math.exp(y[i_w])))
+            if "ln_mu" in names:
+                # ln E* differs from A's row by a constant: E* at the moved optimum is E* exp(change of the row)
+                d = A @ dx
+                moved_E.append(Measured(float(quantities["E_star"].value) * math.exp(d[names.index("ln_mu")]))
+                               if isinstance(quantities["E_star"], Measured) else Missing("E* undetermined"))
+        except (ValueError, RuntimeError, FloatingPointError) as why:
+            moved_w.append(Missing(f"{rule.label}: {why}"))
+            moved_E.append(Missing(f"{rule.label}: {why}"))
+            notes.append(f"{rule.label}: its curve could not be traced at the optimum ({why})")
+        pb.traces += alt.traces
+        times.append(time.perf_counter() - t)
+    qs = []
+    if isinstance(quantities["gamma"], Measured):
+        qs.append(spread_quantity("work of adhesion gamma", "gamma", quantities["gamma"], tuple(moved_w), rules,
+                                  reference))
+    if "ln_mu" in names and isinstance(quantities["E_star"], Measured):
+        qs.append(spread_quantity("reduced modulus E*", "E_star", quantities["E_star"], tuple(moved_E), rules,
+                                  reference))
+    if not qs:
+        return Missing(f"w and E* are undetermined under {reference.label}: no value to spread about")
+    return ModelSpread(reference, rules, tuple(qs), tuple(notes), time.perf_counter() - t0, tuple(times))
+
+
+def _instrument(pb: _Problem, choice: FitChoice, x, lo, hi, p: dict, sd: dict) -> tuple[Instrument, list]:
+    """The instrument's nuisance parameters as Measured (fitted with their bars, held with a note) or Missing
+    at a bound of the fit, and the warnings that say so."""
+    warned = []
+
+    def fitted(key, coord, value, err_of):
+        j = pb.names.index(coord)
+        if x[j] - lo[j] <= BOUND_MARGIN or hi[j] - x[j] <= BOUND_MARGIN:
+            why = f"{value:.4g} is at a bound of the fit ({key} within a factor {math.exp(hi[j]):g} of the stated)"
+            warned.append(f"{key} undetermined: {why}")
+            return Missing(why)
+        e = sd.get(coord)
+        if e is None:
+            why = "a singular covariance: the curve does not determine it"
+            warned.append(f"{key} undetermined: {why}")
+            return Missing(why)
+        return Measured(value, err_of(e))
+
+    if choice.invols_fitted:
+        c = fitted("invols_scale", "ln_invols", p["c"], lambda e: p["c"] * e)
+    else:
+        c = Measured(p["c"], note="held: " + ("calibrated on the contact as on a hard substrate"
+                                               if choice.calibrate_invols else "the file's sensitivity"))
+    if choice.spring_err is not None:
+        k = fitted("spring", "ln_k", p["k"], lambda e: p["k"] * e)
+    else:
+        k = Measured(p["k"], note=f"held at {pb.spring.source}")
+    v = fitted("virtual_deflection", "slope", p["slope"], lambda e: e * pb.noise / pb.eps) \
+        if choice.virtual_deflection else Measured(0.0, note="held at 0: not fitted (-fit_virtual_deflection)")
+    d = fitted("drag", "drag", p["drag"], lambda e: e * pb.noise) if choice.drag else \
+        Measured(0.0, note="held at 0: not fitted (-fit_drag)")
+    return Instrument(c, k, v, d, pb.feat.contact_slope_N_m), warned
 
 
 def _refuse_a_line(data: MeasuredCurve) -> None:
@@ -410,7 +744,8 @@ def _refuse_a_line(data: MeasuredCurve) -> None:
 
 def _bounds(pb: _Problem, choice: FitChoice, modulus: float | None) -> tuple[np.ndarray, np.ndarray]:
     """The bounds of the fitted coordinates: mu in MU_BOUNDS (through w at a held modulus), sigma in [0,
-    SIGMA_MAX], w in [1e-6, 100] J/m^2; the contact point and the baseline free."""
+    SIGMA_MAX], w in [1e-6, 100] J/m^2, the sensitivity's scale and the spring constant within a factor
+    INSTRUMENT_FACTOR of the stated; the contact point, the baseline, its slope and the drag free."""
     lo = np.array([-np.inf] * len(pb.names))
     hi = np.array([np.inf] * len(pb.names))
     for j, name in enumerate(pb.names):
@@ -420,6 +755,8 @@ def _bounds(pb: _Problem, choice: FitChoice, modulus: float | None) -> tuple[np.
             lo[j], hi[j] = 0.0, SIGMA_MAX
         elif name == "ln_gamma":
             lo[j], hi[j] = math.log(1e-6), math.log(100.0)
+        elif name in ("ln_invols", "ln_k"):             # within a factor INSTRUMENT_FACTOR of the stated
+            lo[j], hi[j] = -math.log(INSTRUMENT_FACTOR), math.log(INSTRUMENT_FACTOR)
     if not choice.modulus:                          # mu's bounds through w at the held modulus
         assert modulus is not None, "a held modulus is given (fit_curve refuses it otherwise)"
         E, R, eps = float(modulus), pb.R, pb.eps
@@ -498,7 +835,7 @@ def _align(pb: _Problem, x: np.ndarray) -> float:
     def cost(z0):
         y = x.copy()
         y[j] = z0
-        return float(np.sum(pb.residuals(y) ** 2))
+        return float(np.sum(pb._all(pb.unpack(y))[0] ** 2))
 
     width = 2.0 + 0.1 * abs(Z_off)
     return brent.minimum(cost, guess - width, guess + width, xatol=1e-4)
@@ -507,7 +844,7 @@ def _align(pb: _Problem, x: np.ndarray) -> float:
 def _fitted_features(pb: _Problem, p: dict, fc: ForwardCurve) -> FittedFeatures:
     """The fitted model's jump-in and jump-off positions and pull-off force (the least force on the retract),
     in SI."""
-    scale = 2 * math.pi * pb.R * p["w"]
+    scale = p["gain"] * 2 * math.pi * pb.R * p["w"]         # the force as the file measures it
     ins, offs = fc.jumps[APPROACH], fc.jumps[RETRACT]
     lowest = min(float(fc.pieces[i].F.min()) for i in fc.chains[RETRACT][0])
     return FittedFeatures(pull_off_N=-lowest * scale,
@@ -518,8 +855,9 @@ def _fitted_features(pb: _Problem, p: dict, fc: ForwardCurve) -> FittedFeatures:
 @dataclass(frozen=True)
 class FittedModel:
     """The model at the optimum, to predict from: its F(Z) behind the spring (``curve``, a ForwardCurve), the
-    contact point ``z0`` (m), the baseline ``F0`` (N), the force scale 2 pi R w (N), epsilon (m) and the
-    approach's direction."""
+    contact point ``z0`` (m), the baseline ``F0`` (N) at it, the force scale 2 pi R w (N) times the gain of
+    the instrument's errors, epsilon (m), the approach's direction, the baseline's slope in z (N/m) and the
+    retract's baseline offset (N)."""
 
     curve: ForwardCurve
     z0: float
@@ -527,11 +865,15 @@ class FittedModel:
     scale: float
     epsilon: float
     direction: int
+    slope: float = 0.0
+    drag: float = 0.0
 
     def predict(self, z: np.ndarray, leg: str) -> np.ndarray:
         """The force (N) at piezo positions ``z`` on ``leg`` (approach or retract)."""
-        Z = self.direction * (np.asarray(z, dtype=float) - self.z0) / self.epsilon
-        return self.F0 + self.scale * self.curve.predict(Z, leg)
+        z = np.asarray(z, dtype=float)
+        Z = self.direction * (z - self.z0) / self.epsilon
+        base = self.F0 + self.slope * (z - self.z0) + (self.drag if leg == RETRACT else 0.0)
+        return base + self.scale * self.curve.predict(Z, leg)
 
 
 def predict_curve(fit: CurveFit, z: np.ndarray, leg: str) -> np.ndarray:
