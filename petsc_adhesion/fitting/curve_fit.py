@@ -65,6 +65,9 @@ INSTRUMENT_FACTOR = 5.0
 _STEP = 2e-3
 #: The points before each measured jump always left out of the fit.
 EDGE_POINTS = 3
+#: A change between successive samples after a jump's largest, in its direction, beyond this share of that
+#: largest: the jump still under way (the sample is on neither branch).
+JUMP_TAIL = 0.25
 #: Noise multiples that make a contact, an adhesion.
 _SIGNAL = 5.0
 #: A force that is a straight line in the piezo position on both legs to this share of its range is no
@@ -214,6 +217,23 @@ class _Problem:
             near = (np.arange(n) >= turn) & (np.arange(n) < turn + i) & (Z - jump <= fc.steep(RETRACT))
             near[turn + max(i - EDGE_POINTS, 0):turn + i] = True
             self.weight[near] = 0.0
+        self.weight[self.during_jumps()] = 0.0
+
+    def during_jumps(self) -> np.ndarray:
+        """The samples taken while the lever jumped: a jump the detector spreads over a few samples (its and the
+        lever's response) leaves points after the largest change still moving the jump's way by more than
+        JUMP_TAIL of it, on neither branch (indices into the curve)."""
+        F, turn, out = self.data.F, self.data.turn, []
+        for i, start, sign in ((self.feat.contact_from, 0, -1), (self.feat.free_from, turn, +1)):
+            if i is None:
+                continue
+            j = start + i                       # the first point past the largest change
+            largest = sign * (F[j] - F[j - 1])
+            end = turn if start == 0 else F.size
+            while j + 1 < end and sign * (F[j + 1] - F[j]) > JUMP_TAIL * largest:
+                out.append(j)
+                j += 1
+        return np.array(out, dtype=int)
 
     # x -> physical parameters
     def unpack(self, x) -> dict:
@@ -547,7 +567,7 @@ def calibrated_invols(feat: Features, spring: Spring, baseline_slope: float = 0.
 
 #: The deepest indentation a small-strain half-space model of a sphere describes, over its radius: the
 #: contact radius sqrt(R delta) is then a third of R, where the paraboloid departs from the sphere by 2.5%.
-INDENTATION_MAX = 0.1
+INDENTATION_MAX = 1 / 9
 #: A contact slope above the lever's by more than this share (no series of springs makes it).
 SLOPE_ABOVE = 0.1
 #: A reach of the retract's adhesion beyond the model's, over the larger of this many epsilon and ...
@@ -569,8 +589,8 @@ def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: 
       elastic contact makes (the sensitivity or the spring constant is off), unless its scale is fitted;
     - the mu a compliant contact asks for (E* by Hertz over the indentation, w by JKR from the pull-off) above
       the model's range;
-    - a retract that lets go in several steps, or whose adhesion reaches farther than the lever's stretch at
-      the pull-off plus REACH_EPS epsilon or REACH_R of R: tethers or long-range forces the Lennard-Jones
+    - a retract that lets go in several steps, or whose adhesion (its last point more than 10 noise below the
+      baseline) reaches farther than the lever's stretch at the pull-off plus REACH_EPS epsilon or REACH_R of R: tethers or long-range forces the Lennard-Jones
       sphere does not make."""
     out = []
     s, z, F = data.direction, data.z, data.F
@@ -592,8 +612,8 @@ def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: 
     if delta > INDENTATION_MAX * R and not unknown:
         out.append(f"the indentation reaches {delta * 1e9:.3g} nm, {delta / R:.2g} of the tip's radius "
                    f"{R * 1e9:.3g} nm (the travel in contact {travel * 1e9:.3g} nm less the deflection's rise "
-                   f"{rise * 1e9:.3g} nm): a small-strain half-space model of a sphere holds below "
-                   f"{INDENTATION_MAX:g} R; fit a shallower range (-fit_z_range) or a larger tip")
+                   f"{rise * 1e9:.3g} nm): a small-strain half-space model of a sphere holds below R/9 (a "
+                   f"contact radius of R/3); fit a shallower range (-fit_z_range) or a larger tip")
     S = feat.contact_slope_N_m
     if S is not None and not unknown:
         ratio = c * (S - baseline_slope) / k
@@ -615,10 +635,11 @@ def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: 
     if feat.retract_steps > 1:
         out.append(f"the retract lets go in {feat.retract_steps} steps: several bonds or a tether, which one "
                    f"sphere's Lennard-Jones adhesion does not make")
-    if feat.free_from is not None:
-        zr = z[data.retract]
-        # the approach's contact point (where its force leaves the baseline) to where the retract lets go
-        reach = s * (za[i_c] - zr[feat.free_from])
+    zr, Fr = z[data.retract], F[data.retract]
+    held_on = np.flatnonzero(Fr < F0 - 10 * feat.noise_N)
+    if held_on.size:
+        # the approach's contact point to the last point of the retract still pulled below the baseline
+        reach = s * (za[i_c] - zr[held_on[-1]])
         stretch = c * feat.pull_off_N / k
         allowed = stretch + max(REACH_EPS * eps, REACH_R * R)
         if reach > allowed:

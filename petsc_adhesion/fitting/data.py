@@ -142,7 +142,7 @@ def read_curve(path: str, index: int = 0, spring: float | None = None, invols: f
             if index:
                 raise CurveFileError(f"{_name(path)}: a text file holds one curve; index {index} asked for")
             return _read_text(path, spring, invols)
-        except _TextCurveError:
+        except (_TextCurveError, NeedsInstrument):
             raise
         except CurveFileError as e:
             if ext not in AFM_EXTENSIONS:
