@@ -430,7 +430,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
                      f"{spring.k:.4g} N/m, scale c = {c:.4g}" + (" (the fit's start)" if choice.invols_fitted else
                                                                  " (held)"))
         choice = replace(choice, invols_scale=c)
-    reasons = domain_reasons(data, feat, bodies, spring, choice, base[1])
+    reasons = domain_reasons(data, feat, bodies, spring, choice, base)
     if reasons and choice.outside_domain == "refuse":
         raise OutsideDomain("; ".join(reasons))
     R, eps = bodies.R, bodies.epsilon
@@ -503,7 +503,8 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         warned.append(f"the fit stopped at its cap of {choice.max_evaluations} evaluations (-fit_max_evals) before "
                       f"it converged: its numbers are where it stopped, not an optimum")
     if choice.invols_fitted:            # the indentation and the contact at the fitted scale
-        reasons += [why for why in domain_reasons(data, feat, bodies, Spring(p["k"]), choice, p["slope"], p["c"])
+        fitted = (p["F0"] - p["slope"] * p["z0"], p["slope"], p["drag"])
+        reasons += [why for why in domain_reasons(data, feat, bodies, Spring(p["k"]), choice, fitted, p["c"])
                     if why not in reasons]
     warned += [f"outside the model's domain: {why}" for why in reasons]
     spread = None
@@ -577,10 +578,11 @@ REACH_R = 0.1
 
 
 def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: Spring, choice: FitChoice,
-                   baseline_slope: float = 0.0, scale: float | None = None) -> list[str]:
+                   baseline: tuple | None = None, scale: float | None = None) -> list[str]:
     """Why the curve is outside the model's domain (docs/fitting.md, "Where the model applies"), one line
     each; empty where it is inside.  With the deflection's scale c (``scale``, else ``choice.invols_scale``)
-    the true deflection is c (F - F0) / k.  Where c is fitted and not yet known (``choice.invols_fitted``
+    the true deflection is c (F - F0) / k; ``baseline`` (a, b, d) each leg's baseline (:func:`_baselines`;
+    None: flat at F0).  Where c is fitted and not yet known (``choice.invols_fitted``
     without ``scale``) the indentation and the contact's slope say nothing (any indentation is some c's) and
     are checked after the fit, at its c:
 
@@ -589,11 +591,12 @@ def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: 
       elastic contact makes (the sensitivity or the spring constant is off), unless its scale is fitted;
     - the mu a compliant contact asks for (E* by Hertz over the indentation, w by JKR from the pull-off) above
       the model's range;
-    - a retract that lets go in several steps, or whose adhesion (its last point more than 10 noise below the
-      baseline) reaches farther than the lever's stretch at the pull-off plus REACH_EPS epsilon or REACH_R of R: tethers or long-range forces the Lennard-Jones
+    - a retract that lets go in several steps, or whose adhesion (its last point below its baseline by more
+      than 10 noise and 5% of the pull-off) reaches farther than the lever's stretch at the pull-off plus REACH_EPS epsilon or REACH_R of R: tethers or long-range forces the Lennard-Jones
       sphere does not make."""
     out = []
     s, z, F = data.direction, data.z, data.F
+    a, baseline_slope, drag = baseline if baseline is not None else (feat.F0_N, 0.0, 0.0)
     R, eps = bodies.R, bodies.epsilon
     c, k = scale or choice.invols_scale, spring.k
     unknown = choice.invols_fitted and scale is None
@@ -636,7 +639,8 @@ def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: 
         out.append(f"the retract lets go in {feat.retract_steps} steps: several bonds or a tether, which one "
                    f"sphere's Lennard-Jones adhesion does not make")
     zr, Fr = z[data.retract], F[data.retract]
-    held_on = np.flatnonzero(Fr < F0 - 10 * feat.noise_N)
+    below = a + baseline_slope * zr + drag - Fr
+    held_on = np.flatnonzero(below > max(10 * feat.noise_N, 0.05 * feat.pull_off_N))
     if held_on.size:
         # the approach's contact point to the last point of the retract still pulled below the baseline
         reach = s * (za[i_c] - zr[held_on[-1]])
