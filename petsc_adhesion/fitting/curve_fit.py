@@ -3,7 +3,7 @@ fitted by bounded least squares.
 
 The measured force at piezo position z is modelled as
 
-    F(z) = F_0 + 2 pi R w f(Z; mu, K, sigma),   Z = s (z - z_0) / eps
+    F(z) = F_0 + b (z - z_0) + d [retract] + (k_s / (k c)) 2 pi R w f(Z; mu, K, sigma),   Z = s (z - z_0) / eps
 
 with f the model's force against the base position Z of a spring of stiffness
 K = k eps / (2 pi R w) on the approach or the retract
@@ -11,11 +11,21 @@ K = k eps / (2 pi R w) on the approach or the retract
 constant Z), mu by eq. (9) from w and the reduced modulus E*, sigma = rms / eps,
 s the direction of the approach, z_0 the contact point (where the undeflected
 spring holds the undeformed sphere at the flat, lambda = 0) and F_0 the force
-baseline.  The unknowns are w and E* (optionally the rms roughness), with z_0 and
-F_0 as nuisance parameters; R, eps and k are given.  They are fitted in
-x = (ln mu, ln w, [sigma], z_0 / eps, F_0 / s_F) by scipy's trust-region reflective
-least squares within bounds (mu in [1e-3, 50], the model's range; sigma in [0, 3]),
-on the residuals (F_model - F_i) / s_F, s_F the noise of the far baseline.
+baseline there.  The instrument (docs/fitting.md, "The instrument in the fit"): the
+true deflection sensitivity c times the file's, the true spring constant k against
+the stated k_s (K = k eps / (2 pi R w)), the virtual deflection b (N/m) and the
+retract's baseline offset d (the drag), each fitted or held (:class:`FitChoice`).  The
+unknowns are w and E* (optionally the rms roughness), with z_0, F_0 and the
+instrument's as nuisance parameters; R, eps and k_s are given.  They are fitted in
+x = (ln mu, ln w, [sigma], z_0 / eps, F_0 / s_F, [ln c], [ln (k / k_s)], [b eps / s_F],
+[d / s_F]) by scipy's trust-region reflective least squares within bounds (mu in
+[1e-3, 50], the model's range; sigma in [0, 3]; c and k within a factor 5 of the
+stated), on the residuals (F_model - F_i) / s_F, s_F the noise of the far baseline,
+and with a stated uncertainty of the spring constant the prior's (k - k_s) / dk.
+The segment (approach, retract or both) and the piezo range fitted select the points;
+the samples taken during a jump (the detector spreads it over a few) are on neither
+branch and left out.  Before the fit the curve is checked against the model's domain
+(:func:`domain_reasons`).
 
 Each evaluation at new (mu, K, sigma) traces one curve behind the spring (no error
 bars; cached).  The Jacobian's columns in ln mu, ln w and sigma are forward
@@ -29,6 +39,10 @@ docs/fitting.md measures how often it holds).  The result is a
 :class:`~petsc_adhesion.fitting.results.CurveFit`, each quantity Measured or Missing where a
 parameter is at a bound or undetermined, with a warning for each, and for a chi^2 the noise
 cannot explain (:mod:`~petsc_adhesion.fitting.results`).
+
+With roughness, w's and E*'s model spread: the optimum moved to each other roughness law by one
+Gauss-Newton step, dx = -(J^T J)^-1 J^T r_law, r_law the residuals under that law at the optimum
+(one curve per law; :func:`_curve_spread`).
 """
 from __future__ import annotations
 
