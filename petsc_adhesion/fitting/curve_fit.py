@@ -461,13 +461,17 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     def start(E: float) -> tuple[np.ndarray, float]:
         w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
         mu = min(max(tabor(R, w, E, eps), MU_BOUNDS[0] * 1.01), MU_BOUNDS[1] * 0.99)
+        # the baseline's start: the far approach's median, or with its slope fitted its line at the contact point
+        sloped = choice.virtual_deflection
         given = {"ln_mu": math.log(mu), "ln_gamma": math.log(w), "sigma": sigma0, "z0": 0.0,
-                 "F0": (base[0] + base[1] * feat.pull_off_z_m) / noise, "ln_invols": math.log(choice.invols_scale),
-                 "ln_k": 0.0, "slope": base[1] * eps / noise, "drag": base[2] / noise}
+                 "F0": (base[0] + base[1] * feat.pull_off_z_m if sloped else feat.F0_N) / noise,
+                 "ln_invols": math.log(choice.invols_scale), "ln_k": 0.0, "slope": base[1] * eps / noise,
+                 "drag": base[2] / noise}
         x = np.array([given[n_] for n_ in names], dtype=float)
         j = names.index("z0")
         x[j] = _align(pb, x)
-        x[names.index("F0")] = (base[0] + base[1] * x[j] * eps) / noise    # the baseline at the contact point
+        if sloped:
+            x[names.index("F0")] = (base[0] + base[1] * x[j] * eps) / noise
         return x, float(np.sum(pb._all(pb.unpack(x))[0] ** 2))
 
     if modulus is not None:
@@ -523,7 +527,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     warned += [f"outside the model's domain: {why}" for why in reasons]
     spread = None
     if spread_rules is not None:
-        spread = _curve_spread(pb, x, r, J, JtJ_inv, quantities, A, spread_rules)
+        spread = _curve_spread(pb, x, J, JtJ_inv, quantities, A, spread_rules, lo, hi)
     used = pb.weight > 0
     return CurveFit(**quantities, mu=p["mu"], sigma=p["sigma"], K=p["K"], chi2=chi2, dof=n - m, noise_N=noise,
                     noise_stated=choice.noise is not None, p_value=misfit_p(chi2, n - m, noise_dof),
@@ -682,11 +686,16 @@ def _refuse_empty(data: MeasuredCurve, choice: FitChoice) -> None:
                                 f"least (the curve's z runs over [{data.z.min():.4g}, {data.z.max():.4g}] m)")
 
 
-def _curve_spread(pb: _Problem, x, r, J, JtJ_inv, quantities: dict, A, rules: tuple):
-    """w's and E*'s model spread: the optimum moved to each roughness law of ``rules`` by one Gauss-Newton
-    step from the fit's, dx = -(J^T J)^-1 J^T r_law, r_law the residuals under that law at the optimum and J
-    the fit's Jacobian (one curve traced per law; a linear estimate of the refit, exact where the law's
-    change is small against the curvature of chi^2)."""
+#: Gauss-Newton steps (with the fit's Jacobian) that move the optimum to another roughness law, at most; they
+#: stop where a step moves ln w by less than a tenth of its bar.
+SPREAD_STEPS = 3
+
+
+def _curve_spread(pb: _Problem, x, J, JtJ_inv, quantities: dict, A, rules: tuple, lo, hi):
+    """w's and E*'s model spread: the optimum moved to each roughness law of ``rules`` by Gauss-Newton steps
+    from the fit's with the fit's Jacobian J (a chord method), dx = -(J^T J)^-1 J^T r_law(x_i), r_law the
+    residuals under that law, at most SPREAD_STEPS, within the fit's bounds (one curve traced per step and
+    law; the first step is the refit's to first order in the law's change)."""
     from ..tracing.model_spread import ModelSpread, Rule, spread_quantity
 
     model = replace(pb.template, sigma=pb.unpack(x)["sigma"])
@@ -708,9 +717,16 @@ def _curve_spread(pb: _Problem, x, r, J, JtJ_inv, quantities: dict, A, rules: tu
         alt = replace(pb, template=rule.model(pb.template), cache={}, progress=None)
         alt.weight = pb.weight.copy()
         try:
-            r_law, _ = alt._all(alt.unpack(x))
-            dx = -JtJ_inv @ (J.T @ r_law)
-            y = A @ (x + dx)
+            xi = x.copy()
+            bar = math.sqrt(max(JtJ_inv[i_w, i_w], 0.0)) or 1.0
+            for _ in range(SPREAD_STEPS):
+                r_law, _ = alt._all(alt.unpack(xi))
+                step = -JtJ_inv @ (J.T @ r_law)
+                xi = np.clip(xi + step, lo, hi)
+                if abs(step[i_w]) < 0.1 * bar:
+                    break
+            dx = xi - x
+            y = A @ xi
             moved_w.append(Measured(math.exp(y[i_w])))
             if "ln_mu" in names:
                 # ln E* differs from A's row by a constant: E* at the moved optimum is E* exp(change of the row)
