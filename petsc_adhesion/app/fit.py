@@ -195,6 +195,8 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         if fit_rough and model.roughness == "none":
             raise InputError("-fit_roughness: not with -adh_roughness none (a smooth surface)")
         choice = _curve_choice(opts, fit_modulus, fit_rough)
+        rough = model.roughness != "none" and (model.sigma > 0 or fit_rough)
+        spread = read_model_spread(opts, replace(model, sigma=model.sigma or (0.3 if rough else 0.0)))
         check_input("fit_curve", path)
         try:
             data = read_curve(path, opts.int("fit_curve_index"), spring=opts.real("phys_spring"),
@@ -217,8 +219,6 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         elif data.spring is not None and k != data.spring:
             data = data.rescaled(k)       # the file's force is its spring constant times the measured deflection
             source = f"-phys_spring (the file's force rescaled from its {data.metadata.get('spring constant')} N/m)"
-        rough = model.roughness != "none" and (model.sigma > 0 or fit_rough)
-        spread = read_model_spread(opts, replace(model, sigma=model.sigma or (0.3 if rough else 0.0)))
         req = FitRequest("curve", model, grid, solver, bodies, None, 0.0, data, Spring(k, source), choice, targets,
                          spread)
     if comm.getRank() == 0:
