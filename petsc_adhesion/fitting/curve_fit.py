@@ -42,13 +42,16 @@ cannot explain (:mod:`~petsc_adhesion.fitting.results`).
 
 With roughness, w's and E*'s model spread: the optimum moved to each other roughness law by one
 Gauss-Newton step, dx = -(J^T J)^-1 J^T r_law, r_law the residuals under that law at the optimum
-(one curve per law; :func:`_curve_spread`).
+(one curve per law; :func:`~petsc_adhesion.fitting.outcome.curve_spread`).  What the curve shows by itself
+and the domain's checks are :mod:`~petsc_adhesion.fitting.domain`'s, the optimum's reading
+:mod:`~petsc_adhesion.fitting.outcome`'s.
 """
 from __future__ import annotations
 
 import math
 import time
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
@@ -56,25 +59,20 @@ import numpy as np
 
 from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
-from ..tracing.measured import Measured, Missing
 from .data import MeasuredCurve
 from .forward import APPROACH, RETRACT, ForwardCurve, curve_stop_reason
+from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
+                     domain_reasons, features, refuse_a_line, refuse_empty)
+from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, verdicts
 from .pull_off import maugis_dugdale_gamma
-from .results import (BOUND_MARGIN, NOISE_DOF_PER_DIFFERENCE, CurveFit, Features, FitChoice, FittedFeatures,
-                      Instrument, Spring, misfit, misfit_p, undetermined)
+from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misfit, misfit_p
 
 if TYPE_CHECKING:
     from ..tracing.trace import GridChoice, SolverChoice
 
-__all__ = ["CurveFit", "CurveFitError", "OutsideDomain", "FitProgress", "FittedModel", "domain_reasons", "fit_curve", "features", "MU_BOUNDS", "SIGMA_MAX",
-           "predict_curve"]
+__all__ = ["CurveFit", "CurveFitError", "OutsideDomain", "FitProgress", "FittedModel", "domain_reasons",
+           "calibrated_invols", "fit_curve", "features", "MU_BOUNDS", "SIGMA_MAX", "predict_curve"]
 
-#: The Tabor parameters a fit may reach (the model's range; below 1e-3 the sphere is rigid to 1e-4 in its load).
-MU_BOUNDS = (1e-3, 50.0)
-#: The largest roughness sigma = rms / eps fitted.
-SIGMA_MAX = 3.0
-#: The fitted sensitivity's scale and spring constant stay within this factor of the stated.
-INSTRUMENT_FACTOR = 5.0
 #: Relative step of the Jacobian's differences in ln mu, ln w (and the step in sigma).
 _STEP = 2e-3
 #: The points before each measured jump always left out of the fit.
@@ -82,22 +80,6 @@ EDGE_POINTS = 3
 #: A change between successive samples after a jump's largest, in its direction, beyond this share of that
 #: largest: the jump still under way (the sample is on neither branch).
 JUMP_TAIL = 0.25
-#: Noise multiples that make a contact, an adhesion.
-_SIGNAL = 5.0
-#: A force that is a straight line in the piezo position on both legs to this share of its range is no
-#: force-distance curve (two columns of one quantity): no cantilever's noise is that small.
-_LINEAR = 1e-9
-
-
-class CurveFitError(ValueError):
-    """A curve the fit cannot use; one line."""
-
-
-class OutsideDomain(ValueError):
-    """A curve outside the model's domain (docs/fitting.md, "Where the model applies"), refused before the fit;
-    one line, the reasons after each other."""
-
-
 @dataclass(frozen=True)
 class FitProgress:
     """How far a fit has gone: least-squares ``evaluations``, curves ``traces``d, the best reduced chi^2 so far
@@ -107,53 +89,6 @@ class FitProgress:
     traces: int
     best_reduced_chi2: float
     elapsed: float
-
-
-def features(data: MeasuredCurve) -> Features:
-    """What the measured curve shows by itself (SI): the baseline ``F0_N`` and ``noise_N`` (from the farthest
-    30% of the approach: the median, and the spread of successive differences), the largest force above the
-    baseline ``contact_N``; the pull-off ``pull_off_N`` (the least force of the retract, below the baseline)
-    and its position ``pull_off_z_m``; the jump-in ``jump_in_z_m`` (the largest drop of the force between
-    successive approach points before its largest force) and its size ``jump_in_drop_N``; and, where the
-    force jumps by more than 10 noise between two points, the index of the first approach point in contact
-    ``contact_from`` and of the first retract point off it ``free_from`` (None where it does not jump); the
-    noise estimate's effective degrees of freedom ``noise_dof`` (docs/fitting.md)."""
-    z, F, s = data.z, data.F, data.direction
-    za, Fa = z[data.approach], F[data.approach]
-    zr, Fr = z[data.retract], F[data.retract]
-    depth = s * (za - za[0])                              # how far the approach went, from its start
-    far = depth <= 0.3 * depth.max()
-    if far.sum() < 5:
-        far = np.arange(za.size) < max(5, za.size // 3)
-    F0 = float(np.median(Fa[far]))
-    d = np.diff(Fa[far])
-    noise = float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2)) if d.size > 2 else 0.0
-    note = None
-    if noise <= 0:
-        noise = 1e-3 * float(np.ptp(F)) or 1.0
-        note = (f"the baseline shows no noise (its successive differences do not spread): the noise is taken as "
-                f"1e-3 of the force's range, {noise:.3g} N, and chi^2 and the bars are in units of that")
-    rises = np.diff(Fr)
-    i_off = int(np.argmax(rises))                         # the last retract point in contact
-    top = int(np.argmax(Fa))
-    drops = np.diff(Fa[: top + 1])
-    i_in = int(np.argmin(drops)) if drops.size else 0
-    drop = float(-drops[i_in]) if drops.size else 0.0
-    rise = float(rises[i_off])
-    # the contact's slope over the upper half of the approach's rise, against the travel towards the surface
-    upper = Fa >= F0 + 0.5 * (float(Fa.max()) - F0)
-    slope = float(np.polyfit(s * za[upper], Fa[upper], 1)[0]) if np.count_nonzero(upper) >= 3 else None
-    pull = float(F0 - Fr.min())
-    # a step is a run of successive large rises: a jump spread over a few samples (the lever's and the
-    # detector's response) is one
-    big = (rises > max(10 * noise, 0.1 * pull)) if pull > 0 else np.zeros(rises.size, bool)
-    steps = int(np.count_nonzero(big[1:] & ~big[:-1]) + big[:1].sum())
-    return Features(F0_N=F0, noise_N=noise, noise_dof=NOISE_DOF_PER_DIFFERENCE * max(d.size, 1),
-                    contact_N=float(Fa.max() - F0), pull_off_N=float(F0 - Fr.min()), pull_off_z_m=float(zr[i_off]),
-                    pull_off_at_N=float(Fr[i_off]), jump_in_z_m=float(za[i_in]), jump_in_drop_N=drop,
-                    jump_off_rise_N=rise, contact_from=i_in + 1 if drop > 10 * noise else None,
-                    free_from=i_off + 1 if rise > 10 * noise else None, noise_note=note,
-                    contact_slope_N_m=slope, retract_steps=steps)
 
 
 @dataclass
@@ -179,7 +114,7 @@ class _Problem:
     notes: list = field(default_factory=list)
     evaluations: int = 0
     best_chi2: float = math.inf
-    progress: object = None             # called with a FitProgress after each evaluation (None: silent)
+    progress: Callable[[FitProgress], None] | None = None     # after each evaluation (None: silent)
     t0: float = field(default_factory=time.perf_counter)
 
     def __post_init__(self):
@@ -353,7 +288,8 @@ class _Problem:
         self.evaluations += 1
         self.best_chi2 = min(self.best_chi2, float(r @ r))
         if self.progress is not None:
-            self.progress(FitProgress(self.evaluations, self.traces, self.best_chi2 / max(self.points - len(self.names), 1),
+            dof = max(self.points - len(self.names), 1)
+            self.progress(FitProgress(self.evaluations, self.traces, self.best_chi2 / dof,
                                       time.perf_counter() - self.t0))
         return r
 
@@ -423,19 +359,19 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         raise CurveFitError("the modulus is held but not given")
     if choice.noise is not None and not (math.isfinite(choice.noise) and choice.noise > 0):
         raise CurveFitError(f"the stated noise must be a finite positive force (N), got {choice.noise!r}")
-    _refuse_a_line(data)
+    refuse_a_line(data)
     feat = features(data)
     noise = feat.noise_N if choice.noise is None else float(choice.noise)
     # the most extreme of n samples of noise alone lies about sqrt(2 ln n) deviations out: a signal is beyond
-    signal = (_SIGNAL + math.sqrt(2 * math.log(data.z.size))) * noise
+    signal = (SIGNAL + math.sqrt(2 * math.log(data.z.size))) * noise
     if feat.contact_N < signal:
         raise CurveFitError(f"no contact: the approach rises at most {feat.contact_N:.3g} N above its baseline, "
                             f"within {signal / noise:.3g} times the noise ({noise:.2g} N)")
     if feat.pull_off_N < signal:
         raise CurveFitError(f"no adhesion: the retract falls at most {feat.pull_off_N:.3g} N below the baseline "
                             f"(noise {noise:.2g} N): no pull-off, so the work of adhesion is undetermined")
-    _refuse_empty(data, choice)
-    base = _baselines(data)
+    refuse_empty(data, choice)
+    base = baselines(data)
     notes: list[str] = []
     if choice.calibrate_invols:
         c = calibrated_invols(feat, spring, base[1])
@@ -481,7 +417,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         tries = [start(w_guess * math.sqrt(R / (m**3 * eps**3))) for m in (0.1, 0.3, 1.0, 3.0)]
         x0 = min(tries, key=lambda t: t[1])[0]
     pb.leave_out_edges(x0)
-    lo, hi = _bounds(pb, choice, modulus)
+    lo, hi = bounds(pb, choice, modulus)
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo if np.all(np.isfinite(hi - lo)) else 1), hi - 1e-9)
     pb.evaluations = 0
     res = least_squares(pb.residuals, x0, jac=pb.jacobian, bounds=(lo, hi), method="trf", x_scale="jac",
@@ -508,8 +444,8 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     get = {k_: (float(v) if math.isfinite(v) else None) for k_, v in zip(out_names, sd)}
     Fm, pieces = pb.model_force(p)
     fc = pb.forward(p)
-    quantities, warned = _verdicts(pb, choice, x, lo, hi, p, get, modulus)
-    instrument, warned_i = _instrument(pb, choice, x, lo, hi, p, get)
+    quantities, warned = verdicts(pb, choice, x, lo, hi, p, get, modulus)
+    instrument, warned_i = instrument_values(pb, choice, x, lo, hi, p, get)
     warned += warned_i
     noise_dof = None if choice.noise is not None else feat.noise_dof
     bad = misfit(chi2, n - m, noise_dof)
@@ -527,7 +463,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     warned += [f"outside the model's domain: {why}" for why in reasons]
     spread = None
     if spread_rules is not None:
-        spread = _curve_spread(pb, x, J, JtJ_inv, quantities, A, spread_rules, lo, hi)
+        spread = curve_spread(pb, x, J, JtJ_inv, quantities, A, spread_rules, lo, hi)
     used = pb.weight > 0
     return CurveFit(**quantities, mu=p["mu"], sigma=p["sigma"], K=p["K"], chi2=chi2, dof=n - m, noise_N=noise,
                     noise_stated=choice.noise is not None, p_value=misfit_p(chi2, n - m, noise_dof),
@@ -552,327 +488,6 @@ def _to_moduli(names: tuple) -> np.ndarray:
         A[i, :] = 0.0
         A[i, i], A[i, j] = -1.5, 1.0
     return A
-
-
-def _baselines(data: MeasuredCurve) -> tuple[float, float, float]:
-    """Each leg's baseline on its far part (the farthest 30% of its travel from the surface): the approach's
-    line a + b z (N, N/m: the virtual deflection b) and the retract's offset from it (N: the drag), the
-    median of its far part less the approach's line there."""
-    z, F, s = data.z, data.F, data.direction
-    out = []
-    for sl in (data.approach, data.retract):
-        zz, FF = z[sl], F[sl]
-        depth = s * (zz - zz.min() if s > 0 else zz - zz.max())
-        far = depth <= 0.3 * depth.max()
-        if far.sum() < 5:
-            far = np.argsort(depth)[:5]
-        out.append((zz[far], FF[far]))
-    (za, Fa), (zr, Fr) = out
-    b, a = np.polyfit(za, Fa, 1) if np.ptp(za) > 0 else (0.0, float(np.median(Fa)))
-    drag = float(np.median(Fr - (a + b * zr)))
-    return float(a), float(b), drag
-
-
-def calibrated_invols(feat: Features, spring: Spring, baseline_slope: float = 0.0) -> float:
-    """The scale c of the deflection sensitivity that makes the approach's contact as stiff as the lever, as on
-    a hard substrate (there the piezo's travel is the lever's deflection, so the true slope is k):
-    c = k / (S - b), S the measured contact slope and b the baseline's.  CurveFitError where the curve shows
-    no contact slope."""
-    S = feat.contact_slope_N_m
-    if S is None or not math.isfinite(S) or S - baseline_slope <= 0:
-        raise CurveFitError("the sensitivity cannot be calibrated: the approach shows no rising contact slope")
-    return spring.k / (S - baseline_slope)
-
-
-#: The deepest indentation a small-strain half-space model of a sphere describes, over its radius: the
-#: contact radius sqrt(R delta) is then a third of R, where the paraboloid departs from the sphere by 2.5%.
-INDENTATION_MAX = 1 / 9
-#: A contact slope above the lever's by more than this share (no series of springs makes it).
-SLOPE_ABOVE = 0.1
-#: A reach of the retract's adhesion beyond the model's, over the larger of this many epsilon and ...
-REACH_EPS = 30.0
-#: ... this share of the tip's radius: long-range or tether adhesion.
-REACH_R = 0.1
-
-
-def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: Spring, choice: FitChoice,
-                   baseline: tuple | None = None, scale: float | None = None) -> list[str]:
-    """Why the curve is outside the model's domain (docs/fitting.md, "Where the model applies"), one line
-    each; empty where it is inside.  With the deflection's scale c (``scale``, else ``choice.invols_scale``)
-    the true deflection is c (F - F0) / k; ``baseline`` (a, b, d) each leg's baseline (:func:`_baselines`;
-    None: flat at F0).  Where c is fitted and not yet known (``choice.invols_fitted``
-    without ``scale``) the indentation and the contact's slope say nothing (any indentation is some c's) and
-    are checked after the fit, at its c:
-
-    - the indentation (the travel in contact less the deflection's rise) deeper than INDENTATION_MAX R;
-    - a contact steeper than the lever (by SLOPE_ABOVE): the piezo's travel less than the deflection, which no
-      elastic contact makes (the sensitivity or the spring constant is off), unless its scale is fitted;
-    - the mu a compliant contact asks for (E* by Hertz over the indentation, w by JKR from the pull-off) above
-      the model's range;
-    - a retract that lets go in several steps, or whose adhesion (its last point below its baseline by more
-      than 10 noise and 5% of the pull-off) reaches farther than the lever's stretch at the pull-off plus REACH_EPS epsilon or REACH_R of R: tethers or long-range forces the Lennard-Jones
-      sphere does not make."""
-    out = []
-    s, z, F = data.direction, data.z, data.F
-    a, baseline_slope, drag = baseline if baseline is not None else (feat.F0_N, 0.0, 0.0)
-    R, eps = bodies.R, bodies.epsilon
-    c, k = scale or choice.invols_scale, spring.k
-    unknown = choice.invols_fitted and scale is None
-    za, Fa = z[data.approach], F[data.approach]
-    F0 = feat.F0_N
-    top = int(np.argmax(Fa))
-    # the contact's start: the point after the jump-in, else where the force last leaves the baseline's noise
-    if feat.contact_from is not None:
-        i_c = feat.contact_from
-    else:
-        low = np.flatnonzero(Fa[:top + 1] <= F0 + 5 * feat.noise_N)
-        i_c = int(low[-1]) if low.size else 0
-    travel = s * (za[top] - za[i_c])
-    rise = c * (Fa[top] - Fa[i_c]) / k
-    delta = travel - rise
-    if delta > INDENTATION_MAX * R and not unknown:
-        out.append(f"the indentation reaches {delta * 1e9:.3g} nm, {delta / R:.2g} of the tip's radius "
-                   f"{R * 1e9:.3g} nm (the travel in contact {travel * 1e9:.3g} nm less the deflection's rise "
-                   f"{rise * 1e9:.3g} nm): a small-strain half-space model of a sphere holds below R/9 (a "
-                   f"contact radius of R/3); fit a shallower range (-fit_z_range) or a larger tip")
-    S = feat.contact_slope_N_m
-    if S is not None and not unknown:
-        ratio = c * (S - baseline_slope) / k
-        if ratio > 1 + SLOPE_ABOVE:
-            out.append(f"the contact rises at {ratio:.3g} times the lever's stiffness, steeper than any elastic "
-                       f"contact behind the lever: the deflection sensitivity or the spring constant is off "
-                       f"(-fit_calibrate_invols, -fit_invols_scale, -fit_spring_err)")
-        elif 0 < ratio < 1 and delta > 0 and feat.pull_off_N > 0:
-            # Hertz with JKR's offset: F + 2 P = (4/3) E* sqrt(R) delta^1.5 at the top; w = P / (1.5 pi R)
-            P = c * feat.pull_off_N
-            E = 0.75 * (c * (Fa[top] - F0) + 2 * P) / (math.sqrt(R) * delta ** 1.5)
-            w = P / (1.5 * math.pi * R)
-            mu = tabor(R, w, E, eps)
-            if mu > MU_BOUNDS[1]:
-                out.append(f"the contact rises at {ratio:.2g} of the lever's stiffness: a compliant sample, E* about "
-                           f"{E:.3g} Pa by Hertz over its indentation {delta * 1e9:.3g} nm, which with w about "
-                           f"{w:.3g} J/m^2 (JKR, from the pull-off) makes mu about {mu:.3g}, above the model's "
-                           f"range (mu <= {MU_BOUNDS[1]:g})")
-    if feat.retract_steps > 1:
-        out.append(f"the retract lets go in {feat.retract_steps} steps: several bonds or a tether, which one "
-                   f"sphere's Lennard-Jones adhesion does not make")
-    zr, Fr = z[data.retract], F[data.retract]
-    below = a + baseline_slope * zr + drag - Fr
-    held_on = np.flatnonzero(below > max(10 * feat.noise_N, 0.05 * feat.pull_off_N))
-    if held_on.size:
-        # the approach's contact point to the last point of the retract still pulled below the baseline
-        reach = s * (za[i_c] - zr[held_on[-1]])
-        stretch = c * feat.pull_off_N / k
-        allowed = stretch + max(REACH_EPS * eps, REACH_R * R)
-        if reach > allowed:
-            out.append(f"the retract holds on {reach * 1e9:.3g} nm behind the contact, beyond the lever's stretch "
-                       f"at the pull-off {stretch * 1e9:.3g} nm and the model's reach: long-range or tether "
-                       f"adhesion, which the Lennard-Jones sphere does not make")
-    return out
-
-
-def _refuse_empty(data: MeasuredCurve, choice: FitChoice) -> None:
-    """CurveFitError where the segment and the piezo range asked for leave too few points of the curve."""
-    legs = {"approach": data.approach, "retract": data.retract}
-    wanted = (APPROACH, RETRACT) if choice.segment == "both" else (choice.segment,)
-    for leg in wanted:
-        z = data.z[legs[leg]]
-        inside = np.ones(z.size, bool) if choice.z_range is None else \
-            (z >= choice.z_range[0]) & (z <= choice.z_range[1])
-        if np.count_nonzero(inside) < 10:
-            where = "" if choice.z_range is None else \
-                f" within z in [{choice.z_range[0]:.4g}, {choice.z_range[1]:.4g}] m"
-            raise CurveFitError(f"the {leg} has {int(np.count_nonzero(inside))} points{where}; a fit needs 10 at "
-                                f"least (the curve's z runs over [{data.z.min():.4g}, {data.z.max():.4g}] m)")
-
-
-#: Gauss-Newton steps (with the fit's Jacobian) that move the optimum to another roughness law, at most; they
-#: stop where a step moves ln w by less than a tenth of its bar.
-SPREAD_STEPS = 3
-
-
-def _curve_spread(pb: _Problem, x, J, JtJ_inv, quantities: dict, A, rules: tuple, lo, hi):
-    """w's and E*'s model spread: the optimum moved to each roughness law of ``rules`` by Gauss-Newton steps
-    from the fit's with the fit's Jacobian J (a chord method), dx = -(J^T J)^-1 J^T r_law(x_i), r_law the
-    residuals under that law, at most SPREAD_STEPS, within the fit's bounds (one curve traced per step and
-    law; the first step is the refit's to first order in the law's change)."""
-    from ..tracing.model_spread import ModelSpread, Rule, spread_quantity
-
-    model = replace(pb.template, sigma=pb.unpack(x)["sigma"])
-    reference = Rule.of(model)
-    if model.roughness == "none" or model.sigma == 0:
-        return Missing("a smooth surface (sigma = 0): there is no roughness law to vary")
-    if reference in rules:
-        raise ValueError(f"{reference.label}: the reference's own law, not an alternative to it")
-    if JtJ_inv is None:
-        return Missing("the fit's covariance is singular: its optimum cannot be moved to another law")
-    names = pb.names
-    i_w = names.index("ln_gamma")
-    moved_w: list[Measured | Missing] = []
-    moved_E: list[Measured | Missing] = []
-    notes, times = [], []
-    t0 = time.perf_counter()
-    for rule in rules:
-        t = time.perf_counter()
-        alt = replace(pb, template=rule.model(pb.template), cache={}, progress=None)
-        alt.weight = pb.weight.copy()
-        try:
-            xi = x.copy()
-            bar = math.sqrt(max(JtJ_inv[i_w, i_w], 0.0)) or 1.0
-            for _ in range(SPREAD_STEPS):
-                r_law, _ = alt._all(alt.unpack(xi))
-                step = -JtJ_inv @ (J.T @ r_law)
-                xi = np.clip(xi + step, lo, hi)
-                if abs(step[i_w]) < 0.1 * bar:
-                    break
-            dx = xi - x
-            y = A @ xi
-            moved_w.append(Measured(math.exp(y[i_w])))
-            if "ln_mu" in names:
-                # ln E* differs from A's row by a constant: E* at the moved optimum is E* exp(change of the row)
-                d = A @ dx
-                moved_E.append(Measured(float(quantities["E_star"].value) * math.exp(d[names.index("ln_mu")]))
-                               if isinstance(quantities["E_star"], Measured) else Missing("E* undetermined"))
-        except (ValueError, RuntimeError, FloatingPointError) as why:
-            moved_w.append(Missing(f"{rule.label}: {why}"))
-            moved_E.append(Missing(f"{rule.label}: {why}"))
-            notes.append(f"{rule.label}: its curve could not be traced at the optimum ({why})")
-        pb.traces += alt.traces
-        times.append(time.perf_counter() - t)
-    qs = []
-    if isinstance(quantities["gamma"], Measured):
-        qs.append(spread_quantity("work of adhesion gamma", "gamma", quantities["gamma"], tuple(moved_w), rules,
-                                  reference))
-    if "ln_mu" in names and isinstance(quantities["E_star"], Measured):
-        qs.append(spread_quantity("reduced modulus E*", "E_star", quantities["E_star"], tuple(moved_E), rules,
-                                  reference))
-    if not qs:
-        return Missing(f"w and E* are undetermined under {reference.label}: no value to spread about")
-    return ModelSpread(reference, rules, tuple(qs), tuple(notes), time.perf_counter() - t0, tuple(times))
-
-
-def _instrument(pb: _Problem, choice: FitChoice, x, lo, hi, p: dict, sd: dict) -> tuple[Instrument, list]:
-    """The instrument's nuisance parameters as Measured (fitted with their bars, held with a note) or Missing
-    at a bound of the fit, and the warnings that say so."""
-    warned = []
-
-    def fitted(key, coord, value, err_of):
-        j = pb.names.index(coord)
-        if x[j] - lo[j] <= BOUND_MARGIN or hi[j] - x[j] <= BOUND_MARGIN:
-            why = f"{value:.4g} is at a bound of the fit ({key} within a factor {math.exp(hi[j]):g} of the stated)"
-            warned.append(f"{key} undetermined: {why}")
-            return Missing(why)
-        e = sd.get(coord)
-        if e is None:
-            why = "a singular covariance: the curve does not determine it"
-            warned.append(f"{key} undetermined: {why}")
-            return Missing(why)
-        return Measured(value, err_of(e))
-
-    if choice.invols_fitted:
-        c = fitted("invols_scale", "ln_invols", p["c"], lambda e: p["c"] * e)
-    else:
-        c = Measured(p["c"], note="held: " + ("calibrated on the contact as on a hard substrate"
-                                               if choice.calibrate_invols else "the file's sensitivity"))
-    if choice.spring_err is not None:
-        k = fitted("spring", "ln_k", p["k"], lambda e: p["k"] * e)
-    else:
-        k = Measured(p["k"], note=f"held at {pb.spring.source}")
-    v = fitted("virtual_deflection", "slope", p["slope"], lambda e: e * pb.noise / pb.eps) \
-        if choice.virtual_deflection else Measured(0.0, note="held at 0: not fitted (-fit_virtual_deflection)")
-    d = fitted("drag", "drag", p["drag"], lambda e: e * pb.noise) if choice.drag else \
-        Measured(0.0, note="held at 0: not fitted (-fit_drag)")
-    return Instrument(c, k, v, d, pb.feat.contact_slope_N_m), warned
-
-
-def _refuse_a_line(data: MeasuredCurve) -> None:
-    """CurveFitError for a force that is a straight line in the piezo position over both legs (to _LINEAR of
-    its range): two columns of one quantity, no force-distance relation."""
-    A = np.c_[data.z, np.ones_like(data.z)]
-    coef, *_ = np.linalg.lstsq(A, data.F, rcond=None)
-    left = float(np.sqrt(np.mean((data.F - A @ coef) ** 2)))
-    if left <= _LINEAR * float(np.ptp(data.F)):
-        raise CurveFitError(f"no force-distance relation: the force is a straight line of the piezo position "
-                            f"(slope {coef[0]:.6g} N/m) on approach and retract alike (two columns of one "
-                            f"quantity?)")
-
-
-def _bounds(pb: _Problem, choice: FitChoice, modulus: float | None) -> tuple[np.ndarray, np.ndarray]:
-    """The bounds of the fitted coordinates: mu in MU_BOUNDS (through w at a held modulus), sigma in [0,
-    SIGMA_MAX], w in [1e-6, 100] J/m^2, the sensitivity's scale and the spring constant within a factor
-    INSTRUMENT_FACTOR of the stated; the contact point, the baseline, its slope and the drag free."""
-    lo = np.array([-np.inf] * len(pb.names))
-    hi = np.array([np.inf] * len(pb.names))
-    for j, name in enumerate(pb.names):
-        if name == "ln_mu":
-            lo[j], hi[j] = math.log(MU_BOUNDS[0]), math.log(MU_BOUNDS[1])
-        elif name == "sigma":
-            lo[j], hi[j] = 0.0, SIGMA_MAX
-        elif name == "ln_gamma":
-            lo[j], hi[j] = math.log(1e-6), math.log(100.0)
-        elif name in ("ln_invols", "ln_k"):             # within a factor INSTRUMENT_FACTOR of the stated
-            lo[j], hi[j] = -math.log(INSTRUMENT_FACTOR), math.log(INSTRUMENT_FACTOR)
-    if not choice.modulus:                          # mu's bounds through w at the held modulus
-        assert modulus is not None, "a held modulus is given (fit_curve refuses it otherwise)"
-        E, R, eps = float(modulus), pb.R, pb.eps
-        j = pb.names.index("ln_gamma")
-        lo[j] = max(lo[j], math.log(math.sqrt(MU_BOUNDS[0]**3 * E**2 * eps**3 / R)))
-        hi[j] = min(hi[j], math.log(math.sqrt(MU_BOUNDS[1]**3 * E**2 * eps**3 / R)))
-    return lo, hi
-
-
-def _verdicts(pb: _Problem, choice: FitChoice, x, lo, hi, p: dict, sd: dict, modulus) -> tuple[dict, list]:
-    """The fit's quantities (gamma, E_star, rms, z0, F0) as Measured, or Missing where a parameter is at a
-    bound or undetermined (docs/fitting.md), and the warnings that say so."""
-    eps = pb.eps
-    at = {}
-    for j, name in enumerate(pb.names):
-        if x[j] - lo[j] <= BOUND_MARGIN or hi[j] - x[j] <= BOUND_MARGIN:
-            edge = lo[j] if x[j] - lo[j] <= BOUND_MARGIN else hi[j]
-            at[name] = edge
-    q, warned = {}, []
-
-    def bound_reason(name: str) -> str:
-        edge = at[name]
-        if name == "ln_mu" or (name == "ln_gamma" and not choice.modulus and
-                                math.log(1e-6) < edge < math.log(100.0)):
-            mu_edge = MU_BOUNDS[0] if p["mu"] < 1 else MU_BOUNDS[1]
-            return (f"mu = {p['mu']:.4g} is at the bound {mu_edge:g} of the model's range [{MU_BOUNDS[0]:g}, "
-                    f"{MU_BOUNDS[1]:g}]: the data ask for a mu the model does not reach")
-        if name == "ln_gamma":
-            return f"w = {p['w']:.4g} J/m^2 is at the bound {math.exp(edge):g} J/m^2 of the fit"
-        return f"sigma = {p['sigma']:.4g} is at the bound {edge:g} of [0, {SIGMA_MAX:g}]"
-
-    def judged(key: str, coord: str, value: float, err: float | None):
-        why = bound_reason(coord) if coord in at else undetermined(value, err)
-        if why is None:
-            return Measured(value, err)
-        warned.append(f"{key} undetermined: {why}")
-        return Missing(why)
-
-    w = p["w"]
-    q["gamma"] = judged("gamma", "ln_gamma", w, None if sd["ln_gamma"] is None else w * sd["ln_gamma"])
-    if choice.modulus:
-        e = sd["ln_E_star"]
-        q["E_star"] = judged("E_star", "ln_mu", p["E"], None if e is None else p["E"] * e)
-    else:
-        q["E_star"] = Measured(float(modulus), note="held at the moduli given (eq. 2)")
-    if choice.roughness:
-        e = sd["sigma"]
-        q["rms"] = judged("rms", "sigma", p["sigma"] * eps, None if e is None else e * eps)
-    elif pb.bodies.rms is not None:
-        q["rms"] = Measured(float(pb.bodies.rms), note="held at the rms given")
-    else:
-        q["rms"] = None
-    for key, coord, value, scale in (("z0", "z0", p["z0"], eps), ("F0", "F0", p["F0"], pb.noise)):
-        e = sd[coord]
-        if e is None:
-            why = "a singular covariance: the curve does not determine it"
-            warned.append(f"{key} undetermined: {why}")
-            q[key] = Missing(why)
-        else:
-            q[key] = Measured(value, e * scale)
-    return q, warned
 
 
 def _align(pb: _Problem, x: np.ndarray) -> float:

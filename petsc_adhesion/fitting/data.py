@@ -47,7 +47,8 @@ import numpy as np
 
 from ..errors import printable as _printable
 
-__all__ = ["CurveFileError", "NeedsInstrument", "MeasuredCurve", "VOLT_UNITS", "read_curve", "AFM_EXTENSIONS", "LENGTH_UNITS", "FORCE_UNITS",
+__all__ = ["CurveFileError", "NeedsInstrument", "MeasuredCurve", "VOLT_UNITS", "read_curve", "AFM_EXTENSIONS",
+           "LENGTH_UNITS", "FORCE_UNITS",
            "MIN_POINTS", "MAX_TEXT_BYTES"]
 
 #: The extensions afmformats reads (0.18): a file of these is read through it (``.csv`` and ``.txt`` only when
