@@ -254,6 +254,9 @@ REFUSALS = {
                       "-fit_drag: the retract's offset needs the retract", 2),
     "curve_only": (("-fit_pull_off", "1e-8", *TIP, "-phys_young1", "1e11", "-phys_poisson1", "0.3",
                     "-fit_invols_scale"), "-fit_invols_scale: only with -fit_curve", 2),
+    "invols_on_force": (("-fit_curve", os.path.join(ROOT, "tests", "data", "golden", "curve.csv"), *TIP,
+                         "-phys_spring", "1", "-fit_invols", "5e-8"),
+                        "-fit_invols: '", 2),
     "domain": (("-fit_curve", "soft.csv", *TIP, "-phys_spring", "0.1"),
                "-fit_curve: outside the model's domain: the indentation reaches", 3),
 }

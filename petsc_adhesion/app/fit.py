@@ -205,6 +205,10 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
             raise InputError(f"-{e.option}: required with -fit_curve: {printable(str(e))}") from None
         except CurveFileError as e:
             raise InputError(f"-fit_curve: {printable(str(e))}") from None
+        invols = opts.real("fit_invols")
+        if invols is not None and data.sensitivity != invols:
+            raise InputError(f"-fit_invols: '{printable(path)}' gives a force, not a deflection in volts: no "
+                             f"sensitivity to apply; remove it")
         held = int(data.metadata.get("curves_in_file", 1))
         if held > 1 and not _given(opts, "fit_curve_index"):
             raise InputError(f"-fit_curve_index: required with -fit_curve: '{printable(path)}' holds {held} curves "
