@@ -257,6 +257,8 @@ REFUSALS = {
     "invols_on_force": (("-fit_curve", os.path.join(ROOT, "tests", "data", "golden", "curve.csv"), *TIP,
                          "-phys_spring", "1", "-fit_invols", "5e-8"),
                         "-fit_invols: '", 2),
+    "progress_pull_off": (("-fit_pull_off", "1e-8", *TIP, "-phys_young1", "1e11", "-phys_poisson1", "0.3",
+                           "-progress"), "-progress: applies to -fit_curve", 2),
     "domain": (("-fit_curve", "soft.csv", *TIP, "-phys_spring", "0.1"),
                "-fit_curve: outside the model's domain: the indentation reaches", 3),
 }

@@ -13,11 +13,10 @@ writes the files all together and the report.  A fit runs on one rank.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, replace
 
 from petsc4py import PETSc
-
-import sys
 
 from ..errors import InputError, collective, printable, say
 from ..fitting.curve_fit import CurveFitError, FitProgress, OutsideDomain, fit_curve, predict_curve
@@ -180,6 +179,10 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         for name in ("plot", "csv", "phys_spring"):
             if name in targets or _given(opts, name):
                 raise InputError(f"-{name}: applies to -fit_curve (a pull-off has no curve); remove it")
+        for name in ("progress", "progress_interval"):
+            if _given(opts, name):
+                raise InputError(f"-{name}: applies to -fit_curve (a pull-off's fit is a few curves, without "
+                                 f"progress lines); remove it")
     if "plot" in targets and not targets["plot"].lower().endswith(tuple(PLOT_FORMATS)):
         raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
     inputs = {"options_file": options_files(argv), "fit_curve": [path or ""]}
