@@ -120,8 +120,9 @@ def calibrated_invols(feat: Features, spring: Spring, baseline_slope: float = 0.
 
 
 #: The deepest indentation a small-strain half-space model of a sphere describes, over its radius: the
-#: contact radius sqrt(R delta) is then a third of R, where the paraboloid departs from the sphere by 2.5%.
-INDENTATION_MAX = 1 / 9
+#: contact radius sqrt(R delta) is then half of R, where the paraboloid's height falls 6.7% short of the
+#: sphere's at the contact's edge (2.9% at a third of R).
+INDENTATION_MAX = 1 / 4
 #: A contact slope above the lever's by more than this share (no series of springs makes it).
 SLOPE_ABOVE = 0.1
 #: A reach of the retract's adhesion beyond the model's, over the larger of this many epsilon and ...
@@ -169,8 +170,8 @@ def domain_reasons(data: MeasuredCurve, feat: Features, bodies: Bodies, spring: 
     if delta > INDENTATION_MAX * R and not unknown:
         out.append(f"the indentation reaches {delta * 1e9:.3g} nm, {delta / R:.2g} of the tip's radius "
                    f"{R * 1e9:.3g} nm (the travel in contact {travel * 1e9:.3g} nm less the deflection's rise "
-                   f"{rise * 1e9:.3g} nm): a small-strain half-space model of a sphere holds below R/9 (a "
-                   f"contact radius of R/3); fit a shallower range (-fit_z_range) or a larger tip")
+                   f"{rise * 1e9:.3g} nm): a small-strain half-space model of a sphere holds below R/4 (a "
+                   f"contact radius of R/2); fit a shallower range (-fit_z_range) or a larger tip")
     S = feat.contact_slope_N_m
     if S is not None and not unknown:
         ratio = c * (S - baseline_slope) / k
