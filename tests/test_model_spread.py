@@ -349,7 +349,7 @@ def test_a_rough_pull_off_fit_has_gammas_spread(tmp_path):
 
 def test_a_study_refuses_the_spreads_options(tmp_path):
     """A study's cases compute no spread: asking for one is refused in one line, exit 2, nothing written;
-    so is asking one solve (-adh_lambda) or -fit_curve for one."""
+    so is asking one solve (-adh_lambda) or a smooth -fit_curve for one."""
     from conftest import run_cli
 
     out = tmp_path / "st.json"
@@ -362,8 +362,9 @@ def test_a_study_refuses_the_spreads_options(tmp_path):
     assert proc.returncode == 2 and not out.exists()
     assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: applies to one run's curve or "
                                    "-fit_pull_off, not -adh_lambda (one solve); remove it")
+    # -fit_curve has one with roughness (w's and E*'s, docs/fitting.md); a smooth surface has none to ask for
     proc = run_cli("-fit_curve", tmp_path / "c.csv", "-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9",
-                   "-adh_model_spread", "false", "-summary", out)
+                   "-adh_model_spread", "true", "-summary", out)
     assert proc.returncode == 2 and not out.exists()
-    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: applies to a curve's run or "
-                                   "-fit_pull_off, not -fit_curve; remove it")
+    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: a smooth surface (sigma = 0) has no "
+                                   "roughness law to vary")

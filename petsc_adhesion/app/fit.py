@@ -13,13 +13,14 @@ writes the files all together and the report.  A fit runs on one rank.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, replace
 
 from petsc4py import PETSc
 
-from ..errors import InputError, collective, printable
-from ..fitting.curve_fit import CurveFitError, fit_curve, predict_curve
-from ..fitting.data import CurveFileError, MeasuredCurve, read_curve
+from ..errors import InputError, collective, printable, say
+from ..fitting.curve_fit import CurveFitError, FitProgress, OutsideDomain, fit_curve, predict_curve
+from ..fitting.data import CurveFileError, MeasuredCurve, NeedsInstrument, read_curve
 from ..fitting.pull_off import PullOffFitError, fit_pull_off
 from ..fitting.results import FitChoice, Spring
 from ..io.fit import fit_summary, fit_tree, report_fit
@@ -35,6 +36,7 @@ from .options.checks import check_petsc_values, check_unused
 from .options.reading import AppOptions, read_grid, read_model_spread, read_solver
 from .options.table import ROUGHNESS_OPTIONS, TABLE
 from .optionsfile import options_files
+from .progress import Progress
 
 __all__ = ["FitRequest", "is_fit", "refuse_fit_options", "read", "execute", "main", "FIT_OPTIONS"]
 
@@ -44,7 +46,11 @@ FIT_OPTIONS = {"phys_radius", "phys_radius2", "phys_young1", "phys_poisson1", "p
                "phys_epsilon", "phys_rms", "phys_spring", "adh_roughness", "adh_rmax", "adh_farfield", "adh_pmat",
                "adh_pmat_band", "adh_pc_reuse_its", "grid_type", "grid_n", "grid_paper_uniform", "grid_paper_extra",
                "grid_paper_split", "grid_paper_refine_from", "out", "summary", "plot", "csv",
-               "adh_model_spread", "adh_model_spread_rules", *ROUGHNESS_OPTIONS}
+               "adh_model_spread", "adh_model_spread_rules", "progress", "progress_interval", *ROUGHNESS_OPTIONS}
+#: The options of -fit_curve alone: what is fitted and how.
+CURVE_ONLY = ("fit_curve_index", "fit_modulus", "fit_roughness", "fit_invols", "fit_invols_scale",
+              "fit_calibrate_invols", "fit_spring_err", "fit_virtual_deflection", "fit_drag", "fit_segment",
+              "fit_z_range", "fit_max_evals", "fit_outside_domain")
 _OUTPUTS = ("out", "summary", "plot", "csv")
 #: Points per leg of the fitted model's curve in the files.
 MODEL_POINTS = 400
@@ -78,7 +84,7 @@ class FitRequest:
     spring: Spring | None       # curve: the cantilever
     choice: FitChoice | None    # curve: what is fitted
     targets: dict
-    spread_rules: tuple | None = None   # pull_off: the laws of gamma's model spread (None: none)
+    spread_rules: tuple | None = None   # the laws of gamma's (a curve's: w's and E*'s) model spread (None: none)
 
 
 def _given(opts: AppOptions, name: str) -> bool:
@@ -147,8 +153,7 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         raise InputError("-fit_pull_off: not with -fit_curve; a run fits one measurement")
     kind = "pull_off" if pull is not None else "curve"
     what = "-fit_pull_off" if pull is not None else "-fit_curve"
-    for name, needs in (("fit_pull_off_err", "pull_off"), ("fit_curve_index", "curve"), ("fit_modulus", "curve"),
-                        ("fit_roughness", "curve")):
+    for name, needs in (("fit_pull_off_err", "pull_off"), *((n, "curve") for n in CURVE_ONLY)):
         if _given(opts, name) and kind != needs:
             raise InputError(f"-{name}: only with -fit_{needs}")
     if comm.getSize() > 1:
@@ -174,6 +179,10 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         for name in ("plot", "csv", "phys_spring"):
             if name in targets or _given(opts, name):
                 raise InputError(f"-{name}: applies to -fit_curve (a pull-off has no curve); remove it")
+        for name in ("progress", "progress_interval"):
+            if _given(opts, name):
+                raise InputError(f"-{name}: applies to -fit_curve (a pull-off's fit is a few curves, without "
+                                 f"progress lines); remove it")
     if "plot" in targets and not targets["plot"].lower().endswith(tuple(PLOT_FORMATS)):
         raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
     inputs = {"options_file": options_files(argv), "fit_curve": [path or ""]}
@@ -186,16 +195,27 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         req = FitRequest("pull_off", model, grid, solver, bodies, pull, opts.real("fit_pull_off_err"), None, None,
                          None, targets, read_model_spread(opts, model))
     else:
-        for name in ("adh_model_spread", "adh_model_spread_rules"):
-            if _given(opts, name):
-                raise InputError(f"-{name}: applies to a curve's run or -fit_pull_off, not -fit_curve; remove it")
         if fit_rough and model.roughness == "none":
             raise InputError("-fit_roughness: not with -adh_roughness none (a smooth surface)")
+        choice = _curve_choice(opts, fit_modulus, fit_rough)
+        rough = model.roughness != "none" and (model.sigma > 0 or fit_rough)
+        spread = read_model_spread(opts, replace(model, sigma=model.sigma or (0.3 if rough else 0.0)))
         check_input("fit_curve", path)
         try:
-            data = read_curve(path, opts.int("fit_curve_index"))
+            data = read_curve(path, opts.int("fit_curve_index"), spring=opts.real("phys_spring"),
+                              invols=opts.real("fit_invols"))
+        except NeedsInstrument as e:
+            raise InputError(f"-{e.option}: required with -fit_curve: {printable(str(e))}") from None
         except CurveFileError as e:
             raise InputError(f"-fit_curve: {printable(str(e))}") from None
+        invols = opts.real("fit_invols")
+        if invols is not None and data.sensitivity != invols:
+            raise InputError(f"-fit_invols: '{printable(path)}' gives a force, not a deflection in volts: no "
+                             f"sensitivity to apply; remove it")
+        held = int(data.metadata.get("curves_in_file", 1))
+        if held > 1 and not _given(opts, "fit_curve_index"):
+            raise InputError(f"-fit_curve_index: required with -fit_curve: '{printable(path)}' holds {held} curves "
+                             f"(a force map); name the one to fit, 0 to {held - 1}")
         k = opts.real("phys_spring")
         source = "-phys_spring"
         if k is None:
@@ -206,14 +226,45 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         elif data.spring is not None and k != data.spring:
             data = data.rescaled(k)       # the file's force is its spring constant times the measured deflection
             source = f"-phys_spring (the file's force rescaled from its {data.metadata.get('spring constant')} N/m)"
-        req = FitRequest("curve", model, grid, solver, bodies, None, 0.0, data, Spring(k, source),
-                         FitChoice(modulus=fit_modulus, roughness=fit_rough), targets)
+        req = FitRequest("curve", model, grid, solver, bodies, None, 0.0, data, Spring(k, source), choice, targets,
+                         spread)
     if comm.getRank() == 0:
         check_targets(targets, inputs)
     return req
 
 
-def _fit(req: FitRequest, comm):
+def _curve_choice(opts: AppOptions, fit_modulus: bool, fit_rough: bool) -> FitChoice:
+    """What -fit_curve fits, from its options (checked: one line naming the option)."""
+    z_range = opts.reals("fit_z_range")
+    if _given(opts, "fit_z_range") and (len(z_range) != 2 or z_range[0] >= z_range[1]):
+        raise InputError(f"-fit_z_range: expected two piezo positions lo,hi (m) with lo < hi, got "
+                         f"'{opts.string('fit_z_range')}'")
+    segment = opts.choice("fit_segment")
+    if opts.flag("fit_drag") and segment == "approach":
+        raise InputError("-fit_drag: the retract's offset needs the retract; -fit_segment approach fits none")
+    return FitChoice(modulus=fit_modulus, roughness=fit_rough, max_evaluations=opts.int("fit_max_evals"),
+                     invols_fitted=bool(opts.flag("fit_invols_scale")),
+                     calibrate_invols=bool(opts.flag("fit_calibrate_invols")), spring_err=opts.real("fit_spring_err"),
+                     virtual_deflection=bool(opts.flag("fit_virtual_deflection")), drag=bool(opts.flag("fit_drag")),
+                     segment=segment, z_range=tuple(z_range) if z_range else None,
+                     outside_domain=opts.choice("fit_outside_domain"))
+
+
+def _progress(opts: AppOptions, comm, cap: int):
+    """The progress line of a curve fit (-progress, -progress_interval): evaluations, curves traced, the best
+    reduced chi^2; None where it is not shown."""
+    shown = opts.flag("progress")
+    bar = Progress(comm, sys.stderr.isatty() if shown is None else shown, opts.real("progress_interval"))
+    if not bar.enabled:
+        return None
+
+    def update(p: FitProgress) -> None:
+        bar.update(p.evaluations / cap, f"fit: {p.evaluations} evaluations of at most {cap} (-fit_max_evals), "
+                                        f"{p.traces} curves traced, best reduced chi^2 {p.best_reduced_chi2:.4g}")
+    return update
+
+
+def _fit(req: FitRequest, comm, progress=None):
     """The library's fit of ``req``; InputError (one line naming the option) for what it cannot fit."""
     try:
         if req.kind == "pull_off":
@@ -222,7 +273,7 @@ def _fit(req: FitRequest, comm):
                                 comm=comm, spread_rules=req.spread_rules)
         assert req.data is not None and req.spring is not None, "a curve fit's request holds the curve and spring"
         return fit_curve(req.data, req.bodies, req.spring, req.choice, model=req.model, grid=req.grid,
-                         solver=req.solver, comm=comm)
+                         solver=req.solver, comm=comm, progress=progress, spread_rules=req.spread_rules)
     except PullOffFitError as e:
         raise InputError(f"-fit_pull_off: {printable(str(e))}") from None
     except CurveFitError as e:
@@ -243,7 +294,12 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     written all the same; else 0."""
     comm = PETSc.COMM_WORLD
     req = collective(comm, read, opts, comm, argv)
-    fit = _fit(req, comm)
+    try:
+        fit = _fit(req, comm, _progress(opts, comm, req.choice.max_evaluations) if req.kind == "curve" else None)
+    except OutsideDomain as e:          # refused before any work: nothing written, an earlier result intact
+        say(f"-fit_curve: outside the model's domain: {printable(str(e))}; -fit_outside_domain warn fits it all "
+            f"the same")
+        return 3, None
     head = program_record(Program.of(comm))
     head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted
     given = opts.given()

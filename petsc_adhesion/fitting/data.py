@@ -11,14 +11,21 @@ plain text or CSV (any name; ``.csv``, ``.txt``, ``.tsv``, ``.dat`` ...)
     name is honoured (displacement: m, mm, um, nm, pm; force: N, mN, uN, nN, pN),
     and a name without one is taken in SI, as are the columns of a file without a
     header.  The force is tensile (attractive) negative, as a cantilever's
-    deflection towards the surface gives it.
+    deflection towards the surface gives it.  The second column may instead be the
+    cantilever's deflection, in a length unit (m, nm, ...: the force is the spring
+    constant times it) or in volts (V, mV: times the sensitivity in m/V too); the
+    spring constant and the sensitivity are then the caller's (``spring``,
+    ``invols``), and a deflection without them is :class:`NeedsInstrument`.
 an AFM file afmformats reads
     JPK (``.jpk-force``, ``.jpk-force-map``, ``.jpk-qi-data``, ``.jpk-qi-series``),
     Asylum Research / Igor (``.ibw``), AFM Workshop (``.csv``), NT-MDT (``.txt``),
     afmformats' own ``.h5`` and ``.tab``, and their ``.zip``: the column ``height
     (piezo)`` (else ``height (measured)``) and ``force``, with the spring constant
     (N/m) and the sensitivity (m/V) of the file's metadata when it states them.  A
-    file of several curves (a force map) gives the one of ``index``.
+    file of several curves (a force map) gives the one of ``index``.  A sensitivity
+    ``invols`` given replaces the file's (its force rescaled by their ratio: the
+    deflection is the measured voltage times it); a file that states no spring
+    constant takes ``spring`` for its deflection column.
 
 Approach and retract are split where the displacement turns: at its extreme
 farthest from the first sample.  Either sign convention of the displacement is
@@ -34,13 +41,14 @@ import logging
 import os
 import re
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import printable as _printable
 
-__all__ = ["CurveFileError", "MeasuredCurve", "read_curve", "AFM_EXTENSIONS", "LENGTH_UNITS", "FORCE_UNITS",
+__all__ = ["CurveFileError", "NeedsInstrument", "MeasuredCurve", "VOLT_UNITS", "read_curve", "AFM_EXTENSIONS",
+           "LENGTH_UNITS", "FORCE_UNITS",
            "MIN_POINTS", "MAX_TEXT_BYTES"]
 
 #: The extensions afmformats reads (0.18): a file of these is read through it (``.csv`` and ``.txt`` only when
@@ -49,6 +57,8 @@ AFM_EXTENSIONS = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-serie
                   ".csv", ".txt")
 #: Length and force units a text header may state, in SI.
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "\u00b5m": 1e-6, "\u03bcm": 1e-6, "nm": 1e-9, "pm": 1e-12}
+#: Voltage units a text header may state for a deflection in volts, in V.
+VOLT_UNITS = {"V": 1.0, "mV": 1e-3}
 FORCE_UNITS = {"n": 1.0, "mn": 1e-3, "un": 1e-6, "\u00b5n": 1e-6, "\u03bcn": 1e-6, "nn": 1e-9, "pn": 1e-12}
 #: The fewest points of each of approach and retract.
 MIN_POINTS = 10
@@ -66,6 +76,15 @@ TYPICAL_TRAVEL_M, TYPICAL_FORCE_N = 1e-7, 1e-8
 
 class CurveFileError(ValueError):
     """A file that holds no measured force curve; the message is one line, starting with the file's name."""
+
+
+class NeedsInstrument(CurveFileError):
+    """A file whose deflection needs what it does not state: ``option`` names the input (``fit_invols``: the
+    sensitivity in m/V; ``phys_spring``: the spring constant in N/m); the message is one line."""
+
+    def __init__(self, message: str, option: str):
+        super().__init__(message)
+        self.option = option
 
 
 class _TextCurveError(CurveFileError):
@@ -111,9 +130,11 @@ def _name(path: str) -> str:
     return f"'{os.path.basename(str(path))}'"
 
 
-def read_curve(path: str, index: int = 0) -> MeasuredCurve:
+def read_curve(path: str, index: int = 0, spring: float | None = None, invols: float | None = None) -> MeasuredCurve:
     """The measured curve of ``path`` (see the module for what is read); ``index``: the curve of a file of
-    several.  Raises :class:`CurveFileError` with one line."""
+    several; ``spring`` (N/m) and ``invols`` (m/V): the cantilever's spring constant and the deflection's
+    sensitivity where the caller knows them (a deflection column needs them).  Raises
+    :class:`CurveFileError` with one line."""
     ext = os.path.splitext(str(path))[1].lower()
     ext = ".jpk-" + str(path).lower().rsplit(".jpk-", 1)[1] if ".jpk-" in str(path).lower() else ext
     text_error = None
@@ -121,15 +142,15 @@ def read_curve(path: str, index: int = 0) -> MeasuredCurve:
         try:
             if index:
                 raise CurveFileError(f"{_name(path)}: a text file holds one curve; index {index} asked for")
-            return _read_text(path)
-        except _TextCurveError:
+            return _read_text(path, spring, invols)
+        except (_TextCurveError, NeedsInstrument):
             raise
         except CurveFileError as e:
             if ext not in AFM_EXTENSIONS:
                 raise
             text_error = e
     try:
-        return _read_afm(path, index)
+        return _read_afm(path, index, spring, invols)
     except CurveFileError as e:
         if text_error is not None:
             raise CurveFileError(f"{text_error}; nor is it a file afmformats reads ({str(e).split(': ', 1)[-1]})") \
@@ -213,7 +234,32 @@ def _plausible(raw: np.ndarray, scales: tuple, header: list | None, path: str) -
                              f"{bounds[1]:g} {si}{hint}: {fix}")
 
 
-def _read_text(path: str) -> MeasuredCurve:
+def _deflection(header: list, path: str, spring: float | None, invols: float | None) -> tuple[float, str] | None:
+    """(the factor from the second column to a force in N, what it is) where the header gives that column in
+    volts or a length (a deflection), None for a force; NeedsInstrument where the factor needs the spring
+    constant or the sensitivity and they are not given."""
+    m = _UNIT.search(header[1])
+    if m is None:
+        return None
+    unit = m.group(1).replace("\u00b5", "u").replace("\u03bc", "u")
+    column = f"{_name(path)}: column 2 '{header[1].strip()}'"
+    if unit in VOLT_UNITS:
+        if invols is None:
+            raise NeedsInstrument(f"{column} is a deflection in volts; the sensitivity (m/V) turns it into a "
+                                  f"length", "fit_invols")
+        if spring is None:
+            raise NeedsInstrument(f"{column} is a deflection in volts; the spring constant (N/m) turns it into a "
+                                  f"force", "phys_spring")
+        return VOLT_UNITS[unit] * invols * spring, "volts"
+    if unit in LENGTH_UNITS:
+        if spring is None:
+            raise NeedsInstrument(f"{column} is a deflection (a length); the spring constant (N/m) turns it into a "
+                                  f"force", "phys_spring")
+        return LENGTH_UNITS[unit] * spring, "deflection"
+    return None
+
+
+def _read_text(path: str, spring: float | None = None, invols: float | None = None) -> MeasuredCurve:
     try:
         with open(path, "rb") as f:
             raw = f.read(MAX_TEXT_BYTES + 1)
@@ -229,6 +275,7 @@ def _read_text(path: str) -> MeasuredCurve:
         text = raw.decode("latin-1")
     rows: list[list[float]] = []
     header, scale_z, scale_F = None, 1.0, 1.0
+    deflection = None
     decimal_comma = None                     # decided on the first row of numbers with a comma, then held
     for number, line in enumerate(text.splitlines(), 1):
         stripped = line.strip()
@@ -251,7 +298,8 @@ def _read_text(path: str) -> MeasuredCurve:
                 raise CurveFileError(f"{_name(path)}: the header '{_printable(stripped[:60])}' names one column; "
                                      f"expected the piezo displacement and the force")
             scale_z = _unit(header[0], LENGTH_UNITS, "length", 1, path)
-            scale_F = _unit(header[1], FORCE_UNITS, "force", 2, path)
+            deflection = _deflection(header, path, spring, invols)
+            scale_F = deflection[0] if deflection else _unit(header[1], FORCE_UNITS, "force", 2, path)
             continue
         if len(values) < 2:
             raise CurveFileError(f"{_name(path)}: line {number} has {len(values)} column; expected two: the piezo "
@@ -264,11 +312,15 @@ def _read_text(path: str) -> MeasuredCurve:
         curve = _curve(data[:, 0] * scale_z, data[:, 1] * scale_F, path, "text", None, None, {})
     # what is no curve in any unit (too few points, no turn, a constant force) is said first, by _curve
     _plausible(data, (scale_z, scale_F), header, path)
+    if deflection is not None:
+        curve = replace(curve, spring=spring, sensitivity=invols if deflection[1] == "volts" else None,
+                        metadata={"deflection": deflection[1]})
     return curve
 
 
 # -- afmformats ------------------------------------------------------------------
-def _read_afm(path: str, index: int) -> MeasuredCurve:
+def _read_afm(path: str, index: int, spring_given: float | None = None,
+              invols: float | None = None) -> MeasuredCurve:
     try:
         import afmformats
     except ImportError:
@@ -302,7 +354,8 @@ def _read_afm(path: str, index: int) -> MeasuredCurve:
     d = curves[index]
     columns = list(d.columns)
     zcol = next((c for c in ("height (piezo)", "height (measured)") if c in columns), None)
-    if zcol is None or "force" not in columns:
+    deflected = "force" not in columns and "deflection" in columns and spring_given is not None
+    if zcol is None or ("force" not in columns and not deflected):
         missing = "force" if zcol else "height (piezo)"
         raise CurveFileError(f"{_name(path)}: no column '{missing}' (it has {', '.join(columns) or 'none'}); "
                              f"a force curve needs the piezo height and the force")
@@ -315,7 +368,17 @@ def _read_afm(path: str, index: int) -> MeasuredCurve:
     spring = float(spring) if isinstance(spring, (int, float)) and np.isfinite(spring) and spring > 0 else None
     sens = float(sens) if isinstance(sens, (int, float)) and np.isfinite(sens) and sens > 0 else None
     source = str(meta.get("format", "afmformats"))
-    return _curve(np.asarray(d[zcol], dtype=float), np.asarray(d["force"], dtype=float), path, source, spring, sens,
+    if deflected:           # no force: the deflection (m) times the spring constant given
+        assert spring_given is not None, "deflected only with a spring constant given"
+        F, spring = np.asarray(d["deflection"], dtype=float) * spring_given, spring_given
+    else:
+        F = np.asarray(d["force"], dtype=float)
+    if invols is not None:
+        if sens is None:
+            raise NeedsInstrument(f"{_name(path)}: states no sensitivity (m/V) for the one given to replace; its "
+                                  f"deflection is already in metres", "fit_invols")
+        F, sens = F * (invols / sens), invols       # the deflection is the voltage times the sensitivity
+    return _curve(np.asarray(d[zcol], dtype=float), F, path, source, spring, sens,
                   {**meta, "z_column": zcol, "curves_in_file": len(curves), "index": index})
 
 

@@ -30,7 +30,7 @@ import numpy as np
 from ..model.physical import Bodies
 from ..tracing.measured import Measured, Missing
 
-__all__ = ["Spring", "FitChoice", "Features", "FittedFeatures", "ClosedForm", "CurveFit", "PullOffFit",
+__all__ = ["Spring", "FitChoice", "Instrument", "Features", "FittedFeatures", "ClosedForm", "CurveFit", "PullOffFit",
            "BOUND_MARGIN", "MISFIT_P", "Z95", "NOISE_DOF_PER_DIFFERENCE", "misfit_p", "undetermined", "misfit"]
 
 #: How near a bound (in the fitted coordinate: ln mu, ln w, sigma) a parameter is said to be at it: 1% in w
@@ -44,6 +44,8 @@ Z95 = 1.959963984540054
 #: over sqrt 2) per difference: 2 / var(s^2 / sigma^2) measured on Gaussian noise, 0.30 to 0.32 for 30 to
 #: 1000 points (MAD's efficiency 0.37 times the loss of successive differences sharing a point).
 NOISE_DOF_PER_DIFFERENCE = 0.3
+
+Quantity = Measured | Missing
 
 
 class Predictor(Protocol):
@@ -76,6 +78,54 @@ class FitChoice:
     roughness: bool = False
     noise: float | None = None
     max_evaluations: int = 40
+    #: the instrument's nuisance parameters (docs/fitting.md, "The instrument in the fit"): the deflection
+    #: sensitivity's scale c fitted (else held at ``invols_scale``, 1 or the calibration's), the spring
+    #: constant's standard uncertainty (N/m; None: k held), a baseline sloped in z (the virtual deflection),
+    #: the retract's baseline offset from the approach's (drag)
+    invols_fitted: bool = False
+    invols_scale: float = 1.0
+    calibrate_invols: bool = False
+    spring_err: float | None = None
+    virtual_deflection: bool = False
+    drag: bool = False
+    #: which legs are fitted (approach, retract, both) and the piezo range fitted (m; None: all)
+    segment: str = "both"
+    z_range: tuple | None = None
+    #: outside the model's domain (docs/fitting.md, "Where the model applies"): refuse before fitting, or fit
+    #: and warn
+    outside_domain: str = "refuse"
+
+    def __post_init__(self):
+        if self.segment not in ("approach", "retract", "both"):
+            raise ValueError(f"segment: expected approach, retract or both, got {self.segment!r}")
+        if self.outside_domain not in ("refuse", "warn"):
+            raise ValueError(f"outside_domain: expected refuse or warn, got {self.outside_domain!r}")
+        if not (isinstance(self.max_evaluations, int) and self.max_evaluations >= 1):
+            raise ValueError(f"max_evaluations: expected a positive integer, got {self.max_evaluations!r}")
+        if not (math.isfinite(self.invols_scale) and self.invols_scale > 0):
+            raise ValueError(f"invols_scale: expected a finite positive number, got {self.invols_scale!r}")
+        if self.spring_err is not None and not (math.isfinite(self.spring_err) and self.spring_err > 0):
+            raise ValueError(f"spring_err: expected a finite positive spring constant (N/m), got {self.spring_err!r}")
+        if self.z_range is not None:
+            lo, hi = self.z_range
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+                raise ValueError(f"z_range: expected two finite piezo positions lo < hi (m), got {self.z_range!r}")
+
+
+@dataclass(frozen=True)
+class Instrument:
+    """The instrument's nuisance parameters of a curve fit, each a Measured (fitted: with its bar; held: no bar
+    and a note saying at what) or Missing: ``invols_scale`` c, the factor the true deflection sensitivity is
+    of the one the file's deflection was converted with (the true deflection and force are c times the
+    file's, at the true spring constant); ``spring`` the true spring constant (N/m); ``virtual_deflection``
+    the baseline's slope in z (N/m); ``drag`` the retract's baseline offset from the approach's (N);
+    ``contact_slope`` the measured slope of the approach in contact (N/m, the file's force against z)."""
+
+    invols_scale: Quantity
+    spring: Quantity
+    virtual_deflection: Quantity
+    drag: Quantity
+    contact_slope: float | None = None
 
 
 @dataclass(frozen=True)
@@ -85,7 +135,11 @@ class Features:
     the largest force above the baseline ``contact_N``; the pull-off ``pull_off_N`` at ``pull_off_z_m``
     (force there ``pull_off_at_N``); the jump-in at ``jump_in_z_m`` and its size ``jump_in_drop_N``; the
     jump-off's rise ``jump_off_rise_N``; the first approach point in contact ``contact_from`` and the first
-    retract point off it ``free_from`` (None where the force does not jump by more than 10 noise)."""
+    retract point off it ``free_from`` (None where the force does not jump by more than 10 noise); the slope of
+    the approach in contact ``contact_slope_N_m`` (N/m against the piezo's travel towards the surface, over the
+    upper half of the rise; None with fewer than 3 points there) and the number of steps of the retract
+    ``retract_steps`` (runs of rises of more than 10 noise and a tenth of the pull-off between successive points:
+    a jump spread over a few samples is one step)."""
 
     F0_N: float
     noise_N: float
@@ -100,6 +154,8 @@ class Features:
     contact_from: int | None
     free_from: int | None
     noise_note: str | None = None
+    contact_slope_N_m: float | None = None
+    retract_steps: int = 0
 
 
 @dataclass(frozen=True)
@@ -122,9 +178,6 @@ class ClosedForm:
     mu: float
     formula: str
     lambda_MD: float | None = None
-
-
-Quantity = Measured | Missing
 
 
 @dataclass(frozen=True)
@@ -173,6 +226,10 @@ class CurveFit:
     notes: tuple = ()
     warnings: tuple = ()
     forward: Predictor | None = field(default=None, repr=False)
+    instrument: Instrument | None = field(default=None, repr=False)
+    segment: str = "both"
+    z_range: tuple | None = None
+    spread: object = field(repr=False, default=None)    # ModelSpread | Missing | None: w, E* under other laws
 
     @property
     def reduced_chi2(self) -> float:

@@ -3,12 +3,17 @@
 A cantilever of spring constant k (N/m) on a sphere of radius R: its base at piezo
 position z, Z = s (z - z_0) / eps in the model's units, and the force it measures
 
-    F(z) = F_0 + 2 pi R w f(Z; mu, K, sigma) + noise,   K = k eps / (2 pi R w)
+    F(z) = F_0 + b (z - z_0) + d [retract] + 2 pi R w f(Z; mu, K, sigma) / c + noise,   K = k eps / (2 pi R w)
 
 with f the model's force behind the spring on the approach or the retract
 (:class:`~petsc_adhesion.fitting.forward.ForwardCurve`), mu from w and E* by eq. (9),
 and the noise Gaussian of standard deviation ``noise`` (N), independent from point to
 point (a cantilever's thermal noise, its correlation time below the sampling's).
+The instrument's errors as a fit meets them: the file's deflection converted with a
+sensitivity c times too small (the force it states is the true over c), a baseline
+sloped by b N/m in z (the virtual deflection: light of the laser scattered by the
+sample, a lever's drift) and the retract's baseline offset by d N (the drag of the
+medium on the moving lever).
 The piezo moves evenly from ``approach`` epsilon before the jump-in (or the start of
 contact) to where the load reaches ``top`` (in 2 pi R w), and back.
 """
@@ -34,7 +39,9 @@ class Sampling:
     """How a synthetic curve is measured: ``points`` samples on each of approach and retract, Gaussian noise
     of ``noise`` N (the stream of ``seed``), the piezo from ``approach`` epsilon before the jump-in to the load
     ``top`` (2 pi R w), the contact point ``z0`` (m), the baseline ``F0`` (N) and the direction of the
-    approach (+1: z grows towards the surface)."""
+    approach (+1: z grows towards the surface); the instrument's errors: the true sensitivity ``invols_scale``
+    times the one the force was converted with, the baseline's slope ``virtual_deflection`` (N/m) and the
+    retract's baseline offset ``drag`` (N)."""
 
     noise: float = 0.0
     points: int = 400
@@ -44,6 +51,9 @@ class Sampling:
     F0: float = 0.0
     direction: int = 1
     seed: int = 0
+    invols_scale: float = 1.0
+    virtual_deflection: float = 0.0
+    drag: float = 0.0
 
 
 def forward_curve(model: Model, K: float, top: float = 2.0, grid=None, solver=None, settings=None,
@@ -76,10 +86,13 @@ def synthetic_curve(bodies: Bodies, spring: Spring, sampling: Sampling = Samplin
     Z_lo = (jumps[0] if jumps else fc.pieces[0].Z_hi) - s.approach
     Z = np.linspace(Z_lo, Z_hi, s.points)
     scale = 2 * math.pi * R * w
-    F = np.r_[fc.predict(Z, APPROACH), fc.predict(Z[::-1], RETRACT)] * scale + s.F0
+    z = s.z0 + s.direction * eps * np.r_[Z, Z[::-1]]
+    F = np.r_[fc.predict(Z, APPROACH), fc.predict(Z[::-1], RETRACT)] * scale / s.invols_scale + s.F0 + \
+        s.virtual_deflection * (z - s.z0) + s.drag * (np.arange(z.size) >= s.points)
     rng = np.random.default_rng(s.seed)
     F = F + s.noise * rng.standard_normal(F.size)
-    z = s.z0 + s.direction * eps * np.r_[Z, Z[::-1]]
     return MeasuredCurve(z=z, F=F, turn=s.points, direction=s.direction, spring=spring.k, source="synthetic",
                          metadata={"gamma": w, "E_star": E, "mu": mu, "K": K, "sigma": sigma, "noise_N": s.noise,
-                                   "z0_m": s.z0, "F0_N": s.F0, "seed": s.seed})
+                                   "z0_m": s.z0, "F0_N": s.F0, "seed": s.seed,
+                                   "invols_scale": s.invols_scale, "virtual_deflection_N_m": s.virtual_deflection,
+                                   "drag_N": s.drag})

@@ -37,6 +37,11 @@ DESCRIBE_FIT = {
     "fit/iterations": ("gamma: J/m^2; F_grid: 2 pi R gamma", "the secant's steps: gamma, mu and the model's "
                        "pull-off on the grid"),
     "fit/offsets": ("z0*: m; F0*: N", "the nuisance parameters: contact point z0 and force baseline F0 with bars"),
+    "fit/instrument": ("invols_scale*: 1; spring*: N/m; virtual_deflection*: N/m; drag*: N; contact_slope_N_m: N/m",
+                       "the instrument's nuisance parameters (docs/fitting.md): the deflection sensitivity's scale "
+                       "(the true over the file's), the spring constant, the baseline's slope in z, the retract's "
+                       "baseline offset; each fitted (with its bar) or held (its note in held says at what)"),
+    "fit/instrument/held": ("", "the instrument's parameters held, each with what it is held at"),
     "fit/measured": ("*_N: N; *_m: m", "what the curve shows by itself: baseline, noise, largest force, pull-off "
                      "and its position, jump-in and its size"),
     "fit/fitted": ("*_N: N; *_m: m", "the fitted model's jump-in and jump-off positions and pull-off force"),
@@ -48,11 +53,13 @@ DESCRIBE_FIT = {
     "fit/data": ("z: m; F, F_fit: N", "the measured curve and the fit at its points: piezo displacement z, force F "
                  "(tensile negative), leg (0 approach, 1 retract), F_fit, used (0: left out, next to a jump)"),
     "fit/model": ("z: m; F_*: N", "the fitted model's force on an even grid of z on the approach and the retract"),
-    "fit/model_spread": ("value, err, values, spread: J/m^2; relative: 1; wall_time_s, rule_times_s: s",
-                         "gamma's model spread (a pull-off fit with roughness, docs/model.md): the same root solve "
-                         "under the other roughness laws (rules), on the grid without bars; quantities/0000: "
-                         "gamma under the reference's law with its bar, the spread, relative and warning; its "
-                         "group values: gamma under each rule, one attribute per rule (absent: not solved for, "
+    "fit/model_spread": ("value, err, values, spread: J/m^2 (gamma), Pa (E*); relative: 1; wall_time_s, "
+                         "rule_times_s: s",
+                         "the model spread of a fit with roughness (docs/model.md, docs/fitting.md): a pull-off's "
+                         "gamma by the same root solve under the other roughness laws (rules), a curve's gamma "
+                         "and E* by the optimum moved to each law (one Gauss-Newton step); quantities/NNNN: the "
+                         "value under the reference's law with its bar, the spread, relative and warning; its "
+                         "group values: the value under each rule, one attribute per rule (absent: not found, "
                          "missing says why)"),
 }
 
@@ -75,6 +82,22 @@ def _missing(**quantities) -> dict:
 
 def _verdict(fit) -> dict:
     return {"complete": fit.complete, "trustworthy": fit.trustworthy, "warnings": list(fit.warnings)}
+
+
+def _instrument_record(ins) -> dict:
+    """The instrument's parameters: value and bar of each fitted one, the value of each held one with what it
+    is held at under ``held``, a Missing one null with its reason under ``missing``."""
+    rec: dict = {"held": {}, "missing": {}}
+    for key in ("invols_scale", "spring", "virtual_deflection", "drag"):
+        q = getattr(ins, key)
+        rec[key], rec[f"{key}_err"] = _value(q), _err(q)
+        if isinstance(q, Missing):
+            rec["missing"][key] = q.reason
+        elif q.err is None:
+            rec["held"][key] = q.note or "held"
+    if ins.contact_slope is not None:
+        rec["contact_slope_N_m"] = ins.contact_slope
+    return rec
 
 
 def _curve_record(fit) -> dict:
@@ -103,6 +126,10 @@ def _curve_record(fit) -> dict:
             "given": given, "traces": fit.traces, "iterations": fit.iterations, "status": fit.status,
             "wall_time_s": fit.wall_time_s, "notes": list(fit.notes),
             "missing": _missing(gamma=fit.gamma, E_star=fit.E_star, rms=fit.rms, z0=fit.z0, F0=fit.F0),
+            "segment": fit.segment,
+            **({"z_range_m": list(fit.z_range)} if fit.z_range is not None else {}),
+            **({"instrument": _instrument_record(fit.instrument)} if fit.instrument is not None else {}),
+            **({"model_spread": spread_record(fit.spread)} if fit.spread is not None else {}),
             **_verdict(fit)}
 
 
@@ -200,10 +227,20 @@ def report_fit(fit) -> None:
         if fit.rms is not None:
             out.append(f"  rms = {_pm(fit.rms, 1e-9, 'nm', '.4g')}   sigma = {fit.sigma:.4g}")
         out.append(f"  contact point z0 = {_pm(fit.z0, 1e-9, 'nm')}   baseline F0 = {_pm(fit.F0, 1e-9, 'nN', '.5g')}")
+        ins = fit.instrument
+        if ins is not None:
+            out.append(f"  sensitivity scale c = {_pm(ins.invols_scale, 1.0, '', '.5g')}   spring k = "
+                       f"{_pm(ins.spring, 1.0, 'N/m', '.5g')}")
+            out.append(f"  virtual deflection = {_pm(ins.virtual_deflection, 1.0, 'N/m', '.4g')}   drag = "
+                       f"{_pm(ins.drag, 1e-9, 'nN', '.4g')}   fitted: {fit.segment}"
+                       + (f", z in [{fit.z_range[0] * 1e9:.6g}, {fit.z_range[1] * 1e9:.6g}] nm"
+                          if fit.z_range is not None else ""))
         red = f"{fit.reduced_chi2:.3g}" if math.isfinite(fit.reduced_chi2) else "undefined"
         out.append(f"  noise {fit.noise_N * 1e9:.3g} nN{' (stated)' if fit.noise_stated else ''}, residual rms "
                    f"{fit.residual_rms_N * 1e9:.3g} nN, reduced chi^2 {red} ({fit.dof} degrees of freedom); "
                    f"pull-off measured {m.pull_off_N * 1e9:.4g} nN, fitted {f.pull_off_N * 1e9:.4g} nN")
+        if fit.spread is not None:     # w and E* under the other roughness laws
+            out += [f"  {line}" for line in spread_lines(fit.spread)]
     for n in getattr(fit, "notes", ()):
         out.append(f"  note: {n}")
     for w in fit.warnings:

@@ -230,6 +230,31 @@ TABLE = {o.name: o for o in [
            "with true, that value is where the fit starts)"),
     Option("fit_roughness", "flag", False, "fit: fit the rms roughness too (-phys_rms: its start, default 0.3 "
            "epsilon)"),
+    Option("fit_invols", "real", None, "fit: the deflection sensitivity (m/V) of a -fit_curve file whose deflection "
+           "is in volts (a text column in V or mV); for an AFM file stating its own, the force is rescaled to this "
+           "one", 0.0, 1e-3, lo_open=True),
+    Option("fit_invols_scale", "flag", False, "fit: fit the scale c of the deflection sensitivity (the true over "
+           "the file's: force and deflection c times the file's) as a nuisance parameter; false holds it at 1 (or "
+           "at -fit_calibrate_invols's)"),
+    Option("fit_calibrate_invols", "flag", False, "fit: calibrate the sensitivity's scale on the contact as on a "
+           "hard substrate (its slope made the lever's) before fitting; held there, or the start with "
+           "-fit_invols_scale"),
+    Option("fit_spring_err", "real", None, "fit: the standard uncertainty of the spring constant (N/m): k fitted "
+           "with it as a Gaussian prior, its bar carried into the others' (default: k held)", 0.0, 1e3,
+           lo_open=True),
+    Option("fit_virtual_deflection", "flag", False, "fit: fit a baseline sloped in z (the virtual deflection, "
+           "N/m)"),
+    Option("fit_drag", "flag", False, "fit: fit the retract's baseline offset from the approach's (the drag of "
+           "the medium, N)"),
+    Option("fit_segment", "choice", "both", "fit: the legs of -fit_curve fitted", choices=("both", "approach",
+                                                                                            "retract")),
+    Option("fit_z_range", "reals", (), "fit: the piezo range of -fit_curve fitted, two positions lo,hi (m, in "
+           "the file's z)", -1.0, 1.0),
+    Option("fit_max_evals", "int", 40, "fit: the cap on the least squares' evaluations of -fit_curve; reached, "
+           "the fit ends with a WARNING and exit status 3", 1, 10**6),
+    Option("fit_outside_domain", "choice", "refuse", "fit: a -fit_curve outside the model's domain (a deep "
+           "indentation, mu beyond its range, a contact steeper than the lever, tethers): refuse before fitting "
+           "(exit 3, nothing written) or fit and warn (exit 3)", choices=("refuse", "warn")),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),

@@ -20,6 +20,8 @@ def read_fit(source) -> dict:
         for name in ("data", "model"):
             if name in g:
                 out[name] = {k: v[()] for k, v in g[name].items()}
+        if "instrument" in g:
+            out["instrument"] = dict(g["instrument"].attrs)
         return out
 
 
@@ -55,13 +57,15 @@ def fit_figure(source, out: str, fmt: str = "png") -> None:
         ax.plot(z[sel & used], F[sel & used], ".", ms=3, color=colour, alpha=0.5, label=f"{name}, measured")
         if np.any(sel & ~used):
             ax.plot(z[sel & ~used], F[sel & ~used], "o", ms=4, mfc="none", color=colour, alpha=0.6,
-                    label=f"{name}, left out (next to a jump)")
+                    label=f"{name}, left out (at a jump, or outside the segment or range fitted)")
         if m is not None:
             ax.plot(m["z"] * 1e9, m[f"F_{name}"] * 1e9, "-", lw=1.5, color="k" if k else "0.4",
                     label=f"{name}, fitted model")
         rx.plot(z[sel & used], (d["F_fit"][sel & used] * 1e9 - F[sel & used]) / noise, ".", ms=2, color=colour)
+    ins = fit.get("instrument")
+    scale = f"\nthe sensitivity times {_pm(ins, 'invols_scale', 1.0)}" if isinstance(ins, dict) else ""
     ax.set_title(f"gamma = {_pm(fit, 'gamma', 1.0)} J/m^2, E* = {_pm(fit, 'E_star', 1e9)} GPa, "
-                 f"mu = {float(fit['mu']):.3g}", fontsize=10)
+                 f"mu = {float(fit['mu']):.3g}{scale}", fontsize=10)
     ax.set_ylabel("force (nN)")
     rx.axhline(0.0, color="0.5", lw=0.8)
     rx.set_ylabel("(fit - data) / noise")

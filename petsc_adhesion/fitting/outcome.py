@@ -1,0 +1,203 @@
+"""A curve fit's optimum read into its results: the bounds of the fitted coordinates, each quantity Measured or
+Missing where it is at a bound or undetermined (docs/fitting.md, "When a fit does not hold"), the instrument's
+parameters fitted or held, and w's and E*'s model spread under the other roughness laws ("The roughness
+law's spread in a curve fit").
+
+The fit's problem (``pb``: :class:`~petsc_adhesion.fitting.curve_fit._Problem`) is read for its coordinates'
+names, its constants and, for the spread, its residuals under another law.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from ..tracing.measured import Measured, Missing
+from .domain import MU_BOUNDS
+from .results import BOUND_MARGIN, FitChoice, Instrument, undetermined
+
+__all__ = ["bounds", "verdicts", "instrument_values", "curve_spread", "SIGMA_MAX", "INSTRUMENT_FACTOR",
+           "SPREAD_STEPS"]
+
+#: The largest roughness sigma = rms / eps fitted.
+SIGMA_MAX = 3.0
+#: The fitted sensitivity's scale and spring constant stay within this factor of the stated.
+INSTRUMENT_FACTOR = 5.0
+
+def bounds(pb, choice: FitChoice, modulus: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds of the fitted coordinates: mu in MU_BOUNDS (through w at a held modulus), sigma in [0,
+    SIGMA_MAX], w in [1e-6, 100] J/m^2, the sensitivity's scale and the spring constant within a factor
+    INSTRUMENT_FACTOR of the stated; the contact point, the baseline, its slope and the drag free."""
+    lo = np.array([-np.inf] * len(pb.names))
+    hi = np.array([np.inf] * len(pb.names))
+    for j, name in enumerate(pb.names):
+        if name == "ln_mu":
+            lo[j], hi[j] = math.log(MU_BOUNDS[0]), math.log(MU_BOUNDS[1])
+        elif name == "sigma":
+            lo[j], hi[j] = 0.0, SIGMA_MAX
+        elif name == "ln_gamma":
+            lo[j], hi[j] = math.log(1e-6), math.log(100.0)
+        elif name in ("ln_invols", "ln_k"):             # within a factor INSTRUMENT_FACTOR of the stated
+            lo[j], hi[j] = -math.log(INSTRUMENT_FACTOR), math.log(INSTRUMENT_FACTOR)
+    if not choice.modulus:                          # mu's bounds through w at the held modulus
+        assert modulus is not None, "a held modulus is given (fit_curve refuses it otherwise)"
+        E, R, eps = float(modulus), pb.R, pb.eps
+        j = pb.names.index("ln_gamma")
+        lo[j] = max(lo[j], math.log(math.sqrt(MU_BOUNDS[0]**3 * E**2 * eps**3 / R)))
+        hi[j] = min(hi[j], math.log(math.sqrt(MU_BOUNDS[1]**3 * E**2 * eps**3 / R)))
+    return lo, hi
+
+
+def verdicts(pb, choice: FitChoice, x, lo, hi, p: dict, sd: dict, modulus) -> tuple[dict, list]:
+    """The fit's quantities (gamma, E_star, rms, z0, F0) as Measured, or Missing where a parameter is at a
+    bound or undetermined (docs/fitting.md), and the warnings that say so."""
+    eps = pb.eps
+    at = {}
+    for j, name in enumerate(pb.names):
+        if x[j] - lo[j] <= BOUND_MARGIN or hi[j] - x[j] <= BOUND_MARGIN:
+            edge = lo[j] if x[j] - lo[j] <= BOUND_MARGIN else hi[j]
+            at[name] = edge
+    q, warned = {}, []
+
+    def bound_reason(name: str) -> str:
+        edge = at[name]
+        if name == "ln_mu" or (name == "ln_gamma" and not choice.modulus and
+                                math.log(1e-6) < edge < math.log(100.0)):
+            mu_edge = MU_BOUNDS[0] if p["mu"] < 1 else MU_BOUNDS[1]
+            return (f"mu = {p['mu']:.4g} is at the bound {mu_edge:g} of the model's range [{MU_BOUNDS[0]:g}, "
+                    f"{MU_BOUNDS[1]:g}]: the data ask for a mu the model does not reach")
+        if name == "ln_gamma":
+            return f"w = {p['w']:.4g} J/m^2 is at the bound {math.exp(edge):g} J/m^2 of the fit"
+        return f"sigma = {p['sigma']:.4g} is at the bound {edge:g} of [0, {SIGMA_MAX:g}]"
+
+    def judged(key: str, coord: str, value: float, err: float | None):
+        why = bound_reason(coord) if coord in at else undetermined(value, err)
+        if why is None:
+            return Measured(value, err)
+        warned.append(f"{key} undetermined: {why}")
+        return Missing(why)
+
+    w = p["w"]
+    q["gamma"] = judged("gamma", "ln_gamma", w, None if sd["ln_gamma"] is None else w * sd["ln_gamma"])
+    if choice.modulus:
+        e = sd["ln_E_star"]
+        q["E_star"] = judged("E_star", "ln_mu", p["E"], None if e is None else p["E"] * e)
+    else:
+        q["E_star"] = Measured(float(modulus), note="held at the moduli given (eq. 2)")
+    if choice.roughness:
+        e = sd["sigma"]
+        q["rms"] = judged("rms", "sigma", p["sigma"] * eps, None if e is None else e * eps)
+    elif pb.bodies.rms is not None:
+        q["rms"] = Measured(float(pb.bodies.rms), note="held at the rms given")
+    else:
+        q["rms"] = None
+    for key, coord, value, scale in (("z0", "z0", p["z0"], eps), ("F0", "F0", p["F0"], pb.noise)):
+        e = sd[coord]
+        if e is None:
+            why = "a singular covariance: the curve does not determine it"
+            warned.append(f"{key} undetermined: {why}")
+            q[key] = Missing(why)
+        else:
+            q[key] = Measured(value, e * scale)
+    return q, warned
+
+
+def instrument_values(pb, choice: FitChoice, x, lo, hi, p: dict, sd: dict) -> tuple[Instrument, list]:
+    """The instrument's nuisance parameters as Measured (fitted with their bars, held with a note) or Missing
+    at a bound of the fit, and the warnings that say so."""
+    warned = []
+
+    def fitted(key, coord, value, err_of):
+        j = pb.names.index(coord)
+        if x[j] - lo[j] <= BOUND_MARGIN or hi[j] - x[j] <= BOUND_MARGIN:
+            why = f"{value:.4g} is at a bound of the fit ({key} within a factor {math.exp(hi[j]):g} of the stated)"
+            warned.append(f"{key} undetermined: {why}")
+            return Missing(why)
+        e = sd.get(coord)
+        if e is None:
+            why = "a singular covariance: the curve does not determine it"
+            warned.append(f"{key} undetermined: {why}")
+            return Missing(why)
+        return Measured(value, err_of(e))
+
+    if choice.invols_fitted:
+        c = fitted("invols_scale", "ln_invols", p["c"], lambda e: p["c"] * e)
+    else:
+        c = Measured(p["c"], note="held: " + ("calibrated on the contact as on a hard substrate"
+                                               if choice.calibrate_invols else "the file's sensitivity"))
+    if choice.spring_err is not None:
+        k = fitted("spring", "ln_k", p["k"], lambda e: p["k"] * e)
+    else:
+        k = Measured(p["k"], note=f"held at {pb.spring.source}")
+    v = fitted("virtual_deflection", "slope", p["slope"], lambda e: e * pb.noise / pb.eps) \
+        if choice.virtual_deflection else Measured(0.0, note="held at 0: not fitted (-fit_virtual_deflection)")
+    d = fitted("drag", "drag", p["drag"], lambda e: e * pb.noise) if choice.drag else \
+        Measured(0.0, note="held at 0: not fitted (-fit_drag)")
+    return Instrument(c, k, v, d, pb.feat.contact_slope_N_m), warned
+
+
+#: Gauss-Newton steps (with the fit's Jacobian) that move the optimum to another roughness law, at most; they
+#: stop where a step moves ln w by less than a tenth of its bar.
+SPREAD_STEPS = 3
+
+
+def curve_spread(pb, x, J, JtJ_inv, quantities: dict, A, rules: tuple, lo, hi):
+    """w's and E*'s model spread: the optimum moved to each roughness law of ``rules`` by Gauss-Newton steps
+    from the fit's with the fit's Jacobian J (a chord method), dx = -(J^T J)^-1 J^T r_law(x_i), r_law the
+    residuals under that law, at most SPREAD_STEPS, within the fit's bounds (one curve traced per step and
+    law; the first step is the refit's to first order in the law's change)."""
+    from ..tracing.model_spread import ModelSpread, Rule, spread_quantity
+
+    model = replace(pb.template, sigma=pb.unpack(x)["sigma"])
+    reference = Rule.of(model)
+    if model.roughness == "none" or model.sigma == 0:
+        return Missing("a smooth surface (sigma = 0): there is no roughness law to vary")
+    if reference in rules:
+        raise ValueError(f"{reference.label}: the reference's own law, not an alternative to it")
+    if JtJ_inv is None:
+        return Missing("the fit's covariance is singular: its optimum cannot be moved to another law")
+    names = pb.names
+    i_w = names.index("ln_gamma")
+    moved_w: list[Measured | Missing] = []
+    moved_E: list[Measured | Missing] = []
+    notes, times = [], []
+    t0 = time.perf_counter()
+    for rule in rules:
+        t = time.perf_counter()
+        alt = replace(pb, template=rule.model(pb.template), cache={}, progress=None)
+        alt.weight = pb.weight.copy()
+        try:
+            xi = x.copy()
+            bar = math.sqrt(max(JtJ_inv[i_w, i_w], 0.0)) or 1.0
+            for _ in range(SPREAD_STEPS):
+                r_law, _ = alt._all(alt.unpack(xi))
+                step = -JtJ_inv @ (J.T @ r_law)
+                xi = np.clip(xi + step, lo, hi)
+                if abs(step[i_w]) < 0.1 * bar:
+                    break
+            dx = xi - x
+            y = A @ xi
+            moved_w.append(Measured(math.exp(y[i_w])))
+            if "ln_mu" in names:
+                # ln E* differs from A's row by a constant: E* at the moved optimum is E* exp(change of the row)
+                d = A @ dx
+                moved_E.append(Measured(float(quantities["E_star"].value) * math.exp(d[names.index("ln_mu")]))
+                               if isinstance(quantities["E_star"], Measured) else Missing("E* undetermined"))
+        except (ValueError, RuntimeError, FloatingPointError) as why:
+            moved_w.append(Missing(f"{rule.label}: {why}"))
+            moved_E.append(Missing(f"{rule.label}: {why}"))
+            notes.append(f"{rule.label}: its curve could not be traced at the optimum ({why})")
+        pb.traces += alt.traces
+        times.append(time.perf_counter() - t)
+    qs = []
+    if isinstance(quantities["gamma"], Measured):
+        qs.append(spread_quantity("work of adhesion gamma", "gamma", quantities["gamma"], tuple(moved_w), rules,
+                                  reference))
+    if "ln_mu" in names and isinstance(quantities["E_star"], Measured):
+        qs.append(spread_quantity("reduced modulus E*", "E_star", quantities["E_star"], tuple(moved_E), rules,
+                                  reference))
+    if not qs:
+        return Missing(f"w and E* are undetermined under {reference.label}: no value to spread about")
+    return ModelSpread(reference, rules, tuple(qs), tuple(notes), time.perf_counter() - t0, tuple(times))
