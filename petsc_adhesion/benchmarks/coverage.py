@@ -47,7 +47,7 @@ def case(mu: float, sigma: float) -> list[dict]:
     from ..tracing import results
     from ..tracing.edge_grids import RMAX
     from ..tracing.trace import curve_settings
-    from ..tracing.tracer import Tracer
+    from ..tracing.tracer import Tracer, contact_radius
 
     model = Model(mu=mu, sigma=sigma, rmax=RMAX)
     settings = curve_settings()
@@ -61,27 +61,33 @@ def case(mu: float, sigma: float) -> list[dict]:
                 owners = [seg] + [s for s in segments if f.landing is not None and s.finder is f.landing_by]
                 coarse = error_estimate.coarse_levels(owners)
                 levels = {0: f.point}
+                radius = {0: contact_radius(seg.problem, f.point.x)}
                 for level in coarse:
                     pt = error_estimate.relocate(tracer, seg, f, level)
                     if pt is None:
                         break
                     levels[level] = pt
+                    radius[level] = pt.values["contact_radius"]
                 first = min(levels)                    # as the program: the coarse levels found, then finer
                 for level in range(max(first, 0) + 1, first + 3 + BEYOND):
                     pt = error_estimate.relocate(tracer, seg, f, level)
                     if pt is not None:
                         levels[level] = pt
+                        radius[level] = pt.values["contact_radius"]
                 row = {"mu": mu, "sigma": sigma, "kind": f.label, "segment": seg.kind, "first": first,
                        "lambda": {k: p.p for k, p in levels.items()},
-                       "F": {k: p.values["F"] for k, p in levels.items()}}
+                       "F": {k: p.values["F"] for k, p in levels.items()}, "contact_radius": radius}
                 if f.landing is not None:
                     land = {0: f.landing.values["F"]}
+                    land_a = {0: contact_radius(f.landing_by.cont.pb, f.landing.x)}
                     for k, p in levels.items():
                         if k:
                             hit = error_estimate.relocate(tracer, seg, f, k, target=p.p)
                             if hit is not None:
                                 land[k] = hit.values["F"]
+                                land_a[k] = hit.values["contact_radius"]
                     row["landing_F"] = land
+                    row["landing_contact_radius"] = land_a
                 out.append(row)
     finally:
         tracer.destroy()
@@ -98,16 +104,26 @@ def _run(mu_sigma) -> list:
 
 
 def _series(row: dict) -> list:
-    """(quantity, {level: value}) of an event row: lambda (not for lambda = target), F (not at F = 0)."""
+    """(quantity, {level: value}) of an event row: lambda (not for lambda = target), F (not at F = 0), the
+    contact radius (of the event and of its landing; rows of older studies have none)."""
     kind = row["kind"]
     out = []
     if kind != "lambda":
         out.append((f"{kind} lambda", {int(k): v for k, v in row["lambda"].items()}))
     if kind != "equilibrium":
         out.append((f"{kind} F", {int(k): v for k, v in row["F"].items()}))
+    if "contact_radius" in row:
+        out.append((f"{kind} contact radius", {int(k): v for k, v in row["contact_radius"].items()}))
     if "landing_F" in row:
         out.append(("landing F", {int(k): v for k, v in row["landing_F"].items()}))
+    if "landing_contact_radius" in row:
+        out.append(("landing contact radius", {int(k): v for k, v in row["landing_contact_radius"].items()}))
     return out
+
+
+def _no_contact(values: dict) -> bool:
+    """A contact radius 0 on every level: the state is out of contact (a computed 0, exact), nothing to cover."""
+    return all(v == 0.0 for v in values.values())
 
 
 def estimate(values: dict, first: int) -> tuple | None:
@@ -130,11 +146,14 @@ def truth(values: dict, first: int) -> tuple | None:
 
 def table(rows: list) -> str:
     """Coverage and width of the bars by quantity, from the study's rows."""
-    by, unvalidated, missed = {}, 0, []
+    by, unvalidated, missed, apart = {}, 0, [], 0
     for row in rows:
         if "failed" in row:
             continue
         for name, values in _series(row):
+            if name.endswith("contact radius") and _no_contact(values):
+                apart += 1
+                continue
             est, t = estimate(values, row["first"]), truth(values, row["first"])
             if est is None or t is None:
                 unvalidated += 1
@@ -161,7 +180,8 @@ def table(rows: list) -> str:
     lines.append(f"| all | {total[1]} | {total[0]} | {total[0] / max(1, total[1]):.0%} | | | |")
     firsts = sorted({r["first"] for r in rows if "failed" not in r})
     lines.append(f"\nEstimates from levels starting at {', '.join(map(str, firsts))}; {unvalidated} more quantities "
-                 f"had no estimate or no truth (an event not found again on a level): not counted here.")
+                 f"had no estimate or no truth (an event not found again on a level): not counted here; "
+                 f"{apart} contact radii were 0 on every level (out of contact: exact, no bar needed).")
     lines.append("\nNot covered: " + "; ".join(missed) + ".")
     return "\n".join(lines)
 
@@ -172,11 +192,20 @@ def main(argv: list[str]) -> int:
         print(json.dumps(case(float(argv[1]), float(argv[2]))))
         return 0
     if argv[:1] != ["-table"]:
-        with ThreadPoolExecutor(2) as pool:
-            rows = [r for rs in pool.map(_run, CASES) for r in rs]
+        # each case's rows replace that case's stored ones as soon as it is done, so that a study cut short
+        # leaves the cases it finished, and the others as they were (the table says which hold what)
         os.makedirs(os.path.dirname(DATA), exist_ok=True)
-        with open(DATA, "w") as f:
-            json.dump(rows, f, indent=0)
+        stored = []
+        if os.path.exists(DATA):
+            with open(DATA) as f:
+                stored = json.load(f)
+        with ThreadPoolExecutor(2) as pool:
+            for done in pool.map(_run, CASES):
+                where = {(r["mu"], r["sigma"]) for r in done}
+                stored = [r for r in stored if (r["mu"], r["sigma"]) not in where] + done
+                with open(DATA + ".part", "w") as f:
+                    json.dump(stored, f, indent=0)
+                os.replace(DATA + ".part", DATA)
     with open(DATA) as f:
         rows = json.load(f)
     cases = sorted({(r["mu"], r["sigma"]) for r in rows})

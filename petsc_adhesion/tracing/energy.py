@@ -45,7 +45,7 @@ import numpy as np
 from ..core.events import Fold, Found
 from ..core.protocol import Point
 
-__all__ = ["Node", "Loop", "cycle", "energy_bar", "hermite_integral"]
+__all__ = ["Node", "Loop", "cycle", "energy_bar", "hermite_integral", "border", "border_integral"]
 
 #: 3-point Gauss-Legendre on [0, 1]: exact for the product of a cubic and a quadratic.
 _GL_T = 0.5 + 0.5 * np.array([-math.sqrt(0.6), 0.0, math.sqrt(0.6)])
@@ -304,3 +304,26 @@ def energy_bar(result: Loop, fold: Fold, event_of) -> float | None:
         e = max(worst if eu is None else eu, worst if ev is None else ev)
         bar += abs(fold.value(v.point) - fold.value(u.point)) * e
     return bar
+
+
+def border(result: Loop) -> list[int]:
+    """The nodes of ``result``'s loops' borders (:func:`cycle`), by index into ``result.nodes``, in order."""
+    return sorted({n for i, j, _ in result.pieces for n in range(i, j + 1)})
+
+
+def border_integral(result: Loop, points: dict, weight: float) -> float:
+    """The closed integral of F dc along the loops' borders through ``points`` ({node index: point}, one for
+    every node of :func:`border`), each piece by the planar Hermite interpolant of its two ends, unhalved.
+
+    With the curve's own points it is the energy of :func:`cycle` but for the quadrature's refinement; with
+    the same nodes put on another level's curve (the corners, a fold and its landing, located there) it is
+    that level's energy with the same quadrature, so that the difference of the two holds the grid's
+    change and little of the quadrature's error (the pieces are alike on the two curves).
+    """
+    nodes = result.nodes
+    total = 0.0
+    for i, j, k in result.pieces:
+        for n in range(i, j):
+            if nodes[n].seg == nodes[n + 1].seg:            # between two grids: one state, no work
+                total += k * _integral(points[n], points[n + 1], weight)
+    return total

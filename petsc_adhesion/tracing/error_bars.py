@@ -23,10 +23,12 @@ import numpy as np
 from ..core.events import EventFinder, ParameterValue
 from ..discretization.preconditioning import memory_available, memory_needed
 from ..discretization.resolution import NODES_PER_ZONE, cohesive_zone
+from . import energy
 from .measured import Measured
 from .tracer import carry, contact_radius
 
-__all__ = ["Estimate", "LandingEstimate", "relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE", "MAX_LEVEL", "too_large"]
+__all__ = ["Estimate", "LandingEstimate", "relocate", "extrapolate", "event_errors", "coarse_levels", "LOCAL_STEPS", "BAR_FACTOR", "FLOOR", "COARSE", "MAX_LEVEL", "too_large",
+           "energy_levels", "ENERGY_LEVELS"]
 
 #: Steps a local trace may take to pass the event on another level.
 LOCAL_STEPS = 40
@@ -54,7 +56,9 @@ class LandingEstimate:
 class Estimate:
     """The best values and bars of an event's lambda, F and contact radius from its levels (no grid values:
     the event's own point holds them); behind a spring Z (else None); the ``levels`` used; whether
-    -target_error was met; why refinement stopped short (``refinement``, or None); the landing's."""
+    -target_error was met; why refinement stopped short (``refinement``, or None); the landing's; and the
+    event located on each other level (``located``: (level, point, its landing's point or None), the
+    corners of the cycle's loops on that level, :func:`energy_levels`)."""
 
     lam: Measured
     F: Measured
@@ -64,6 +68,7 @@ class Estimate:
     Z: Measured | None = None
     refinement: str | None = None
     landing: LandingEstimate | None = None
+    located: tuple = ()
 
 
 def relocate(tracer, seg, found, level: int, target=None):
@@ -264,4 +269,65 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> Estim
                                  lam=Measured(*bar["lambda"], grid=point.p) if spring else None)
     return Estimate(lam=Measured(*est["lambda"]), F=Measured(*est["F"]), contact_radius=Measured(*est["contact_radius"]),
                     levels=tuple(sorted(points)), target_met=met, Z=Measured(*est["Z"]) if "Z" in est else None,
-                    refinement=stop if stop and not met else None, landing=landed)
+                    refinement=stop if stop and not met else None, landing=landed,
+                    located=tuple((k, points[k], landing.get(k)) for k in sorted(points) if k))
+
+
+#: The levels besides 0 the energy of a cycle is computed on: the two coarsest its jumps' events share.
+ENERGY_LEVELS = 2
+
+
+def energy_levels(tracer, loop, fold, estimate_of) -> dict[int, float] | str:
+    """The energy of ``loop`` (:func:`~.energy.cycle` under ``fold``'s control) on other levels of its grids,
+    as {level: energy}, level 0 the loop's own; or why not (collective).
+
+    On a level k the loops' borders are the same nodes put on that level's curve: every computed point
+    carried to the level's grid of its segment (:func:`~.tracer.carry`, a zero-length arclength
+    correction normal to the curve), and the corners (each fold jumped at and its landing) located there
+    by the events' error bars (``estimate_of(found)``: the event's :class:`Estimate`, its ``located``
+    points), since a corner carried would slide along its branch off the jump.  Each level's energy is
+    the loop's plus the change of :func:`~.energy.border_integral` from level 0 to k: the same pieces,
+    the same quadrature, so the quadrature's error (nearly) cancels and the grid's remains.  The levels:
+    the ENERGY_LEVELS coarsest (besides 0) on which every jump and landing was located, the events'.
+    """
+    jumps = {id(f): f for f in loop.jumps}
+    located = {}
+    for f in jumps.values():
+        est = estimate_of(f)
+        if not isinstance(est, Estimate):
+            return f"the {f.label} at lambda = {f.point.p:.6g} has no error estimate"
+        located[id(f)] = {k: (pt, land) for k, pt, land in est.located if pt is not None and land is not None}
+    shared = sorted(set.intersection(*(set(v) for v in located.values()))) if located else []
+    levels = shared[:ENERGY_LEVELS]
+    if len(levels) < ENERGY_LEVELS:
+        return "the jumps were not located on enough common levels"
+    nodes = loop.nodes
+    on = energy.border(loop)
+    own = {n: nodes[n].point for n in on}
+    base = energy.border_integral(loop, own, fold.weight)
+    out = {0: float(loop.energy)}
+    for level in levels:
+        pts: dict[int, Any] = {}
+        made: dict[int, Any] = {}
+        try:
+            for n in on:
+                node = nodes[n]
+                if node.found is not None and id(node.found) in jumps:
+                    pt, land = located[id(node.found)][level]
+                    pts[n] = land if node.landing else pt
+                    continue
+                owner = tracer.segments[node.seg]
+                if node.seg not in made:
+                    made[node.seg] = tracer.segment(
+                        owner.kind, owner.grid.edge if owner.grid is not None else None, level=level,
+                        settings=replace(tracer.set, monitor=False),
+                        band=owner.grid.band if owner.kind == "scaled" else None, zone=owner.zone)
+                pt = carry(owner, made[node.seg], node.point)
+                if pt is None:
+                    return f"a point of the loop at lambda = {node.point.p:.6g} was not carried to level {level}"
+                pts[n] = pt
+        finally:
+            for seg in made.values():
+                seg.destroy()
+        out[level] = out[0] + energy.border_integral(loop, pts, fold.weight) - base
+    return out
