@@ -57,56 +57,53 @@ DOC = os.path.join(paths.DOCS, "coverage.md")
 HEADING = "## The energy of a cycle"
 
 
-def _jump_record(ev, key: str) -> dict:
-    """A jump of the program's cycle (an :class:`~petsc_adhesion.tracing.curve.Event`; ``key``: lam or Z, its
-    c): its c (best, grid, bar) and the heights of the jump in F."""
-    c = getattr(ev, key)
-    return {"kind": ev.kind, "c": c.value, "c_grid": c.value if c.grid is None else c.grid, "c_err": c.err,
-            "F": ev.F.value, "landing_F": None if ev.landing is None else ev.landing.F.value,
-            "error_note": ev.note}
-
-
 def _program(model, K) -> dict:
-    """The program's energy and bar (trace_curve, defaults), the bar's terms and the times."""
-    from ..tracing import energy
+    """The program's energy and bar (trace_curve, defaults), the energies on the levels its bar came from, the
+    bound the bar was before (the events' errors summed, :func:`~petsc_adhesion.tracing.energy.energy_bar`,
+    for comparison) and the times."""
+    from ..tracing import energy, error_bars, results
     from ..tracing.measured import Measured
     from ..tracing.trace import CurveRequest, trace_curve
 
-    seen, cycle_s = {}, {}
-    real_bar, real_cycle = energy.energy_bar, energy.cycle
+    seen: dict = {}
+    real_energy, real_levels, real_cycle = results._energy, error_bars.energy_levels, energy.cycle
 
-    def bar(result, fold, record_of):
-        total = real_bar(result, fold, record_of)
-        key = "Z" if fold.weight else "lam"
-        jumps = [_jump_record(record_of(f), key) for f in result.jumps]
-        term = sum(abs(j["landing_F"] - j["F"]) * (abs(j["c_grid"] - j["c"]) + j["c_err"])
-                   for j in jumps if j["landing_F"] is not None and j["c_err"] is not None)
-        quad = result.quadrature_err if result.pieces else 0.0
-        seen["spring" if fold.weight else "rigid"] = {
-            "jumps": jumps, "terms": None if total is None else
-            {"jumps": term, "stretches": total - term - quad, "quadrature": quad}}
-        return total
+    def machine(fold) -> str:
+        return "spring" if fold.weight else "rigid"
+
+    def bar(loop, fold, event_of_found, levels):
+        seen.setdefault(machine(fold), {})["bound"] = energy.energy_bar(loop, fold, event_of_found)
+        return real_energy(loop, fold, event_of_found, levels)
+
+    def on_levels(tracer, loop, fold, estimate_of):
+        t = time.perf_counter()
+        out = real_levels(tracer, loop, fold, estimate_of)
+        seen.setdefault(machine(fold), {}).update({"levels_s": time.perf_counter() - t,
+                                                   "energies": out if isinstance(out, str) else
+                                                   {str(k): v for k, v in out.items()}})
+        return out
 
     def cycle(segments, fold):
         t = time.perf_counter()
         out = real_cycle(segments, fold)
-        cycle_s["spring" if fold.weight else "rigid"] = time.perf_counter() - t
+        seen.setdefault(machine(fold), {})["cycle_s"] = time.perf_counter() - t
         return out
 
-    energy.energy_bar, energy.cycle = bar, cycle
+    results._energy, error_bars.energy_levels, energy.cycle = bar, on_levels, cycle
     try:
         t = time.perf_counter()
         c = trace_curve(model, request=CurveRequest(spring=K))
         wall = time.perf_counter() - t
     finally:
-        energy.energy_bar, energy.cycle = real_bar, real_cycle
-    machine = "rigid" if K is None else "spring"
+        results._energy, error_bars.energy_levels, energy.cycle = real_energy, real_levels, real_cycle
+    mine = seen.get("rigid" if K is None else "spring", {})
     cyc = c.rigid if K is None else c.spring.cycle
     got = isinstance(cyc.energy, Measured)
     return {"value": cyc.energy.value if got else None, "bar": cyc.energy.err if got else None,
+            "bar_note": cyc.energy.note if got else None,
             "loops": cyc.loops if got else 0, "note": None if got else cyc.energy.reason,
-            "bar_terms": seen[machine]["terms"], "jumps": seen[machine]["jumps"],
-            "time": {"curve_s": wall, "cycle_s": cycle_s[machine]}}
+            "bar_levels": mine.get("energies"), "old_bar": mine.get("bound"),
+            "time": {"curve_s": wall, "cycle_s": mine.get("cycle_s", 0.0), "levels_s": mine.get("levels_s", 0.0)}}
 
 
 def _level(model, K, level: int) -> dict:
@@ -202,12 +199,50 @@ def case(mu: float, sigma: float, K: float | None) -> dict:
             truth, tbar = (None, None) if why else _truth(levels, use)
         else:
             why = why or "level 3 too costly"
-    if not why and tbar > RESOLVE * (abs(row["value"] - truth) if bar is None else bar):
-        why = f"the truth's bar {tbar:.1e} is above {RESOLVE:g} times the program's" + (" error" if bar is None else "")
+    why = why or _unresolved(row, truth, tbar)
     row |= {"levels": {str(k): v for k, v in levels.items()}, "truth_levels": list(use), "truth": truth,
             "truth_bar": tbar, "resolved": not why, "unresolved": why,
             "level0_diff": row["value"] - levels[0]["energy_default"]}
     row["time"]["case_s"] = time.perf_counter() - t0
+    return row | derived(row)
+
+
+def _unresolved(row: dict, truth, tbar) -> str | None:
+    """Why the truth does not resolve the program's error (its bar above RESOLVE times the program's bar, or
+    its error where it has none), or None."""
+    if truth is None:
+        return "no truth"
+    if tbar > RESOLVE * (abs(row["value"] - truth) if row["bar"] is None else row["bar"]):
+        return f"the truth's bar {tbar:.1e} is above {RESOLVE:g} times the program's" + \
+            (" error" if row["bar"] is None else "")
+    return None
+
+
+def program_case(mu: float, sigma: float, K: float | None) -> dict:
+    """The program's part of one case alone (this process): its value, bar, levels and times."""
+    import petsc4py
+    petsc4py.init([sys.argv[0]])
+    from ..model.parameters import Model
+
+    return {"mu": mu, "sigma": sigma, "K": K} | _program(Model(mu=mu, sigma=sigma), K)
+
+
+def merged(stored: dict, program: dict) -> dict:
+    """A stored case's truth (its traces on levels 0 .. 3 do not depend on how the program makes its bar) with
+    the program's part measured again: the same value (the curve is unchanged: to 1e-12, else the row says
+    it failed), the new bar, judged against the stored truth."""
+    row = {k: v for k, v in stored.items() if k not in ("bar_terms", "jumps")} | program
+    row["time"] = {**stored.get("time", {}), **program["time"]}
+    if "failed" in stored or program["value"] != stored["value"] and \
+            not (program["value"] is not None and stored["value"] is not None and
+                 abs(program["value"] - stored["value"]) <= 1e-12 * max(1.0, abs(stored["value"]))):
+        return {"mu": stored["mu"], "sigma": stored["sigma"], "K": stored["K"],
+                "failed": [f"the program's value {program['value']} is not the stored {stored.get('value')}"],
+                "time": row["time"]}
+    row["value"] = stored["value"]
+    if row["truth"] is not None and not (row["unresolved"] or "").startswith(("no cycle", "the levels jump")):
+        row["unresolved"] = _unresolved(row, row["truth"], row["truth_bar"])
+        row["resolved"] = not row["unresolved"]
     return row | derived(row)
 
 
@@ -235,6 +270,21 @@ def _run(c) -> dict:
     row["time"]["process_s"] = time.perf_counter() - t
     print(f"mu = {mu:g}, sigma = {sigma:g}, {_machine(row)}: {row['time']['process_s']:.0f} s", file=sys.stderr,
           flush=True)
+    return row
+
+
+def _run_program(c) -> dict:
+    mu, sigma, K = c
+    t = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.energy_coverage", "-program-case",
+                           f"{mu:g}", f"{sigma:g}", "rigid" if K is None else f"{K:g}"],
+                          capture_output=True, text=True, cwd=paths.ROOT)
+    if proc.returncode:
+        return {"mu": mu, "sigma": sigma, "K": K, "failed": proc.stderr.strip().splitlines()[-1:],
+                "time": {"process_s": time.perf_counter() - t}}
+    row = json.loads(proc.stdout.strip().splitlines()[-1])
+    print(f"mu = {mu:g}, sigma = {sigma:g}, {_machine(row)}: {time.perf_counter() - t:.0f} s (program)",
+          file=sys.stderr, flush=True)
     return row
 
 
@@ -424,12 +474,27 @@ truth's bar), a lower bound of the ratio wherever the truth's bar holds, is {saf
 
 
 def main(argv: list[str]) -> int:
-    """The study (or one case with -case mu sigma K|rigid, or the table alone with -table)."""
-    if argv[:1] == ["-case"]:
+    """The study (or one case with -case mu sigma K|rigid, the program's part of one with -program-case, the
+    program's part of every case against the stored truth with -program, or the table alone with -table)."""
+    if argv[:1] in (["-case"], ["-program-case"]):
         K = None if argv[3] == "rigid" else float(argv[3])
-        print(json.dumps(case(float(argv[1]), float(argv[2]), K)))
+        run = case if argv[0] == "-case" else program_case
+        print(json.dumps(run(float(argv[1]), float(argv[2]), K)))
         return 0
-    if argv[:1] != ["-table"]:
+    if argv[:1] == ["-program"]:
+        with open(DATA) as f:
+            data = json.load(f)
+        stored = {(r["mu"], r["sigma"], r["K"]): r for r in data["rows"]}
+        t = time.perf_counter()
+        with ThreadPoolExecutor(2) as pool:
+            rows = [merged(stored[c], p) if "failed" not in p else p for c, p in zip(CASES, pool.map(_run_program, CASES))]
+        made = {"study_s": data["made"].get("study_s"), "program_s": time.perf_counter() - t,
+                "truth": {k: data["made"].get(k) for k in ("commit", "changed")} if "truth" not in data["made"]
+                else data["made"]["truth"], **paths.source()}
+        with open(DATA + ".part", "w") as f:
+            json.dump({"made": made, "rows": rows}, f, indent=1)
+        os.replace(DATA + ".part", DATA)
+    elif argv[:1] != ["-table"]:
         t = time.perf_counter()
         with ThreadPoolExecutor(2) as pool:
             rows = list(pool.map(_run, CASES))

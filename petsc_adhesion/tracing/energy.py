@@ -137,15 +137,16 @@ class _Pieces:
         a = cont.points[j]
         return cont.inner(a.xdot, pt.x - a.x) + a.pdot * (pt.p - a.p)
 
-    def integral(self, i: int) -> tuple[float, float]:
-        """(integral, error estimate) from node i to node i + 1; (0, 0) between two grids.
+    def integral(self, i: int) -> tuple[float, float, list]:
+        """(integral, error estimate, the points it was halved at, in order) from node i to node i + 1;
+        (0, 0, []) between two grids.
 
         The piece is halved at the curve's point halfway along the step (the arclength corrector on the
         hyperplane there) until the two halves' sum changes by less than the piece's share of ``tol``
         (at most MAX_HALVINGS times); the last change is the estimate."""
         u, v = self.nodes[i], self.nodes[i + 1]
         if u.seg != v.seg:
-            return 0.0, 0.0
+            return 0.0, 0.0, []
         k, j = u.seg, u.key[1]
         s0 = u.key[2]
         s1 = v.key[2] if v.key[1] == j else self._along(k, j, v.point)
@@ -154,20 +155,20 @@ class _Pieces:
 
     def _refine(self, k, j, a, b, s0, s1, whole, depth, width):
         if depth >= MAX_HALVINGS or j >= len(self.segments[k].cont.points) - 1:
-            return whole, abs(whole) if depth == 0 else 0.0
+            return whole, (abs(whole) if depth == 0 else 0.0), []
         try:
             m = self._arc(k, j)(0.5 * (s0 + s1), True)
         except RuntimeError:                   # the corrector did not reach: the piece as it is, its whole value its bar
-            return whole, abs(whole)
+            return whole, abs(whole), []
         self.solves += 1
         left, right = _integral(a, m, self.weight), _integral(m, b, self.weight)
         change = abs(left + right - whole)
         if change <= self.tol * max(width, 1e-300):
-            return left + right, change
+            return left + right, change, [m]
         half = 0.5 * width
-        il, el = self._refine(k, j, a, m, s0, 0.5 * (s0 + s1), left, depth + 1, half)
-        ir, er = self._refine(k, j, m, b, 0.5 * (s0 + s1), s1, right, depth + 1, half)
-        return il + ir, el + er
+        il, el, pl = self._refine(k, j, a, m, s0, 0.5 * (s0 + s1), left, depth + 1, half)
+        ir, er, pr = self._refine(k, j, m, b, 0.5 * (s0 + s1), s1, right, depth + 1, half)
+        return il + ir, el + er, pl + [m] + pr
 
 
 #: Halvings of a piece at most (the interpolant's error falls by about 16 with each).
@@ -205,7 +206,8 @@ class Loop:
     it cannot be walked, ``note`` saying why), the sum of the last changes of the pieces' integrals on
     halving (``quadrature_err``), the points solved for on the way (``solves``), the hysteresis ``loops``,
     the folds the approach and then the retraction jump at (``jumps``), the ``pieces`` of the loops'
-    borders as (first node, last node, multiplicity) and the ``nodes`` walked."""
+    borders as (first node, last node, multiplicity), the ``nodes`` walked and the points each piece of
+    the borders was halved at (``inner``: (first node, its points in order))."""
 
     energy: float | None
     note: str | None = None
@@ -215,6 +217,7 @@ class Loop:
     jumps: tuple = ()
     pieces: tuple = ()
     nodes: tuple = ()
+    inner: tuple = ()
 
 
 def cycle(segments, fold: Fold) -> Loop:
@@ -248,14 +251,16 @@ def cycle(segments, fold: Fold) -> Loop:
         i = j + 1
     pieces = _Pieces(segments, nodes, fold.weight, QUADRATURE_TOL)
     energy = quadrature = 0.0
+    inner = []
     for i, j, k in runs:
         for n in range(i, j):
-            value, err = pieces.integral(n)
+            value, err, halved = pieces.integral(n)
             energy += k * value
             quadrature += abs(k) * err
+            inner.append((n, tuple(halved)))
     jumped = approach[1] + retract[1]
     return Loop(energy, None, quadrature, pieces.solves, len(approach[1]) if runs else 0,
-                tuple(jumped) if runs else (), tuple(runs), tuple(nodes))
+                tuple(jumped) if runs else (), tuple(runs), tuple(nodes), tuple(inner))
 
 
 def energy_bar(result: Loop, fold: Fold, event_of) -> float | None:
@@ -306,24 +311,29 @@ def energy_bar(result: Loop, fold: Fold, event_of) -> float | None:
     return bar
 
 
-def border(result: Loop) -> list[int]:
-    """The nodes of ``result``'s loops' borders (:func:`cycle`), by index into ``result.nodes``, in order."""
-    return sorted({n for i, j, _ in result.pieces for n in range(i, j + 1)})
+def border(result: Loop) -> list[tuple[int, int]]:
+    """The points of ``result``'s loops' borders (:func:`cycle`) as (node index, -1) for a node of
+    ``result.nodes`` and (node index, m) for the m-th point its piece was halved at, each once."""
+    out = {(n, -1) for i, j, _ in result.pieces for n in range(i, j + 1)}
+    out |= {(n, m) for n, pts in result.inner for m in range(len(pts))}
+    return sorted(out)
 
 
 def border_integral(result: Loop, points: dict, weight: float) -> float:
-    """The closed integral of F dc along the loops' borders through ``points`` ({node index: point}, one for
-    every node of :func:`border`), each piece by the planar Hermite interpolant of its two ends, unhalved.
+    """The closed integral of F dc along the loops' borders through ``points`` (one for every key of
+    :func:`border`), each piece by the planar Hermite interpolants between the points it was halved at.
 
-    With the curve's own points it is the energy of :func:`cycle` but for the quadrature's refinement; with
-    the same nodes put on another level's curve (the corners, a fold and its landing, located there) it is
-    that level's energy with the same quadrature, so that the difference of the two holds the grid's
-    change and little of the quadrature's error (the pieces are alike on the two curves).
+    With the curve's own points it is the energy of :func:`cycle` (the same sums); with the same points
+    put on another level's curve (the corners, a fold and its landing, located there) it is that level's
+    energy by the same quadrature on the same partition, so that the difference of the two holds the
+    grid's change and not the quadrature's error.
     """
-    nodes = result.nodes
+    nodes, inner = result.nodes, dict(result.inner)
     total = 0.0
     for i, j, k in result.pieces:
         for n in range(i, j):
-            if nodes[n].seg == nodes[n + 1].seg:            # between two grids: one state, no work
-                total += k * _integral(points[n], points[n + 1], weight)
+            if nodes[n].seg != nodes[n + 1].seg:            # between two grids: one state, no work
+                continue
+            chain = [points[n, -1]] + [points[n, m] for m in range(len(inner.get(n, ())))] + [points[n + 1, -1]]
+            total += k * sum(_integral(a, b, weight) for a, b in zip(chain, chain[1:]))
     return total

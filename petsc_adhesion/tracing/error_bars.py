@@ -301,20 +301,20 @@ def energy_levels(tracer, loop, fold, estimate_of) -> dict[int, float] | str:
     levels = shared[:ENERGY_LEVELS]
     if len(levels) < ENERGY_LEVELS:
         return "the jumps were not located on enough common levels"
-    nodes = loop.nodes
+    nodes, inner = loop.nodes, dict(loop.inner)
     on = energy.border(loop)
-    own = {n: nodes[n].point for n in on}
+    own = {(n, m): nodes[n].point if m < 0 else inner[n][m] for n, m in on}
     base = energy.border_integral(loop, own, fold.weight)
     out = {0: float(loop.energy)}
     for level in levels:
-        pts: dict[int, Any] = {}
+        pts: dict[tuple[int, int], Any] = {}
         made: dict[int, Any] = {}
         try:
-            for n in on:
+            for n, m in on:
                 node = nodes[n]
-                if node.found is not None and id(node.found) in jumps:
+                if m < 0 and node.found is not None and id(node.found) in jumps:
                     pt, land = located[id(node.found)][level]
-                    pts[n] = land if node.landing else pt
+                    pts[n, m] = land if node.landing else pt
                     continue
                 owner = tracer.segments[node.seg]
                 if node.seg not in made:
@@ -322,10 +322,10 @@ def energy_levels(tracer, loop, fold, estimate_of) -> dict[int, float] | str:
                         owner.kind, owner.grid.edge if owner.grid is not None else None, level=level,
                         settings=replace(tracer.set, monitor=False),
                         band=owner.grid.band if owner.kind == "scaled" else None, zone=owner.zone)
-                pt = carry(owner, made[node.seg], node.point)
+                pt = carry(owner, made[node.seg], own[n, m])
                 if pt is None:
-                    return f"a point of the loop at lambda = {node.point.p:.6g} was not carried to level {level}"
-                pts[n] = pt
+                    return f"a point of the loop at lambda = {own[n, m].p:.6g} was not carried to level {level}"
+                pts[n, m] = pt
         finally:
             for seg in made.values():
                 seg.destroy()
