@@ -300,24 +300,34 @@ def _g(x, digits: int = 2) -> str:
     return "-" if x is None else f"{x:.{digits}g}" if x == 0 else f"{x:.{digits}e}".replace("e-0", "e-").replace("e+0", "e")
 
 
+def _levels_cell(r: dict) -> str:
+    """The levels the program's bar came from, and the old bound's ratio to the error beside them."""
+    lv = r.get("bar_levels")
+    where = "-" if not r["loops"] else "events' bound" if not isinstance(lv, dict) else \
+        ", ".join(sorted(lv, key=int))
+    old = r.get("old_bar")
+    return where + ("" if old is None or not r.get("error") else f" ({_g(old / r['error'])})")
+
+
 def table(rows: list, made: dict | None = None) -> str:
-    """The per-case table, the summary line and the cost, from the study's rows."""
+    """The per-case table, the summary line and the cost, from the study's rows (those not measured again
+    since the bar changed, ``stale``, named apart)."""
+    stale = [r for r in rows if r.get("stale")]
+    rows = [r for r in rows if not r.get("stale")]
     lines = ["| mu | sigma | machine | loops | energy (program) | bar | truth | truth's bar | levels | \\|error\\| | "
-             "bar / \\|error\\| | covered | bar: jumps, stretches, quadrature | curve (s) |",
+             "bar / \\|error\\| | covered | bar's levels (old bound / \\|error\\|) | curve (s) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     counted, ratios, missed, unresolved, failed, barless = [], [], [], [], [], []
     for r in rows:
         if "failed" in r:
-            failed.append(f"mu = {r['mu']:g}, sigma = {r['sigma']:g}, {_machine(r)}")
+            failed.append(f"mu = {r['mu']:g}, sigma = {r['sigma']:g}, {_machine(r)} ({'; '.join(r['failed'])})")
             continue
-        terms = r["bar_terms"] or {}
-        split = ", ".join(_g(terms.get(k), 1) for k in ("jumps", "stretches", "quadrature")) if r["bar"] else "-"
         cov = "truth not resolved" if not r["resolved"] else "no bar" if r["bar"] is None else \
             "yes" if r["covered"] else "**no**"
         lines.append(f"| {r['mu']:g} | {r['sigma']:g} | {_machine(r)} | {r['loops']} | {r['value']:.8f} | {_g(r['bar'])} | "
                      + ("- | - | " if r["truth"] is None else f"{r['truth']:.8f} | {_g(r['truth_bar'], 1)} | ")
                      + f"{', '.join(map(str, r['truth_levels']))} | {_g(r['error'])} | {_g(r['ratio'])} | {cov} | "
-                     f"{split} | {r['time']['curve_s']:.1f} |")
+                     f"{_levels_cell(r)} | {r['time']['curve_s']:.1f} |")
         if not r["resolved"]:
             unresolved.append(f"{_where(r)} ({r['unresolved']}; "
                               f"value {r['value']:.8f}, bar {_g(r['bar'])}"
@@ -325,8 +335,7 @@ def table(rows: list, made: dict | None = None) -> str:
                               + ")")
             continue
         if r["bar"] is None:
-            barless.append(f"{_where(r)} (value {r['value']:.8f}, truth {r['truth']:.8f}, error {_g(r['error'])}: "
-                           + "; ".join(f"{j['kind']}: {j['error_note']}" for j in r["jumps"] if j["error_note"]) + ")")
+            barless.append(f"{_where(r)} (value {r['value']:.8f}, truth {r['truth']:.8f}, error {_g(r['error'])})")
             continue
         if r["loops"]:
             counted.append(r)
@@ -341,7 +350,8 @@ def table(rows: list, made: dict | None = None) -> str:
     if counted:
         lo, hi = min(ratios, key=lambda x: x[0]), max(ratios, key=lambda x: x[0])
         lines.append(f"**With hysteresis: covered in {cov} of {len(counted)} cases** (a bar given, the truth resolved); "
-                     f"bar / |error| median {np.median([x for x, _ in ratios]):.2g}, the smallest {lo[0]:.2g} "
+                     f"bar / |error| median {np.median([x for x, _ in ratios]):.2g}, 90th percentile "
+                     f"{np.percentile([x for x, _ in ratios], 90):.2g}, the smallest {lo[0]:.2g} "
                      f"({_where(lo[1])}), the widest {hi[0]:.3g} ({_where(hi[1])}).")
     if zeros:
         lines.append(f"Without hysteresis: {len(zeros)} cases, "
@@ -353,40 +363,44 @@ def table(rows: list, made: dict | None = None) -> str:
     lines.append("\nTruth not resolved: " + ("; ".join(unresolved) if unresolved else "none") + ".")
     if failed:
         lines.append("\nFailed: " + "; ".join(failed) + ".")
+    if stale:
+        lines.append("\nNot measured again with the bar as it is (the study was cut short): "
+                     + "; ".join(_where(r) for r in stale) + ".")
     ok = [r for r in rows if "failed" not in r]
     curve = np.array([r["time"]["curve_s"] for r in ok])
     cyc = np.array([r["time"]["cycle_s"] for r in ok])
-    wall = (made or {}).get("study_s")
+    lvl = np.array([r["time"].get("levels_s", 0.0) for r in ok if r["loops"]])
+    share = lvl / np.array([r["time"]["curve_s"] for r in ok if r["loops"]])
+    src = made or {}
+    wall = src.get("program_s", src.get("study_s"))
     lines.append(f"\nCost: the whole curve with its error bars (`trace_curve`, what the energy needs) took "
                  f"{np.median(curve):.2g} s median, {curve.min():.2g} to {curve.max():.3g} s; `energy.cycle` "
                  f"itself {np.median(cyc) * 1e3:.0f} ms median, at most {cyc.max():.2g} s "
-                 f"({np.median(cyc / curve):.1%} of the curve's time median)."
-                 + ("" if wall is None else f"  The study took {wall / 60:.0f} minutes on 2 cores."))
+                 f"({np.median(cyc / curve):.1%} of the curve's time median)"
+                 + ("" if not len(lvl) else
+                    f"; the energy on the other levels (`error_bars.energy_levels`, with hysteresis) "
+                    f"{np.median(lvl):.2g} s median, at most {lvl.max():.2g} s, {np.median(share):.0%} of the "
+                    f"curve's time median, at most {share.max():.0%}")
+                 + "." + ("" if wall is None else f"  The {'program' if 'program_s' in src else 'study'} took "
+                          f"{wall / 60:.0f} minutes on 2 shared cores."))
     return "\n".join(lines)
 
 
 def _diagnosis(rows: list) -> list:
-    """Over the cases with hysteresis, a bar and a resolved truth: the true error split into the quadrature's
-    (the program's value against the same curve's with the tight tolerance) and the grid's (the rest), the
-    jumps' share of the grid's (each jump's c at level 0 against its extrapolation from the truth's levels,
-    times the jump's height), and each jump's c-error against the program's (grid value's distance from
-    the best value plus its bar)."""
+    """Over the cases with hysteresis, a bar from the levels and a resolved truth: the error of the levels'
+    extrapolation E against the truth, the level-0 value's, and the old bound's ratio to the error."""
     from ..tracing.error_bars import extrapolate
 
     out = []
     for r in rows:
         if "failed" in r or not r["resolved"] or not r["loops"] or r["bar"] is None:
             continue
-        lv, use = r["levels"], r["truth_levels"]
-        d = {"row": r, "quad_err": abs(r["value"] - lv["0"]["energy"]), "grid_err": abs(lv["0"]["energy"] - r["truth"]),
-             "jump_err": 0.0, "c_ratios": []}
-        for i, (j, p) in enumerate(zip(lv["0"]["jumps"], r["jumps"])):
-            c = extrapolate({k: lv[str(k)]["jumps"][i]["c"] for k in use})[0]
-            if j["landing_F"] is not None:
-                d["jump_err"] += abs(j["landing_F"] - j["F"]) * abs(j["c"] - c)
-            if p["c_err"] is not None and j["c"] != c:
-                d["c_ratios"].append((abs(p["c_grid"] - p["c"]) + p["c_err"]) / abs(j["c"] - c))
-        out.append(d)
+        lv = r.get("bar_levels")
+        if not isinstance(lv, dict):
+            continue
+        best, best_bar = extrapolate({int(k): v for k, v in lv.items()})
+        out.append({"row": r, "best_err": abs(best - r["truth"]), "best_bar": best_bar,
+                    "distance": abs(r["value"] - best), "old": r.get("old_bar")})
     return out
 
 
@@ -394,80 +408,88 @@ def _span(xs: list) -> str:
     return f"{min(xs):.2g} to {max(xs):.3g} (median {np.median(xs):.2g})" if xs else "-"
 
 
-_OWN = {"jumps": "jumps'", "stretches": "stretches'", "quadrature": "quadrature's"}
-
-
 def section(rows: list, made: dict | None = None) -> str:
     """The section of docs/coverage.md, from the study's rows."""
-    diag = _diagnosis(rows)
-    terms = ("jumps", "stretches", "quadrature")
-    qr = [d["row"]["bar_terms"]["quadrature"] / d["quad_err"] for d in diag if d["quad_err"] > 0]
-    jr = [d["row"]["bar_terms"]["jumps"] / d["jump_err"] for d in diag if d["jump_err"] > 0]
-    cr = [x for d in diag for x in d["c_ratios"]]
-    alone = {t: sum(d["row"]["error"] <= d["row"]["bar_terms"][t] for d in diag) for t in terms}
-    dominant = [max(terms, key=lambda t: d["row"]["bar_terms"][t]) for d in diag]
-    safe = [d["row"]["bar"] / (d["row"]["error"] + d["row"]["truth_bar"]) for d in diag]
-    blurred = [d["row"] for d in diag if d["row"]["error"] < d["row"]["truth_bar"]]
-    ok = [r for r in rows if "failed" not in r]
+    diag = _diagnosis([r for r in rows if not r.get("stale")])
+    ok = [r for r in rows if "failed" not in r and not r.get("stale")]
     diffs = [abs(r["level0_diff"]) / abs(r["value"]) for r in ok if r["value"]]
     used = sorted({tuple(r["truth_levels"]) for r in ok})
+    bar_levels = sorted({tuple(sorted(map(int, r["bar_levels"]))) for r in ok if isinstance(r.get("bar_levels"), dict)})
+    bound = [_where(r) for r in ok if r["loops"] and not isinstance(r.get("bar_levels"), dict)]
     jumps_differ = [r for r in ok if any(len(v["jumps"]) != len(r["levels"]["0"]["jumps"]) or v["folds"] !=
                                          r["levels"]["0"]["folds"] for v in r["levels"].values())]
+    gain = [d["row"]["error"] / d["best_err"] for d in diag if d["best_err"] > 0]
+    held = sum(d["best_err"] <= d["best_bar"] for d in diag)
+    share = [d["distance"] / d["row"]["bar"] for d in diag if d["row"]["bar"]]
+    old = [d["old"] / d["row"]["error"] for d in diag if d["old"] is not None and d["row"]["error"]]
+    loose = [d for d in diag if d["row"]["ratio"] is not None and d["row"]["ratio"] > 5]
+    blurred = [d["row"] for d in diag if d["row"]["error"] < d["row"]["truth_bar"]]
+    safe = [d["row"]["bar"] / (d["row"]["error"] + d["row"]["truth_bar"]) for d in diag]
     src = made or {}
+    truth_src = src.get("truth") or src
     return SECTION.format(
         table=table(rows, made), n=len(ok), hyst=sum(1 for r in ok if r["loops"]), m=len(diag),
-        zero=", ".join(_where(r) for r in ok if not r["loops"]) or "none",
-        quad=_span(qr), jump=_span(jr), c=_span(cr), safe=_span(safe),
-        alone=", ".join(f"the {_OWN[t]} term alone in {alone[t]}" for t in terms),
-        excess=_span([d["jump_err"] / d["row"]["error"] for d in diag if d["row"]["error"] > 0]),
-        dominant=", ".join(f"{t} in {dominant.count(t)}" for t in terms if dominant.count(t)) or "-",
-        blurred=len(blurred),
-        gq=(f"{np.median([d['quad_err'] / (d['quad_err'] + d['grid_err']) for d in diag]):.0%}" if diag else "-"),
-        same=f"{max(diffs, default=0.0):.0e}", resolve=RESOLVE, tol=TRUTH_TOL, budget=LEVEL3_BUDGET,
+        resolve=RESOLVE, tol=TRUTH_TOL, budget=LEVEL3_BUDGET, same=f"{max(diffs, default=0.0):.0e}",
         used="; ".join(", ".join(map(str, u)) for u in used),
+        bar_levels="; ".join(", ".join(map(str, u)) for u in bar_levels) or "none",
+        bound=("none" if not bound else "; ".join(bound)),
         differ=("none" if not jumps_differ else "; ".join(_where(r) for r in jumps_differ)),
-        commit=(src.get("commit") or "?")[:7])
+        commit=(src.get("commit") or "?")[:7], truth_commit=(truth_src.get("commit") or "?")[:7],
+        gain=_span(gain), held=held, share=_span(share), old=_span(old), safe=_span(safe), blurred=len(blurred),
+        loose="none" if not loose else "; ".join(
+            f"{_where(d['row'])} (bar / error {d['row']['ratio']:.3g}: the extrapolation E is "
+            f"{d['best_err']:.1e} from the truth, the level-0 value {d['row']['error']:.1e})" for d in loose))
 
 
 SECTION = HEADING + """
 
 <!-- made by: python -m petsc_adhesion.benchmarks.energy_coverage (data: docs/data/energy_coverage.json; -table redraws from it) -->
 Made by `python -m petsc_adhesion.benchmarks.energy_coverage` (`-table` redraws it from
-docs/data/energy_coverage.json).  The energy one approach-retract cycle dissipates
-(`summary["energy"]`, and behind a spring `summary["spring"]["energy"]`; `tracing/energy.py`)
-is computed on the curve's own grids (level 0), and its bar is built from the events' errors:
-each jump moved in its control c by its fold's error (the grid value's distance from the best
-value plus its bar) times the jump's height in F, each stretch of a loop's border moved in F by
-its ends' errors times its width in c, plus the quadrature's estimate.
+docs/data/energy_coverage.json; `-program` measures the program's part again against the stored truth).
+The energy one approach-retract cycle dissipates (`summary["energy"]`, and behind a spring
+`summary["spring"]["energy"]`; `tracing/energy.py`) is the integral of the curve the files hold,
+on its own grids (level 0).  Its bar comes from the same nested levels as the events' (`tracing/error_bars.py`,
+`energy_levels`): the loops' borders put on the levels of the events' estimates (every computed
+point and every point the quadrature halved at carried to that level's grid of its segment by a
+zero-length arclength correction, each corner, a fold jumped at and its landing, as the events' error
+bars located it there), integrated by the same quadrature on the same partition, so that the
+level's energy differs from level 0's by the grid's change alone.  The levels' energies are
+extrapolated as the events' values are (X + h^2 (A + B log h)), and the bar is the level-0 value's
+distance from that extrapolation E plus E's own bar (2.5 times its distance from Richardson's, with
+the floor) plus the quadrature's estimate: the errors of the jumps and of the borders, which largely
+cancel in the loop's area, are credited because each level's area is computed whole.  The value
+stays level 0's (E is more accurate, but it is not the area of a curve the run traced).  Where the
+levels cannot be had (a jump not located on them, a point not carried), the bar is the old bound (each
+jump moved by its fold's error times its height, each stretch by its ends' errors times its width), with
+a note saying so.  Levels the bars came from: {bar_levels}; the old bound: {bound}.
 
 What was measured: {n} cases ({hyst} with hysteresis), mu = 1, 2, 3, 5 by sigma = 0, 0.2 (the
 Hermite rule), each with the rigid machine and springs K = 0.05, 0.5, 2, and mu = 0.5 (rigid:
 no hysteresis; K = 2: a small loop).  The program's value and bar are `trace_curve`'s with its
-defaults (commit {commit}).  The truth is the whole curve traced again on the default grids at
+defaults (commit {commit}).  The truth (traced at commit {truth_commit}; the bar's code does not enter
+it) is the whole curve traced again on the default grids at
 refinement levels 0, 1, 2 (2^k times the nodes), started, traced back and jumped exactly as
 `trace_curve` does, its energy integrated with a quadrature tolerance of {tol:g} (the
 program's: 1e-5), and extrapolated by `error_bars.extrapolate`.  Where that extrapolation's own
 bar is above {resolve:g} times the program's bar, level 3 is traced too (when expected below
-{budget:.0f} s) and levels 1, 2, 3 are used, else the case is "truth not resolved".  Levels
+{budget:.0f} s) and levels 1, 2, 3 are used, else the case is "truth not resolved" (a bar as tight as
+the error it bounds needs a truth ten times better).  Levels
 used: {used}.  Cases whose levels found a different number of folds or jumps: {differ}.
 Level 0 of the truth's trace is the program's own curve: its energy with the program's
 tolerance is the program's value to {same} (relative) in every case.  A bar covers when
-|value - truth| <= bar.
+|value - truth| <= bar.  The last column's levels are those the bar came from; beside them, in
+brackets, the bar / |error| the old bound (sums of the events' errors, before) would have given.
 
 {table}
 
-Which term carries the bar ({m} cases with hysteresis, a bar and a resolved truth).  The
-error is almost all the grid's: the quadrature's true error (the program's value against the
-same curve integrated with the tight tolerance) is a median {gq} of it, and its estimate is
-{quad} times that error.  Each jump's c-error as the program states it (grid value's distance
-from the best value, plus the bar) is {c} times the true one (level 0 against the levels'
-extrapolation): the best values of the folds are accurate, so the jumps' term is, in effect, the
-sum of |jump height x c-error| over the jumps ({jump} times it).  That sum alone is {excess}
-times the energy's whole error: the jumps' and the borders' errors, both the coarse grid's, evidently
-largely cancel in the loop's area, which the bar, a sum of absolute values, does not credit.  Of the {m} cases the error is covered by {alone}; the
-largest term: {dominant} cases.  In {blurred} cases the
-error is below the truth's own bar, so their bar / |error| is uncertain; bar / (|error| +
-truth's bar), a lower bound of the ratio wherever the truth's bar holds, is {safe}.
+How the bar is made, on the same data ({m} cases with hysteresis, a bar from the levels and a
+resolved truth).  The levels' extrapolation E is {gain} times closer to the truth than the level-0
+value, and within its own bar in {held} of them; the level-0 value's distance from E is {share} of the
+bar, so the bar is, in effect, the level-0 value's error estimated by the levels, which is why its ratio
+to the true error sits just above 1: the bar is as wide as the error it bounds, plus E's bar.  The old
+bound would have been {old} times the error.  Where the bar is wider than 5 times the error: {loose}.
+In {blurred} cases the error is below the truth's own bar, so their bar / |error| is uncertain; bar /
+(|error| + truth's bar), a lower bound of the ratio wherever the truth's bar holds, is {safe}.
 """
 
 
@@ -482,18 +504,25 @@ def main(argv: list[str]) -> int:
         print(json.dumps(run(float(argv[1]), float(argv[2]), K)))
         return 0
     if argv[:1] == ["-program"]:
+        # each case stored as soon as it is done (cheapest first), the others marked not measured again, so
+        # that a run cut short leaves a table of what it measured
         with open(DATA) as f:
             data = json.load(f)
-        stored = {(r["mu"], r["sigma"], r["K"]): r for r in data["rows"]}
+        if "truth" not in data["made"]:
+            data["made"] = {"study_s": data["made"].get("study_s"),
+                            "truth": {k: data["made"].get(k) for k in ("commit", "changed")}}
+        rows = [r | {"stale": True} for r in data["rows"]]
+        where = {(r["mu"], r["sigma"], r["K"]): i for i, r in enumerate(rows)}
+        order = sorted(CASES, key=lambda c: (c[0], c[2] is not None, c[1]))
         t = time.perf_counter()
         with ThreadPoolExecutor(2) as pool:
-            rows = [merged(stored[c], p) if "failed" not in p else p for c, p in zip(CASES, pool.map(_run_program, CASES))]
-        made = {"study_s": data["made"].get("study_s"), "program_s": time.perf_counter() - t,
-                "truth": {k: data["made"].get(k) for k in ("commit", "changed")} if "truth" not in data["made"]
-                else data["made"]["truth"], **paths.source()}
-        with open(DATA + ".part", "w") as f:
-            json.dump({"made": made, "rows": rows}, f, indent=1)
-        os.replace(DATA + ".part", DATA)
+            for c, p in zip(order, pool.map(_run_program, order)):
+                i = where[c]
+                rows[i] = p if "failed" in p else merged({k: v for k, v in rows[i].items() if k != "stale"}, p)
+                data["made"] |= {"program_s": time.perf_counter() - t, **paths.source()}
+                with open(DATA + ".part", "w") as f:
+                    json.dump({"made": data["made"], "rows": rows}, f, indent=1)
+                os.replace(DATA + ".part", DATA)
     elif argv[:1] != ["-table"]:
         t = time.perf_counter()
         with ThreadPoolExecutor(2) as pool:
