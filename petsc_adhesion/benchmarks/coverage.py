@@ -178,6 +178,12 @@ def table(rows: list) -> str:
         lines.append(f"| {name} | {len(items)} | {covered} | {covered / len(items):.0%} | "
                      f"{np.median(ratio):.2g} | {np.percentile(ratio, 90):.2g} | {ratio.min():.2g} |")
     lines.append(f"| all | {total[1]} | {total[0]} | {total[0] / max(1, total[1]):.0%} | | | |")
+    radii = [(max(e, f), b) for name, items in by.items() if name.endswith("contact radius") for e, b, f in items]
+    if radii:
+        ratio = np.array([b / e for e, b in radii])
+        covered = int(np.sum(ratio >= 1))
+        lines.append(f"\nThe contact radii together: {covered} of {len(radii)} covered ({covered / len(radii):.0%}), "
+                     f"bar / true error median {np.median(ratio):.2g}, 90th percentile {np.percentile(ratio, 90):.2g}.")
     firsts = sorted({r["first"] for r in rows if "failed" not in r})
     lines.append(f"\nEstimates from levels starting at {', '.join(map(str, firsts))}; {unvalidated} more quantities "
                  f"had no estimate or no truth (an event not found again on a level): not counted here; "
@@ -223,9 +229,9 @@ def main(argv: list[str]) -> int:
 DOC_TEXT = """# Do the error bars hold?
 
 <!-- made by: ./run coverage (data: docs/data/coverage.json; ./run coverage -table redraws from it) -->
-Every event the program reports (folds, their landings' loads, load extrema, equilibria,
-the state at lambda = 0) carries a best value and an error bar
-(`error_estimate.py`).  The event is located again on its own grid at the nested
+Every event the program reports (folds, their landings, load extrema, equilibria,
+the state at lambda = 0) carries a best value and an error bar for its lambda, its F and its
+contact radius, and a fold's landing for its F and contact radius (`tracing/error_bars.py`).  The event is located again on its own grid at the nested
 refinement levels -1 and -2 (every other node, every fourth), each by a short trace
 through it; the best value is the three-level extrapolation X + h^2 (A + B log h) with
 h = 2^-level (the collocation's error has an h^2 log h term besides h^2, from the
@@ -237,6 +243,12 @@ they resolve the contact edge (zone/5 there; `error_estimate.coarse_levels`): le
 -2, -1, 0 at small mu, -1, 0, 1 or 0, 1, 2 at large mu; where a coarse level does
 not yield the event, finer levels take its place; `-target_error TOL` adds finer
 levels until the bar is below TOL.
+
+The contact radius is the first r where the gap rises through the edge level, on the cubic
+through the four nodes about it (`discretization/contact.py`, `crossing`: linear interpolation
+would add a term that jumps as refinement moves the nodes past the edge), and it is extrapolated
+from the same levels as lambda and F, with the same bar.  Out of contact it is 0 on every level,
+exactly: those are counted apart, not as covered.
 
 The truth below is the same extrapolation from the two levels beyond those and the
 finest of them (levels a + 2 .. a + 4 for an estimate from a .. a + 2), 16 times finer; the
@@ -254,8 +266,11 @@ it 95% of the time and stays within a factor 5 (covering 95% takes a median bar 
 h^2 behaviour), 15 to 20 times the best value's.  The uncovered cases (listed under the table) are those whose
 level differences change sign between the coarse and the fine levels, or shrink by far
 less than 4 from level -2 to 0: two error terms of opposite sign, or a level -2 grid not
-yet in the asymptotic range, which the coarse levels alone cannot show.  Where it
-matters, `-target_error` refines until the finest three levels agree.
+yet in the asymptotic range, which the coarse levels alone cannot show (the contact radii
+not covered are listed with the others; their level differences were not examined one by one).
+Where it matters, `-target_error` refines until the
+finest three levels agree (its target is watched on lambda and F; the contact radius comes with
+them).
 """
 
 

@@ -27,12 +27,19 @@ exactly.  The
 step between two grids (a point carried to the next segment's grid) adds
 nothing: its two ends are one state on two discretizations.
 
-The error bar (:func:`energy_bar`) bounds the effect of the grid's error on
-the area: each jump moved in c by its fold's error (times the jump's height
-in F), and each stretch of a loop's border moved in F by the larger error of
-F at its two ends (times its width in c); an event's grid error is its
-distance from its best value plus its bar.  It is measured against finer
-grids in docs/coverage.md.
+The error bar comes from the loops on the nested levels of the events' error
+bars (:func:`~petsc_adhesion.tracing.error_bars.energy_levels`): the borders'
+points (:func:`border`) put on each level's curve and integrated there by
+the same quadrature on the same partition (:func:`border_integral`), so that
+the errors of the jumps and of the borders, which largely cancel in the
+area, cancel in each level's area too; the results (``tracing/results.py``)
+extrapolate them.  Where the levels cannot be had, :func:`energy_bar` bounds
+the grid's effect on the area from the events' errors: each jump moved in c
+by its fold's error (times the jump's height in F), and each stretch of a
+loop's border moved in F by the larger error of F at its two ends (times its
+width in c); an event's grid error is its distance from its best value plus
+its bar (sums of absolute values, which do not credit that cancellation).  Both are
+measured against finer grids in docs/coverage.md.
 """
 from __future__ import annotations
 

@@ -262,19 +262,18 @@ def _cycle(segments, fold, event_of_found, open_reason: str | None, levels=None)
 def _energy(loop, fold, event_of_found, levels) -> Measured:
     """The energy of a walked cycle with its bar (collective).
 
-    The value is the curve's own (level 0: the integral of the branch the files hold).  Its bar, as an
-    event's grid value's: the distance of the level-0 energy from the levels' extrapolation E (X + h^2 (A +
-    B log h), :func:`~.error_bars.extrapolate`) plus E's bar (2.5 |E - Richardson's|, with its floor), plus
-    the quadrature's estimate; the areas' errors of the jumps and the borders cancel within each level's
-    loop, which this credits (docs/coverage.md).  Where the levels cannot be had (a jump not located on
-    them, a point not carried), the bound of :func:`~.energy.energy_bar` (sums of the events' errors), with
-    a note saying so.  0 without hysteresis: both walks cover the same stretch, a computed 0."""
+    The value is the curve's own (level 0: the integral of the branch the files hold).  Its bar: the loop
+    computed whole on one other level of its grids (:func:`~.error_bars.energy_levels`), three times the
+    level-0 value's distance from Richardson's value of the two (:func:`~.error_bars.energy_bar_of`), plus
+    the quadrature's estimate; the errors of the jumps and of the borders cancel within each level's loop,
+    which this credits (docs/coverage.md).  Where the level cannot be had (a jump not located on it, a point
+    not carried), the bound of :func:`~.energy.energy_bar` (sums of the events' errors), with a note saying
+    so.  0 without hysteresis: both walks cover the same stretch, a computed 0."""
     if not loop.pieces:
         return Measured(loop.energy, 0.0)
     got = levels(loop) if levels is not None else None
     if isinstance(got, dict):
-        best, bar = error_bars.extrapolate(got)
-        return Measured(loop.energy, abs(loop.energy - best) + bar + loop.quadrature_err)
+        return Measured(loop.energy, error_bars.energy_bar_of(got) + loop.quadrature_err)
     bound = energy.energy_bar(loop, fold, event_of_found)
     note = None if got is None or bound is None else f"bar bounded by the events' errors ({got})"
     return Measured(loop.energy, bound, note=note)
