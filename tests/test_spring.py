@@ -324,10 +324,11 @@ def fine(curve):
 def test_energy_bar_covers_finer_grids(fine):
     """The energy of a cycle (rigid machine and behind K = 0.5, mu = 1) within its bar of the value
     extrapolated from whole curves traced on levels 0, 1, 2 (second order: the changes 1.0e-5, 2.6e-6), and
-    the bar tight: below 5 times the error (the bar comes from the loop on levels -2, -1, 0, put there point
-    by point; the truth from curves traced whole, their own grids' centres: independent of it).  Measured:
-    rigid 0.0399152 +- 1.5e-5, error 1.4e-5 (bar / error 1.1); spring 0.519946 +- 6.2e-5, error 5.1e-5
-    (1.2); before, from the events' errors summed, 7.7e-5 and 5.1e-4 (5.6 and 10)."""
+    the bar tight: below 5 times the error (the bar comes from the loop put on level -1 point by point; the
+    truth from curves traced whole on finer levels, their grids centred where those traces moved them:
+    independent of it).  Measured: rigid 0.0399152 +- 4.1e-5, error 1.4e-5 (bar / error 3.0); spring
+    0.519946 +- 1.5e-4, error 5.1e-5 (3.0); before, from the events' errors summed, 7.7e-5 and 5.1e-4 (5.6
+    and 10)."""
     from petsc_adhesion.tracing.error_bars import extrapolate
 
     c = fine["curve"]
