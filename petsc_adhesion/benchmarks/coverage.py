@@ -184,6 +184,11 @@ def table(rows: list) -> str:
         covered = int(np.sum(ratio >= 1))
         lines.append(f"\nThe contact radii together: {covered} of {len(radii)} covered ({covered / len(radii):.0%}), "
                      f"bar / true error median {np.median(ratio):.2g}, 90th percentile {np.percentile(ratio, 90):.2g}.")
+    older = sorted({(r["mu"], r["sigma"]) for r in rows if "failed" not in r and "contact_radius" not in r})
+    if older:
+        lines.append("\nCases stored before the contact radius was measured (the study that adds it was cut short; "
+                     "their events' lambda and F are counted, no contact radius): "
+                     + ", ".join(f"mu = {m:g}, sigma = {s:g}" for m, s in older) + ".")
     firsts = sorted({r["first"] for r in rows if "failed" not in r})
     lines.append(f"\nEstimates from levels starting at {', '.join(map(str, firsts))}; {unvalidated} more quantities "
                  f"had no estimate or no truth (an event not found again on a level): not counted here; "
