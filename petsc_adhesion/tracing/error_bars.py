@@ -276,9 +276,10 @@ def event_errors(tracer, seg, found, target_error: float | None = None) -> Estim
 
 #: The energy's bar is this times the level-0 value's distance from Richardson's value of levels 0 and k
 #: (:func:`energy_bar_of`): about 3 times the level-0 error, as the events' grid values' is |X_0 - X_-1| / 3
-#: (docs/coverage.md).  Measured against whole curves traced on levels 0, 1, 2 (docs/coverage.md, the energy's
-#: section): the three-level extrapolation of levels -2, -1, 0 (or -1, 0, 1) put point by point missed 2 of
-#: 14 cases at mu <= 2 (bar / error 0.42, 0.51), this bar none, with a median of 3.
+#: (docs/coverage.md).  Chosen on the first 14 cases with hysteresis at mu <= 2 of docs/coverage.md's energy
+#: study, against whole curves traced on levels 0, 1, 2: the three-level extrapolation of levels -2, -1, 0
+#: (or -1, 0, 1) put point by point missed 2 (bar / error 0.42, 0.51), this bar none (median 3); the whole
+#: study, and where it loses (two levels that agree by accident; the finer level at mu = 3), is there.
 ENERGY_BAR_FACTOR = 3.0
 
 
