@@ -188,7 +188,7 @@ def table(rows: list) -> str:
     if older:
         lines.append("\nCases stored before the contact radius was measured (the study that adds it was cut short; "
                      "their events' lambda and F are counted, no contact radius): "
-                     + ", ".join(f"mu = {m:g}, sigma = {s:g}" for m, s in older) + ".")
+                     + "; ".join(f"mu = {m:g}, sigma = {s:g}" for m, s in older) + ".")
     firsts = sorted({r["first"] for r in rows if "failed" not in r})
     lines.append(f"\nEstimates from levels starting at {', '.join(map(str, firsts))}; {unvalidated} more quantities "
                  f"had no estimate or no truth (an event not found again on a level): not counted here; "
@@ -244,7 +244,7 @@ log-singular kernel on graded grids: Richardson alone leaves it, and its error s
 too widely for a bar that both covers and stays tight), and the bar is 2.5 times the
 distance of that value from Richardson's, and at least 0.06% of the last refinement's
 change (the two can agree by accident).  The coarse levels are used only as far as
-they resolve the contact edge (zone/5 there; `error_estimate.coarse_levels`): levels
+they resolve the contact edge (zone/5 there; `error_bars.coarse_levels`): levels
 -2, -1, 0 at small mu, -1, 0, 1 or 0, 1, 2 at large mu; where a coarse level does
 not yield the event, finer levels take its place; `-target_error TOL` adds finer
 levels until the bar is below TOL.
