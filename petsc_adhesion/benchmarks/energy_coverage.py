@@ -427,6 +427,7 @@ def section(rows: list, made: dict | None = None) -> str:
     truth_src = src.get("truth") or src
     return SECTION.format(
         table=table(rows, made), n=len(ok), hyst=sum(1 for r in ok if r["loops"]), m=len(diag),
+        failed=sum(1 for r in rows if "failed" in r),
         resolve=RESOLVE, tol=TRUTH_TOL, budget=LEVEL3_BUDGET, same=f"{max(diffs, default=0.0):.0e}",
         used="; ".join(", ".join(map(str, u)) for u in used),
         bar_levels=", ".join(map(str, bar_levels)) or "none", bound=("none" if not bound else "; ".join(bound)),
@@ -466,7 +467,8 @@ as above), its bar was 1.07 to 36 times the error (median 1.5) in 12 and missed 
 of mu = 2 cost 20 to 30% of the curve's time.  Three times Richardson's distance covered all 14
 (median 3) from one coarser level.
 
-What was measured: {n} cases ({hyst} with hysteresis), mu = 1, 2, 3, 5 by sigma = 0, 0.2 (the
+What was measured: {n} cases ({hyst} with hysteresis; {failed} more under "Failed" below, not judged:
+there the program's curve is no longer the one the stored truth started from), mu = 1, 2, 3, 5 by sigma = 0, 0.2 (the
 Hermite rule), each with the rigid machine and springs K = 0.05, 0.5, 2, and mu = 0.5 (rigid:
 no hysteresis; K = 2: a small loop).  The program's value and bar are `trace_curve`'s with its
 defaults (commit {commit}).  The truth (traced at commit {truth_commit}; the bar's code does not enter
