@@ -64,8 +64,12 @@ def test_the_table_says_what_each_case_holds(data):
         cells = [c.strip() for c in line.strip("|").split(" | ")]
         if len(cells) == 14 and re.fullmatch(r"[0-9.]+", cells[0]):
             lines[cells[0], cells[1], cells[2]] = cells
-    rows = [r for r in data["rows"] if "failed" not in r]
+    rows = [r for r in data["rows"] if "failed" not in r and not r.get("stale")]
     assert len(lines) == len(rows)
+    # a case not measured again since the bar changed is named apart, not tabled
+    for r in data["rows"]:
+        if r.get("stale"):
+            assert ec._where(r) in doc.split("Not measured again", 1)[1].split("\n", 1)[0]
     for r in rows:
         cells = lines[f"{r['mu']:g}", f"{r['sigma']:g}", "rigid" if r["K"] is None else f"K = {r['K']:g}"]
         assert float(cells[4]) == pytest.approx(r["value"], abs=1e-8)

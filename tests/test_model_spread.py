@@ -69,7 +69,7 @@ def test_at_small_sigma_the_laws_agree(slight):
         # more than ten of its bars (either reason warns)
         assert (q.warning is not None) == (q.spread > WARN_BARS * q.reference.err), q
     # measured: the pull-off F moves by 5.5e-4 (0.067 %), 1400 bars of 3.9e-7; the folds and the equilibrium
-    # by 15 to 260 bars; the pull-off lambda by 0.63 of its bar of 2.1e-4 and the energy by 2.0: no warning
+    # by 15 to 260 bars; the pull-off lambda by 0.63 of its bar of 2.1e-4 and the energy by 3.8 (its bar 3.8e-5): no warning
     warned = {q.name for q in spread.quantities if q.warning}
     assert warned == {"pull-off F", "snap_on lambda", "snap_on F", "snap_off lambda", "snap_off F",
                       "equilibrium lambda"}

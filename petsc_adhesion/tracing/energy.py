@@ -27,12 +27,19 @@ exactly.  The
 step between two grids (a point carried to the next segment's grid) adds
 nothing: its two ends are one state on two discretizations.
 
-The error bar (:func:`energy_bar`) bounds the effect of the grid's error on
-the area: each jump moved in c by its fold's error (times the jump's height
-in F), and each stretch of a loop's border moved in F by the larger error of
-F at its two ends (times its width in c); an event's grid error is its
-distance from its best value plus its bar.  It is measured against finer
-grids in docs/coverage.md.
+The error bar comes from the loops on the nested levels of the events' error
+bars (:func:`~petsc_adhesion.tracing.error_bars.energy_levels`): the borders'
+points (:func:`border`) put on each level's curve and integrated there by
+the same quadrature on the same partition (:func:`border_integral`), so that
+the errors of the jumps and of the borders, which largely cancel in the
+area, cancel in each level's area too; the results (``tracing/results.py``)
+extrapolate them.  Where the levels cannot be had, :func:`energy_bar` bounds
+the grid's effect on the area from the events' errors: each jump moved in c
+by its fold's error (times the jump's height in F), and each stretch of a
+loop's border moved in F by the larger error of F at its two ends (times its
+width in c); an event's grid error is its distance from its best value plus
+its bar (sums of absolute values, which do not credit that cancellation).  Both are
+measured against finer grids in docs/coverage.md.
 """
 from __future__ import annotations
 
@@ -45,7 +52,7 @@ import numpy as np
 from ..core.events import Fold, Found
 from ..core.protocol import Point
 
-__all__ = ["Node", "Loop", "cycle", "energy_bar", "hermite_integral"]
+__all__ = ["Node", "Loop", "cycle", "energy_bar", "hermite_integral", "border", "border_integral"]
 
 #: 3-point Gauss-Legendre on [0, 1]: exact for the product of a cubic and a quadratic.
 _GL_T = 0.5 + 0.5 * np.array([-math.sqrt(0.6), 0.0, math.sqrt(0.6)])
@@ -137,15 +144,16 @@ class _Pieces:
         a = cont.points[j]
         return cont.inner(a.xdot, pt.x - a.x) + a.pdot * (pt.p - a.p)
 
-    def integral(self, i: int) -> tuple[float, float]:
-        """(integral, error estimate) from node i to node i + 1; (0, 0) between two grids.
+    def integral(self, i: int) -> tuple[float, float, list]:
+        """(integral, error estimate, the points it was halved at, in order) from node i to node i + 1;
+        (0, 0, []) between two grids.
 
         The piece is halved at the curve's point halfway along the step (the arclength corrector on the
         hyperplane there) until the two halves' sum changes by less than the piece's share of ``tol``
         (at most MAX_HALVINGS times); the last change is the estimate."""
         u, v = self.nodes[i], self.nodes[i + 1]
         if u.seg != v.seg:
-            return 0.0, 0.0
+            return 0.0, 0.0, []
         k, j = u.seg, u.key[1]
         s0 = u.key[2]
         s1 = v.key[2] if v.key[1] == j else self._along(k, j, v.point)
@@ -154,20 +162,20 @@ class _Pieces:
 
     def _refine(self, k, j, a, b, s0, s1, whole, depth, width):
         if depth >= MAX_HALVINGS or j >= len(self.segments[k].cont.points) - 1:
-            return whole, abs(whole) if depth == 0 else 0.0
+            return whole, (abs(whole) if depth == 0 else 0.0), []
         try:
             m = self._arc(k, j)(0.5 * (s0 + s1), True)
         except RuntimeError:                   # the corrector did not reach: the piece as it is, its whole value its bar
-            return whole, abs(whole)
+            return whole, abs(whole), []
         self.solves += 1
         left, right = _integral(a, m, self.weight), _integral(m, b, self.weight)
         change = abs(left + right - whole)
         if change <= self.tol * max(width, 1e-300):
-            return left + right, change
+            return left + right, change, [m]
         half = 0.5 * width
-        il, el = self._refine(k, j, a, m, s0, 0.5 * (s0 + s1), left, depth + 1, half)
-        ir, er = self._refine(k, j, m, b, 0.5 * (s0 + s1), s1, right, depth + 1, half)
-        return il + ir, el + er
+        il, el, pl = self._refine(k, j, a, m, s0, 0.5 * (s0 + s1), left, depth + 1, half)
+        ir, er, pr = self._refine(k, j, m, b, 0.5 * (s0 + s1), s1, right, depth + 1, half)
+        return il + ir, el + er, pl + [m] + pr
 
 
 #: Halvings of a piece at most (the interpolant's error falls by about 16 with each).
@@ -205,7 +213,8 @@ class Loop:
     it cannot be walked, ``note`` saying why), the sum of the last changes of the pieces' integrals on
     halving (``quadrature_err``), the points solved for on the way (``solves``), the hysteresis ``loops``,
     the folds the approach and then the retraction jump at (``jumps``), the ``pieces`` of the loops'
-    borders as (first node, last node, multiplicity) and the ``nodes`` walked."""
+    borders as (first node, last node, multiplicity), the ``nodes`` walked and the points each piece of
+    the borders was halved at (``inner``: (first node, its points in order))."""
 
     energy: float | None
     note: str | None = None
@@ -215,6 +224,7 @@ class Loop:
     jumps: tuple = ()
     pieces: tuple = ()
     nodes: tuple = ()
+    inner: tuple = ()
 
 
 def cycle(segments, fold: Fold) -> Loop:
@@ -248,14 +258,16 @@ def cycle(segments, fold: Fold) -> Loop:
         i = j + 1
     pieces = _Pieces(segments, nodes, fold.weight, QUADRATURE_TOL)
     energy = quadrature = 0.0
+    inner = []
     for i, j, k in runs:
         for n in range(i, j):
-            value, err = pieces.integral(n)
+            value, err, halved = pieces.integral(n)
             energy += k * value
             quadrature += abs(k) * err
+            inner.append((n, tuple(halved)))
     jumped = approach[1] + retract[1]
     return Loop(energy, None, quadrature, pieces.solves, len(approach[1]) if runs else 0,
-                tuple(jumped) if runs else (), tuple(runs), tuple(nodes))
+                tuple(jumped) if runs else (), tuple(runs), tuple(nodes), tuple(inner))
 
 
 def energy_bar(result: Loop, fold: Fold, event_of) -> float | None:
@@ -304,3 +316,31 @@ def energy_bar(result: Loop, fold: Fold, event_of) -> float | None:
         e = max(worst if eu is None else eu, worst if ev is None else ev)
         bar += abs(fold.value(v.point) - fold.value(u.point)) * e
     return bar
+
+
+def border(result: Loop) -> list[tuple[int, int]]:
+    """The points of ``result``'s loops' borders (:func:`cycle`) as (node index, -1) for a node of
+    ``result.nodes`` and (node index, m) for the m-th point its piece was halved at, each once."""
+    out = {(n, -1) for i, j, _ in result.pieces for n in range(i, j + 1)}
+    out |= {(n, m) for n, pts in result.inner for m in range(len(pts))}
+    return sorted(out)
+
+
+def border_integral(result: Loop, points: dict, weight: float) -> float:
+    """The closed integral of F dc along the loops' borders through ``points`` (one for every key of
+    :func:`border`), each piece by the planar Hermite interpolants between the points it was halved at.
+
+    With the curve's own points it is the energy of :func:`cycle` (the same sums); with the same points
+    put on another level's curve (the corners, a fold and its landing, located there) it is that level's
+    energy by the same quadrature on the same partition, so that the difference of the two holds the
+    grid's change and not the quadrature's error.
+    """
+    nodes, inner = result.nodes, dict(result.inner)
+    total = 0.0
+    for i, j, k in result.pieces:
+        for n in range(i, j):
+            if nodes[n].seg != nodes[n + 1].seg:            # between two grids: one state, no work
+                continue
+            chain = [points[n, -1]] + [points[n, m] for m in range(len(inner.get(n, ())))] + [points[n + 1, -1]]
+            total += k * sum(_integral(a, b, weight) for a, b in zip(chain, chain[1:]))
+    return total

@@ -31,7 +31,7 @@ from mpi4py import MPI
 from ..core.events import Extremum, Fold, ParameterValue, Zero
 from ..discretization import grid
 from ..model.reference.rigid import far_deflection, load_beyond
-from . import energy
+from . import energy, error_bars
 from .curve import Assessment, Branch, Cycle, Event, Landing, Profile
 from .measured import Measured, Missing
 from .tracer import contact_radius
@@ -244,8 +244,11 @@ def unclosed(segments, reason: str) -> str | None:
     return None
 
 
-def _cycle(segments, fold, event_of_found, open_reason: str | None) -> Cycle:
-    """The cycle under ``fold``'s control: its energy and bar, or Missing with why (collective)."""
+def _cycle(segments, fold, event_of_found, open_reason: str | None, levels=None) -> Cycle:
+    """The cycle under ``fold``'s control: its energy and bar, or Missing with why (collective).
+
+    ``levels(loop)``: the loop's energy on the nested levels ({level: energy}, :func:`~.error_bars.energy_levels`)
+    or why not; None when the error bars were not asked for."""
     K = 1.0 / fold.weight if fold.weight else None
     if open_reason is not None:
         return Cycle(Missing(open_reason), None, K)
@@ -253,13 +256,34 @@ def _cycle(segments, fold, event_of_found, open_reason: str | None) -> Cycle:
     if loop.energy is None:
         assert loop.note is not None, "a cycle not walked says why"
         return Cycle(Missing(loop.note), None, K)
-    return Cycle(Measured(loop.energy, energy.energy_bar(loop, fold, event_of_found)), loop.loops, K)
+    return Cycle(_energy(loop, fold, event_of_found, levels), loop.loops, K)
 
 
-def curve(segments, estimates: dict, profiles: bool = False) -> Traced:
+def _energy(loop, fold, event_of_found, levels) -> Measured:
+    """The energy of a walked cycle with its bar (collective).
+
+    The value is the curve's own (level 0: the integral of the branch the files hold).  Its bar: the loop
+    computed whole on one other level of its grids (:func:`~.error_bars.energy_levels`), three times the
+    level-0 value's distance from Richardson's value of the two (:func:`~.error_bars.energy_bar_of`), plus
+    the quadrature's estimate; the errors of the jumps and of the borders cancel within each level's loop,
+    which this credits (docs/coverage.md).  Where the level cannot be had (a jump not located on it, a point
+    not carried), the bound of :func:`~.energy.energy_bar` (sums of the events' errors), with a note saying
+    so.  0 without hysteresis: both walks cover the same stretch, a computed 0."""
+    if not loop.pieces:
+        return Measured(loop.energy, 0.0)
+    got = levels(loop) if levels is not None else None
+    if isinstance(got, dict):
+        return Measured(loop.energy, error_bars.energy_bar_of(got) + loop.quadrature_err)
+    bound = energy.energy_bar(loop, fold, event_of_found)
+    note = None if got is None or bound is None else f"bar bounded by the events' errors ({got})"
+    return Measured(loop.energy, bound, note=note)
+
+
+def curve(segments, estimates: dict, profiles: bool = False, tracer=None) -> Traced:
     """The traced curve (its segments, in order) as values: its branch, its events with their bars
     (``estimates``: the :class:`~.error_bars.Estimate` of each located event by ``id`` of its ``Found``,
-    Missing where it failed; none asked for: absent), the pull-off, its cycles.
+    Missing where it failed; none asked for: absent), the pull-off, its cycles (``tracer``: the one that
+    traced the segments, for the energy's levels; None, or no estimates: the energy's bar from the events').
 
     Collective.  ``profiles`` (rank 0, else empty): the nodes and the pressure of
     every point, for the resolution check.
@@ -273,7 +297,9 @@ def curve(segments, estimates: dict, profiles: bool = False) -> Traced:
     why = unclosed(segments, stop_reason(last.stop, last.set))
     cycles = {}
     for fold in (e for e in segments[0].finder.events if isinstance(e, Fold)):
-        cycles["spring" if fold.weight else "rigid"] = _cycle(segments, fold, lambda f: by_found[id(f)], why)
+        levels = None if tracer is None or not estimates else \
+            (lambda loop, fold=fold: error_bars.energy_levels(tracer, loop, fold, lambda f: estimates.get(id(f))))
+        cycles["spring" if fold.weight else "rigid"] = _cycle(segments, fold, lambda f: by_found[id(f)], why, levels)
     states = []
     for seg in segments:
         pb = seg.problem
