@@ -31,7 +31,7 @@ from concurrent.futures import ThreadPoolExecutor
 from . import paths
 
 __all__ = ["MUS", "SIGMAS", "EXTRA", "TRUNCATED", "TRUNCATED_OPTIONS", "cell", "main", "OUT", "TIMEOUT", "HEAD",
-           "STABILITY_DOC", "TRUNCATED_MARK", "LEVELS",
+           "STABILITY_DOC", "TRUNCATED_MARK", "REFINED_MARK", "LEVELS",
            "refinement", "refinement_table", "HALF_INFINITE_10", "TRUNCATION", "truncated_check"]
 
 MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 4.5, 7.0, 10.0, 20.0, 50.0, 100.0, 300.0, 1000.0)
@@ -46,8 +46,10 @@ TRUNCATED_OPTIONS = ("-adh_rmax", "10", "-adh_farfield", "false")
 OUT = os.path.join(paths.DOCS, "stability.md")
 #: mu = 10 truncated takes about 3950 steps in the physical frame (tracing/edge_grids.py MU_TRUNCATED).
 TIMEOUT = 1800
-#: The line that opens the truncated model's table in docs/stability.md (``truncated`` rewrites what follows).
+#: The line that opens the truncated model's table in docs/stability.md (``truncated`` rewrites what follows,
+#: up to REFINED_MARK: the refinement tables after it are kept).
 TRUNCATED_MARK = "## The truncated model"
+REFINED_MARK = "## The truncated model's events refined"
 
 
 def cell(mu: float, sigma: float, extra=()) -> dict:
@@ -200,6 +202,11 @@ def _truncated_table(cells) -> str:
                                 done=sum(_done(c) for c, _ in cells), total=len(cells), failures=_failures(cells))
 
 
+def _refined_tail(text: str) -> str:
+    """The refinement tables of docs/stability.md (from REFINED_MARK on), kept when the tables above are made."""
+    return "\n" + REFINED_MARK + text.split(REFINED_MARK, 1)[1] if REFINED_MARK in text else ""
+
+
 def _rerun_truncated(pairs) -> int:
     """The truncated cells ``pairs`` (mu, sigma) traced again, their rows of docs/stability.md replaced (the
     others kept as they were), the counts made again from the rows."""
@@ -210,7 +217,8 @@ def _rerun_truncated(pairs) -> int:
     cells = {(c["mu"], c["sigma"]): c for c, _ in _run([(m, s, TRUNCATED_OPTIONS, "truncated") for m, s in pairs])}
     with open(OUT) as f:
         text = f.read()
-    head, section = text.split(TRUNCATED_MARK)
+    head, section = text.split(TRUNCATED_MARK, 1)
+    section = section.split(REFINED_MARK)[0]
     old_rows, old_failures = {}, {}
     for line in section.splitlines():
         parts = [p.strip() for p in line.split("|")]
@@ -237,7 +245,8 @@ def _rerun_truncated(pairs) -> int:
     with open(OUT, "w") as f:
         f.write(head.rstrip("\n") + "\n\n" + TRUNCATED_DOC.format(head=HEAD, rows="\n".join(rows), done=done,
                                                                 total=len(rows),
-                                                                failures="\n".join(failures) or "none"))
+                                                                failures="\n".join(failures) or "none")
+                + _refined_tail(text))
     print(f"{len(cells)} truncated cells traced again; {done} of {len(rows)} completed; docs/stability.md written")
     return 0
 
@@ -265,7 +274,7 @@ def main(argv: list[str]) -> int:
             text = f.read()
         head = text.split(TRUNCATED_MARK)[0].rstrip("\n") + "\n\n"
         with open(OUT, "w") as f:
-            f.write(head + _truncated_table(cells))
+            f.write(head + _truncated_table(cells) + _refined_tail(text))
         print(f"{sum(_done(c) for c, _ in cells)} of {len(cells)} truncated cells completed; docs/stability.md written")
         return 0
     if argv[:1] == ["truncated"]:
@@ -280,11 +289,13 @@ def main(argv: list[str]) -> int:
     main_cells, trunc_cells = cells[:len(jobs)], cells[len(jobs):]
     rows = "\n".join(_row(c, w) for c, w in main_cells)
     done = sum(_done(c) for c, _ in main_cells)
+    with open(OUT) as f:
+        tail = _refined_tail(f.read())
     with open(OUT, "w") as f:
         f.write(STABILITY_DOC.format(head=HEAD, rows=rows, done=done, total=len(main_cells),
                                      failures=_failures(main_cells),
                                      machine=f"{os.cpu_count()} cores, two cells at a time, one rank each")
-                + _truncated_table(trunc_cells))
+                + _truncated_table(trunc_cells) + tail)
     print(f"{done} of {len(main_cells)} cells and {sum(_done(c) for c, _ in trunc_cells)} of {len(trunc_cells)} "
           f"truncated cells completed; docs/stability.md written")
     return 0
