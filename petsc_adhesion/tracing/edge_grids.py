@@ -150,7 +150,8 @@ def sharp(model) -> bool:
 #: The truncated model (-adh_farfield false) on grids that follow the edge, traced in the physical frame
 #: throughout (:func:`frame_of_edge`, on :func:`margined` grids), up to this mu: there every step moves the
 #: edge by about a tenth of its zone, so the steps grow like the edge's travel over the zone, about mu^2
-#: (mu = 5: 755, mu = 7: 1704, mu = 10: about 3950 steps to F = 2, within -cont_max_steps' default).
+#: (mu = 5: 755, mu = 7: 1704 to F = 2, mu = 10: 3977 to F = 2 when it was traced on past r_m, within
+#: -cont_max_steps' default; it now stops where its contact reaches r_m, before F = 2).
 MU_TRUNCATED = 10.0
 
 
