@@ -1145,13 +1145,53 @@ def test_shared_memory_folder_unusable(tmp_path, np_):
     assert listing(out) == []
 
 
+def test_library_start_refuses_unusable_tmpdir(tmp_path):
+    """Guarantee 9, the library's start: a first call (petsc_adhesion.curve) in a process whose TMPDIR is a
+    file raises RuntimeError, one line naming TMPDIR and the remedy, before MPI_Init (it was Open MPI's page
+    from orte_init and MPI_Init's abort, exit 1, the caller's process gone); the caller goes on."""
+    (tmp_path / "afile").write_text("x")
+    code = ("import petsc_adhesion\n"
+            "try:\n    petsc_adhesion.curve(1.0, cont_F_max=0)\n"
+            "except RuntimeError as e:\n    print('said:', e)\n"
+            "print('the caller goes on')\n")
+    env = dict(conftest._env(), TMPDIR=str(tmp_path / "afile"))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=HANG)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr[-1500:]
+    assert proc.stdout.splitlines() == [f"said: TMPDIR: '{tmp_path / 'afile'}' is not a writable directory (MPI keeps "
+                                        f"its session files there): set it to one that is, or unset it",
+                                        "the caller goes on"], proc.stdout
+
+
+@needs_mpiexec
+def test_tmpdir_under_a_bare_mpiexec(tmp_path):
+    """Guarantee 9 under `mpiexec -n 2` (not ./run): Open MPI's launcher makes its session folder in TMPDIR
+    before any rank runs, so a TMPDIR it cannot use is its own text and no code of ours runs (documented:
+    docs/guarantees.md, docs/install.md): nothing written, no line of ours.  A TMPDIR the ranks alone are
+    given (mpiexec -x, env) is not read by their MPI_Init: the run is not refused for it, and completes."""
+    (tmp_path / "afile").write_text("x")
+    out = tmp_path / "out"
+    out.mkdir()
+    base = [shutil.which("mpiexec"), "-n", "2"]
+    run = [sys.executable, "-m", "petsc_adhesion", *SOLVE, "-summary", str(out / "s.json")]
+    env = conftest._env()
+    proc = subprocess.run(base + run, cwd=out, env=dict(env, TMPDIR=str(tmp_path / "afile")), capture_output=True,
+                          text=True, timeout=HANG)
+    assert proc.returncode not in (0, None) and "petsc-adhesion" not in proc.stderr + proc.stdout, proc.stderr
+    assert listing(out) == []
+    proc = subprocess.run(base + ["env", f"TMPDIR={tmp_path / 'afile'}"] + run, cwd=out, env=env,
+                          capture_output=True, text=True, timeout=HANG)
+    assert proc.returncode == 0 and listing(out) == ["s.json"], proc.stderr[-1500:]
+
+
 def test_dev_shm_unusable_in_process(tmp_path, monkeypatch):
     """Guarantee 9, in-process: /dev/shm itself not a writable folder, on a rank of two: the line names it and
     says how to mend it; on one rank nothing is said."""
+    from petsc_adhesion import singleton
     from petsc_adhesion.app import cli as app_cli
 
-    monkeypatch.setattr(app_cli, "SHARED_MEMORY_DEFAULT", str(tmp_path / "missing-shm"))
-    for v in app_cli.SHARED_MEMORY_VARIABLES:
+    monkeypatch.setattr(singleton, "SHARED_MEMORY_DEFAULT", str(tmp_path / "missing-shm"))
+    for v in singleton.SHARED_MEMORY_VARIABLES:
         monkeypatch.delenv(v, raising=False)
     monkeypatch.delenv("TMPDIR", raising=False)
     monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")

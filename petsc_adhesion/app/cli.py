@@ -21,6 +21,7 @@ from contextlib import nullcontext
 
 from ..errors import Interrupted, first_line, printable, say, tell
 from ..io.resultset import said_after
+from ..singleton import surroundings
 from .optionsfile import environment_error, file_error, named_file_error, options_files, stray_word
 
 __all__ = ["main", "input_error", "EXIT_OK", "EXIT_FAILED", "EXIT_INPUT", "EXIT_INCOMPLETE"]
@@ -155,41 +156,10 @@ def _program(argv: list[str]) -> int:
     return run.main(opts, argv, helping)
 
 
-#: Where Open MPI's shared-memory transport keeps its segments, the variable that moves it (Open MPI 4's vader,
-#: 5's sm), and its default.
-SHARED_MEMORY_VARIABLES = ("OMPI_MCA_btl_vader_backing_directory", "OMPI_MCA_btl_sm_backing_directory")
-SHARED_MEMORY_DEFAULT = "/dev/shm"
-
-
-def _writable_directory(path: str) -> bool:
-    return os.path.isdir(path) and os.access(path, os.W_OK | os.X_OK)
-
-
 def environment() -> str | None:
-    """What in the process's surroundings would make MPI or PETSc fail with a page of text, in one line, or None:
-    a working directory that was removed (PETSc reads .petscrc there), a TMPDIR Open MPI cannot write its
-    session files into, and on several ranks a shared-memory folder (/dev/shm, or the one Open MPI is told to
-    use) the ranks cannot make their segments in (Open MPI's page of warnings at MPI_Init, or its abort).  One
-    process alone makes no segment (measured: a singleton runs with that folder unusable), so it is not
-    asked."""
-    try:
-        os.getcwd()
-    except OSError:
-        return "the working directory no longer exists (it was removed): change to one that does"
-    tmp = os.environ.get("TMPDIR")
-    if tmp is not None and not (os.path.isdir(tmp) and os.access(tmp, os.W_OK | os.X_OK)):
-        return f"TMPDIR: '{printable(tmp)}' is not a writable directory (MPI keeps its session files there): " \
-               f"set it to one that is, or unset it"
-    size = os.environ.get("OMPI_COMM_WORLD_SIZE", "1")
-    if size.isdigit() and int(size) > 1:
-        named = next((v for v in SHARED_MEMORY_VARIABLES if os.environ.get(v)), None)
-        shm = os.environ[named] if named else SHARED_MEMORY_DEFAULT
-        if not _writable_directory(shm):
-            where = f"{named}: '{printable(shm)}'" if named else f"'{shm}'"
-            remedy = "set it to a writable folder, or unset it" if named else \
-                f"mount it writable (a tmpfs), or set {SHARED_MEMORY_VARIABLES[0]} to a writable folder such as /tmp"
-            return f"{where} is not a writable directory (the ranks share memory through files there): {remedy}"
-    return None
+    """What in the process's surroundings would make MPI or PETSc fail with a page of text, in one line, or
+    None (:func:`petsc_adhesion.singleton.surroundings`)."""
+    return surroundings()
 
 
 def _main(argv: list[str]) -> int:

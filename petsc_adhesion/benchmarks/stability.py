@@ -3,7 +3,9 @@
     ./run stability            # all cells, two at a time, into docs/stability.md (about 6 minutes)
     ./run stability 20 2       # one cell (mu, sigma), printed
     ./run stability truncated  # the truncated model's rows only, into their table of docs/stability.md
+    python -m petsc_adhesion.benchmarks.stability truncated 10 0 [MU SIGMA ...]  # those rows only, rewritten
     python -m petsc_adhesion.benchmarks.stability refinement 10 -6 [STEPS]  # its events on levels -2 .. 2
+    python -m petsc_adhesion.benchmarks.stability truncated-check  # mu = 10 to F = 0.5 against the half-infinite
 
 Each cell traces the curve from far apart to F >= 2 with the program's
 defaults and -cont_error_estimate, as a user would, and records whether it
@@ -29,8 +31,8 @@ from concurrent.futures import ThreadPoolExecutor
 from . import paths
 
 __all__ = ["MUS", "SIGMAS", "EXTRA", "TRUNCATED", "TRUNCATED_OPTIONS", "cell", "main", "OUT", "TIMEOUT", "HEAD",
-           "STABILITY_DOC", "TRUNCATED_MARK", "LEVELS",
-           "refinement", "refinement_table"]
+           "STABILITY_DOC", "TRUNCATED_MARK", "REFINED_MARK", "LEVELS",
+           "refinement", "refinement_table", "HALF_INFINITE_10", "TRUNCATION", "truncated_check"]
 
 MUS = (0.001, 0.01, 0.1, 1.0, 3.0, 4.5, 7.0, 10.0, 20.0, 50.0, 100.0, 300.0, 1000.0)
 SIGMAS = (0.0, 0.1, 0.2, 0.4, 1.0, 2.0)
@@ -39,13 +41,15 @@ EXTRA = ((1.0, 0.0, ("-cont_F_max", "50"), "strong compression"),
          (10.0, 0.0, ("-cont_F_max", "50"), "strong compression"),
          (1e-4, 0.0, (), "smallest Tabor parameter"))
 #: The truncated model's cells (mu, sigma) and their options: r_m = 10 without the far field (the paper's model).
-TRUNCATED = tuple((m, s) for m in (0.1, 1.0, 3.0, 10.0) for s in (0.0, 0.3, 1.0))
+TRUNCATED = tuple((m, s) for m in (0.1, 1.0, 3.0, 10.0) for s in (0.0, 0.3, 1.0)) + ((5.0, 0.0), (7.0, 0.0))
 TRUNCATED_OPTIONS = ("-adh_rmax", "10", "-adh_farfield", "false")
 OUT = os.path.join(paths.DOCS, "stability.md")
 #: mu = 10 truncated takes about 3950 steps in the physical frame (tracing/edge_grids.py MU_TRUNCATED).
 TIMEOUT = 1800
-#: The line that opens the truncated model's table in docs/stability.md (``truncated`` rewrites what follows).
+#: The line that opens the truncated model's table in docs/stability.md (``truncated`` rewrites what follows,
+#: up to REFINED_MARK: the refinement tables after it are kept).
 TRUNCATED_MARK = "## The truncated model"
+REFINED_MARK = "## The truncated model's events refined"
 
 
 def cell(mu: float, sigma: float, extra=()) -> dict:
@@ -129,6 +133,42 @@ def refinement(mu: float, lam_max: float = math.inf, steps: int | None = None, s
     return out
 
 
+#: The half-infinite model's turning points at mu = 10 (the mu = 10 row of the table above, its summary):
+#: snap-on, snap-off, snap-on before the contact, and the contact's snap-off, each with a bar below 2e-6.
+HALF_INFINITE_10 = (-6.08463995, -6.42384017, -6.31243824, -16.20065750)
+#: What the truncation moves them by at most: the load beyond r_m = 10 is about 5e-4 of the pull-off at
+#: these approaches (reference.load_beyond), the deflection it causes inside 8.5e-5 (far_deflection); the
+#: turning points before the contact, where the load is about 0.05, move by 1.7e-3 (measured).
+TRUNCATION = 5e-3
+
+
+def truncated_check() -> list[str]:
+    """mu = MU_TRUNCATED = 10 truncated at r_m = 10, traced past its equilibrium to F = 0.5 (about 3000 steps,
+    143 s: too slow for the suite; tests/test_truncated.py checks mu = 4): what is wrong, one line each (none
+    when the curve completes with exit 0 and no warning, has two fold pairs as the half-infinite model has,
+    within TRUNCATION of its turning points, a pull-off within 1% of JKR's -3/4 and one equilibrium)."""
+    from ..model.reference.jkr import JKR_PULL_OFF
+    from ..tracing.edge_grids import MU_TRUNCATED
+
+    c = cell(MU_TRUNCATED, 0.0, (*TRUNCATED_OPTIONS, "-cont_F_max", "0.5", "-cont_error_estimate", "false"))
+    s, wrong = c["summary"], []
+    if c["status"] != 0 or s is None or not s["complete"] or s["warnings"]:
+        return [f"exit {c['status']}: {c['error'] or (s and s['warnings'])}"]
+    kinds = [e["kind"] for e in s["folds"]]
+    if kinds != ["snap_on", "snap_off", "snap_on", "snap_off"]:
+        wrong.append(f"turning points {kinds}, not two pairs")
+    for e, half in zip(s["folds"], HALF_INFINITE_10):
+        if abs(e["lambda"] - half) >= TRUNCATION:
+            wrong.append(f"{e['kind']} at lambda = {e['lambda']:.8f}, the half-infinite model's at {half:.8f}")
+    if abs(s["pull_off"]["F"] / JKR_PULL_OFF - 1) >= 0.01:
+        wrong.append(f"pull-off F = {s['pull_off']['F']:.6f}, more than 1% from JKR's {JKR_PULL_OFF}")
+    if len(s["equilibria"]) != 1:
+        wrong.append(f"{len(s['equilibria'])} equilibria, not one")
+    print(f"mu = 10 truncated to F = 0.5: {s['steps']} steps, {c['wall_s']:.0f} s; turning points "
+          + ", ".join(f"{e['lambda']:.6f}" for e in s["folds"]) + f"; pull-off {s['pull_off']['F']:.6f}")
+    return wrong
+
+
 def refinement_table(rows) -> str:
     """:func:`refinement`'s rows as a markdown table: the values, the ratios of successive differences, and
     the default value's distance from the Richardson value of levels 1 and 2 in units of its bar."""
@@ -162,6 +202,58 @@ def _truncated_table(cells) -> str:
                                 done=sum(_done(c) for c, _ in cells), total=len(cells), failures=_failures(cells))
 
 
+def _refined_tail(text: str) -> str:
+    """The refinement tables of docs/stability.md (from REFINED_MARK on), kept when the tables above are made."""
+    return "\n" + REFINED_MARK + text.split(REFINED_MARK, 1)[1] if REFINED_MARK in text else ""
+
+
+def _rerun_truncated(pairs) -> int:
+    """The truncated cells ``pairs`` (mu, sigma) traced again, their rows of docs/stability.md replaced (the
+    others kept as they were), the counts made again from the rows."""
+    unknown = [p for p in pairs if p not in TRUNCATED]
+    if unknown:
+        print(f"not a truncated cell: {unknown}; the cells are {TRUNCATED}", file=sys.stderr)
+        return 2
+    cells = {(c["mu"], c["sigma"]): c for c, _ in _run([(m, s, TRUNCATED_OPTIONS, "truncated") for m, s in pairs])}
+    with open(OUT) as f:
+        text = f.read()
+    head, section = text.split(TRUNCATED_MARK, 1)
+    section = section.split(REFINED_MARK)[0]
+    old_rows, old_failures = {}, {}
+    for line in section.splitlines():
+        parts = [p.strip() for p in line.split("|")]
+        if line.startswith("| ") and len(parts) > 3 and parts[2].endswith("truncated"):
+            old_rows[(float(parts[1]), float(parts[2].split()[0]))] = line
+        elif line.startswith("- mu = "):
+            mu, sigma = line[len("- mu = "):].split(":")[0].replace("sigma = ", "").replace(" truncated", "").split(",")
+            old_failures[(float(mu), float(sigma))] = line
+        elif line.startswith("Cells not completed: - mu = "):
+            rest = line[len("Cells not completed: "):]
+            mu, sigma = rest[len("- mu = "):].split(":")[0].replace("sigma = ", "").replace(" truncated", "").split(",")
+            old_failures[(float(mu), float(sigma))] = rest
+    rows, failures = [], []
+    for key in TRUNCATED:
+        if key in cells:
+            rows.append(_row(cells[key], "truncated"))
+            if not _done(cells[key]):
+                failures.append(_failures([(cells[key], "truncated")]))
+        elif key in old_rows:
+            rows.append(old_rows[key])
+            if key in old_failures:
+                failures.append(old_failures[key])
+    done = sum(1 for r in rows if r.split("|")[3].strip() == "yes")
+    unrun = [f"mu = {m:g}, sigma = {sg:g}" for m, sg in TRUNCATED if (m, sg) not in cells and (m, sg) not in old_rows]
+    said = ("\n".join(failures) or "none") + \
+        (f"\n\nCells without a row (in TRUNCATED, not traced yet): {'; '.join(unrun)}" if unrun else "")
+    with open(OUT, "w") as f:
+        f.write(head.rstrip("\n") + "\n\n" + TRUNCATED_DOC.format(head=HEAD, rows="\n".join(rows), done=done,
+                                                                total=len(rows),
+                                                                failures=said)
+                + _refined_tail(text))
+    print(f"{len(cells)} truncated cells traced again; {done} of {len(rows)} completed; docs/stability.md written")
+    return 0
+
+
 def _run(jobs) -> list:
     with ThreadPoolExecutor(2) as pool:
         return list(pool.map(lambda j: (cell(*j[:3]), j[3]), jobs))
@@ -175,15 +267,22 @@ def main(argv: list[str]) -> int:
         mu, lam_max = float(argv[1]), float(argv[2]) if len(argv) > 2 else math.inf
         print(refinement_table(refinement(mu, lam_max, int(argv[3]) if len(argv) > 3 else None)))
         return 0
+    if argv == ["truncated-check"]:
+        wrong = truncated_check()
+        print("\n".join(wrong) or "mu = 10 truncated: as the half-infinite model, within TRUNCATION")
+        return 1 if wrong else 0
     if argv == ["truncated"]:
         cells = _run(truncated)
         with open(OUT) as f:
             text = f.read()
         head = text.split(TRUNCATED_MARK)[0].rstrip("\n") + "\n\n"
         with open(OUT, "w") as f:
-            f.write(head + _truncated_table(cells))
+            f.write(head + _truncated_table(cells) + _refined_tail(text))
         print(f"{sum(_done(c) for c, _ in cells)} of {len(cells)} truncated cells completed; docs/stability.md written")
         return 0
+    if argv[:1] == ["truncated"]:
+        pairs = [(float(argv[i]), float(argv[i + 1])) for i in range(1, len(argv) - 1, 2)]
+        return _rerun_truncated(pairs)
     if argv:
         c = cell(float(argv[0]), float(argv[1]))
         print(HEAD + "\n" + _row(c))
@@ -193,11 +292,13 @@ def main(argv: list[str]) -> int:
     main_cells, trunc_cells = cells[:len(jobs)], cells[len(jobs):]
     rows = "\n".join(_row(c, w) for c, w in main_cells)
     done = sum(_done(c) for c, _ in main_cells)
+    with open(OUT) as f:
+        tail = _refined_tail(f.read())
     with open(OUT, "w") as f:
         f.write(STABILITY_DOC.format(head=HEAD, rows=rows, done=done, total=len(main_cells),
                                      failures=_failures(main_cells),
                                      machine=f"{os.cpu_count()} cores, two cells at a time, one rank each")
-                + _truncated_table(trunc_cells))
+                + _truncated_table(trunc_cells) + tail)
     print(f"{done} of {len(main_cells)} cells and {sum(_done(c) for c, _ in trunc_cells)} of {len(trunc_cells)} "
           f"truncated cells completed; docs/stability.md written")
     return 0
@@ -234,18 +335,27 @@ Cells not completed: {failures}
 
 TRUNCATED_DOC = """## The truncated model
 
-<!-- made by: ./run stability truncated (python -m petsc_adhesion.benchmarks.stability truncated) -->
+<!-- made by: ./run stability truncated (python -m petsc_adhesion.benchmarks.stability truncated); rows
+     traced again alone by: python -m petsc_adhesion.benchmarks.stability truncated MU SIGMA ... -->
 The paper's own model, `-adh_rmax 10 -adh_farfield false` (the domain ends at r_m = 10, nothing
 added beyond), with the defaults otherwise and `-cont_error_estimate`.  It is traced in the physical
 frame throughout (a grid in r / a could not keep its end at r_m), on grids graded about the contact
 edge and regridded as it moves; a sharp edge (mu > 3.3) gets COARSE_MARGIN = 4 times the nodes a
 zone of NODES_PER_ZONE (tracing/edge_grids.py `margined`), so that the edge crossing the nodes
 makes no spurious turning points.  Every step there moves the edge by about a tenth of its zone:
-the steps grow about as mu^2 (mu = 10: 3977 steps), and mu = 10 is the most it is traced to
-(MU_TRUNCATED).  A domain of r_m = 10 is small for a soft sphere: at mu = 10 the smooth contact
-reaches it before F = 2 (its edge at r = 9.75, the gap at r_m below 13 epsilon, |P(r_m)| above 1e-3 of the peak
-attraction), and the run says so with exit 3, the model's limit and not the grid's (its curve and
-events are whole; tests/test_truncated.py traces it to F = 0.5 with exit 0).
+the steps grow about as mu^2, and mu = 10 is the most it is traced to (MU_TRUNCATED).
+
+A domain of r_m = 10 is small for a soft sphere.  Where the contact's attraction reaches r_m
+(|P(r_m)| above 1e-3 of the peak attraction, the gap there below about 13 epsilon) the truncated
+model ends, and so does its curve: the run stops there, its events before it whole with their
+bars, and says where it ended and what to do (a larger `-adh_rmax`, or `-cont_F_max` up to that
+load) with exit 3, since the curve asked for (to F = 2) is not all there.  At mu = 10 that
+happens before F = 2.  A `-cont_F_max` beyond the load at which even Hertz's contact (the
+narrowest an adhesive contact has at a given load) reaches r_m, (2 / (3 pi)) r_m^3 mu^-1.5
+(6.71 at mu = 10), is refused in one line before any work (tracing/edge_grids.py `domain_load`).
+`python -m petsc_adhesion.benchmarks.stability truncated-check` traces mu = 10 to F = 0.5 and
+checks its turning points against the half-infinite model's (within 5e-3) and its pull-off
+against JKR's (within 1%); tests/test_truncated.py checks mu = 4 so in the suite.
 {done} of {total} cells completed.
 
 {head}

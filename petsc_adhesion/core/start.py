@@ -7,6 +7,10 @@ end in PETSc's error page and MPI_Abort.  It is started with
 records it), and the handlers the process had before (Python's: SIGPIPE ignored,
 so a write to a closed pipe is an error the writer sees; the command line's:
 SIGINT, SIGTERM and SIGHUP end the run in one line) are kept.
+
+Before MPI_Init the process's surroundings are asked (:func:`petsc_adhesion.singleton.surroundings`): an
+unwritable TMPDIR in a process that starts MPI itself would end a library call's process in Open MPI's
+page and abort; it is a :class:`StartError` in one line with its remedy instead.
 """
 from __future__ import annotations
 
@@ -16,16 +20,29 @@ import signal
 import sys
 import threading
 
-__all__ = ["start_petsc", "KEPT_SIGNALS"]
+from ..singleton import surroundings
+
+__all__ = ["start_petsc", "KEPT_SIGNALS", "StartError"]
 
 #: The signals whose handlers the process keeps through PETSc's start-up.
 KEPT_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP", "SIGPIPE") if hasattr(signal, name))
 
 
+class StartError(RuntimeError):
+    """MPI cannot start in these surroundings: one line naming what and the remedy."""
+
+
 def start_petsc(argv: list[str] | None = None) -> bool:
-    """Initialise PETSc with ``argv`` (its options) unless it runs already; True when it was started here."""
+    """Initialise PETSc with ``argv`` (its options) unless it runs already; True when it was started here.
+
+    StartError, before MPI_Init, where the surroundings would make it abort (MPI not yet started by
+    anyone: once mpi4py has, its session folder exists and nothing here is asked)."""
     if "petsc4py.PETSc" in sys.modules:
         return False
+    if "mpi4py.MPI" not in sys.modules:
+        bad = surroundings()
+        if bad:
+            raise StartError(bad)
     import petsc4py
 
     kept = {s: signal.getsignal(s) for s in KEPT_SIGNALS}

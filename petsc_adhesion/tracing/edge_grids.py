@@ -16,7 +16,7 @@ from ..model.pressure import pressure_law
 
 __all__ = ["BAND", "BAND_ZONES", "CONTACT_SPACING", "REACH", "RMAX", "A_SWITCH", "A_SWITCH_ZONES", "GROW", "band",
            "a_switch", "grid_for", "scaled_grid_for", "scaled_band", "sharp",
-           "frame_of_edge", "MU_TRUNCATED", "soft", "margined"]
+           "frame_of_edge", "MU_TRUNCATED", "soft", "margined", "EDGE_SHARE", "PEAK_ATTRACTION", "domain_load"]
 
 
 #: Half-width of the fine band about the edge in the physical frame ...
@@ -150,8 +150,28 @@ def sharp(model) -> bool:
 #: The truncated model (-adh_farfield false) on grids that follow the edge, traced in the physical frame
 #: throughout (:func:`frame_of_edge`, on :func:`margined` grids), up to this mu: there every step moves the
 #: edge by about a tenth of its zone, so the steps grow like the edge's travel over the zone, about mu^2
-#: (mu = 5: 755, mu = 7: 1704, mu = 10: about 3950 steps to F = 2, within -cont_max_steps' default).
+#: (mu = 5: 755, mu = 7: 1704 to F = 2, mu = 10: 3977 to F = 2 when it was traced on past r_m, within
+#: -cont_max_steps' default; it now stops where its contact reaches r_m, before F = 2).
 MU_TRUNCATED = 10.0
+
+
+#: The contact reaches the end of the domain when |P(r_m)| exceeds this share of the peak attraction: there the
+#: truncated model (nothing beyond r_m) ends, and its curve stops (:class:`~petsc_adhesion.tracing.tracer.Tracer`).
+EDGE_SHARE = 1e-3
+#: The peak of the Lennard-Jones attraction, |P| at H + 1 = 3^(1/6) (units 8 gamma / (3 epsilon)).
+PEAK_ATTRACTION = 2.0 / (3.0 * 3.0 ** 0.5)
+
+
+def domain_load(mu: float, rmax: float) -> float:
+    """The load at which Hertz's contact radius reaches r_m: F_H = (2 / (3 pi)) r_m^3 mu^(-3/2).
+
+    Hertz (1882), a^3 = 3 P R / (4 E*), in the model's units (contact radii in sqrt(epsilon R), loads in
+    2 pi R gamma; the first term of :func:`~petsc_adhesion.model.reference.jkr.jkr_load`).  At a given load
+    adhesion only widens the contact (the Maugis-Dugdale family runs from Hertz's and DMT's radius to JKR's,
+    the widest), and roughness spreads the pressure further out, so the truncated model's contact has reached
+    r_m by F_H at the latest: a curve asked to go past it would leave the model's domain (infinite for a
+    rigid sphere, mu = 0, which does not deform)."""
+    return math.inf if mu <= 0 else 2.0 / (3.0 * math.pi) * rmax**3 / mu**1.5
 
 
 def frame_of_edge(model) -> bool:

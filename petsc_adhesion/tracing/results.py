@@ -34,6 +34,7 @@ from ..model.reference.rigid import far_deflection, load_beyond
 from . import energy, error_bars
 from .curve import Assessment, Branch, Cycle, Event, Landing, Profile
 from .measured import Measured, Missing
+from .edge_grids import EDGE_SHARE, PEAK_ATTRACTION
 from .tracer import contact_radius
 
 __all__ = ["curve_events", "spring_fold", "curve", "Traced", "stop_reason", "assess", "WALL_GAP", "event_of",
@@ -183,7 +184,9 @@ def stop_reason(stop, settings) -> str:
             "p_max": f"approach lambda = {value:.4g} >= -cont_lambda_max {settings.p_max:g}",
             "p_min": f"approach lambda = {value:.4g} <= {settings.p_min:g}",
             "max_steps": f"-cont_max_steps {value} reached",
-            "max_folds": f"more than -cont_max_folds {value} turning points"}[reason]
+            "max_folds": f"more than -cont_max_folds {value} turning points",
+            "domain_end": f"the contact reaches the end of the truncated model's domain r_m at lambda = "
+                          f"{value:.6g}"}[reason]
 
 
 def _current(segments, seg) -> list:
@@ -330,10 +333,6 @@ def curve(segments, estimates: dict, profiles: bool = False, tracer=None) -> Tra
         else None)
 
 
-#: The contact reaches the end of the domain when |P(r_m)| exceeds this share of the peak attraction.
-EDGE_SHARE = 1e-3
-#: The peak of the Lennard-Jones attraction, |P| at H + 1 = 3^(1/6) (units 8 gamma / (3 epsilon)).
-PEAK_ATTRACTION = 2.0 / (3.0 * 3.0 ** 0.5)
 
 
 def _missed_minimum(segments) -> str:
@@ -402,6 +401,16 @@ def assess(segments, res: Traced, grid_warning: str | None, at_lambda=()) -> Ass
         if not any(abs(x - t) <= 1e-9 * max(1.0, abs(t)) for x in found):
             short.append(f"-cont_at_lambda {t:g} not reached: the curve spans lambda in "
                          f"[{min(p.p for p in pts):.4g}, {max(p.p for p in pts):.4g}]")
+    rm = float(problem.nodes(pts[-1].x)[-1])         # in the frame of the edge r_m moves with the contact radius
+    if res.stop[0] == "domain_end":
+        # the truncated model ends at r_m: its curve stopped there, every event before it whole; the load
+        # asked for lies beyond the model's domain, not the grid's
+        end = pts[-1]
+        short.append(f"the curve ends at F = {end.values['F']:.4g} (lambda = {end.p:.6g}), short of -cont_F_max "
+                     f"{segments[-1].cont.set.observable_max:g}: there the contact reaches the end of the truncated "
+                     f"model's domain r_m = {rm:g}, beyond which it does not hold (its events before it are whole): "
+                     f"give a larger -adh_rmax, or -cont_F_max up to {end.values['F']:.3g}")
+        return Assessment(tuple(warn + short), tuple(short), grid_warning or None)
     edge = 0.0
     for seg in segments:
         last = seg.problem.hi == seg.problem.layout.N
@@ -410,7 +419,6 @@ def assess(segments, res: Traced, grid_warning: str | None, at_lambda=()) -> Ass
             if last:
                 edge = max(edge, abs(float(law(H[-1:])[0][0])))
     edge = mpi.allreduce(edge, op=MPI.MAX)
-    rm = float(problem.nodes(pts[-1].x)[-1])         # in the frame of the edge r_m moves with the contact radius
     if edge > EDGE_SHARE * PEAK_ATTRACTION:
         short.append(f"the contact reaches the end of the domain r_m = {rm:g} (|P(r_m)| up to "
                      f"{edge:.2g}): give a larger -adh_rmax")

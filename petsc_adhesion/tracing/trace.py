@@ -45,7 +45,7 @@ from . import error_bars, results
 from .legs import instrument_curve
 from .curve import Curve, Diagnostics, ErrorEstimate, GridRecord, Program, Solution, SpringResult
 from .measured import Missing
-from .edge_grids import MU_TRUNCATED, RMAX, grid_for
+from .edge_grids import MU_TRUNCATED, RMAX, domain_load, grid_for
 from .tracer import Segment, Tracer
 
 __all__ = ["GridChoice", "SolverChoice", "PetscSettings", "check_inputs", "CurveRequest", "curve_settings", "trace_curve", "solve_at", "rigid_edge",
@@ -315,6 +315,10 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
         raise ValueError(f"farfield False (the model truncated at r_m) is traced in the physical frame, up to "
                          f"mu = {MU_TRUNCATED:g}: got mu = {model.mu:g}")
     settings = settings or curve_settings(step_scale(model))
+    if not model.farfield and settings.observable == "F" and settings.observable_max > domain_load(model.mu, model.rmax):
+        raise ValueError(f"settings.observable_max: {settings.observable_max:g} lies beyond the truncated model's "
+                         f"domain at mu = {model.mu:g}: Hertz's contact reaches r_m = {model.rmax:g} at F = "
+                         f"{domain_load(model.mu, model.rmax):.4g}; give at most that, a larger rmax, or farfield True")
     lam0 = far_approach(model) if request.lambda_start is None else request.lambda_start
     if request.spring and request.lambda_start is None:
         lam0 = min(lam0, spring_start(request.spring))

@@ -44,6 +44,8 @@ from ..discretization.influence import create_influence
 from ..discretization.problem import Problem
 from ..discretization.resolution import zone_of
 from .edge_grids import (
+    EDGE_SHARE,
+    PEAK_ATTRACTION,
     a_switch,
     band,
     GROW,
@@ -161,6 +163,15 @@ class _Regrid:
         return False
 
 
+def at_domain_end(problem, x: np.ndarray) -> bool:
+    """Whether the contact of a physical-frame state x reaches the end of its domain r_m: |P(r_m)| above
+    EDGE_SHARE of the peak attraction (collective: the last node lies on the last rank)."""
+    local = 0.0
+    if problem.hi == problem.layout.N:
+        local = abs(float(problem.law(problem.separation(x)[-1:])[0][0]))
+    return problem.comm.tompi4py().allreduce(local, op=MPI.MAX) > EDGE_SHARE * PEAK_ATTRACTION
+
+
 #: Steps at most of the far branch traced back from the start (:meth:`Tracer.extend_back`); its steps grow
 #: by the continuation's factor 1.5 a step, so 200 reach lambda = -1e15 from a step of 0.05.
 FAR_STEPS = 200
@@ -251,12 +262,26 @@ class Tracer:
         if started:
             started()
         hook = (lambda: pause(self)) if pause else None
+        # the truncated model (no far field) ends at r_m: where its contact gets there the model no longer
+        # holds, and its curve stops (the half-infinite model goes on: beyond r_m the far field is added)
+        truncated = not self.model.farfield
         while True:
             regrid = _Regrid(self, seg) if seg.kind != "fixed" else None
+            ended = [False]
+
+            def until(a, b, seg=seg, regrid=regrid, ended=ended) -> bool:
+                if truncated and at_domain_end(seg.problem, b.x):
+                    ended[0] = True
+                    return True
+                return regrid is not None and regrid(a, b)
+
             if start is None:
-                seg.cont.resume(on_step=seg.finder, until=regrid, pause=hook)
+                seg.cont.resume(on_step=seg.finder, until=until, pause=hook)
             else:
-                seg.cont.run(start, on_step=seg.finder, until=regrid, pause=hook)
+                seg.cont.run(start, on_step=seg.finder, until=until, pause=hook)
+            if ended[0]:
+                seg.cont.stop = ("domain_end", seg.cont.points[-1].p)
+                return self.segments
             if regrid is None or regrid.next is None:
                 return self.segments
             seg, start = regrid.next

@@ -18,11 +18,11 @@ from ...io.inputs import size_words
 from ...model.parameters import Model
 from ...model.reference.jkr import jkr_zero_load
 from ...model.reference.rigid import load_beyond
-from ...tracing.edge_grids import MU_TRUNCATED
+from ...tracing.edge_grids import MU_TRUNCATED, domain_load
 from .reading import _NUMBER, AppOptions, _strict_float, _strict_int
 from .table import ROUGHNESS_OPTIONS, SOLVER_PREFIXES, TABLE, Option
 
-__all__ = ["DOMAIN_SHARE", "smallest_domain", "check_consistency", "check_memory", "memory_limits", "petsc_error", "PETSC_GLOBAL", "petsc_names", "check_unused", "check_petsc_values"]
+__all__ = ["truncated_too_far", "DOMAIN_SHARE", "smallest_domain", "check_consistency", "check_memory", "memory_limits", "petsc_error", "PETSC_GLOBAL", "petsc_names", "check_unused", "check_petsc_values"]
 
 
 #: The attraction beyond r_m may carry at most this share of the DMT pull-off at contact.
@@ -97,10 +97,21 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
                          f"reach of {DOMAIN_SHARE:.0%} of the attraction)")
 
 
+    F_max = opts.real("cont_F_max")
+    if not fixed and not model.farfield and model.rmax is not None and F_max > domain_load(model.mu, model.rmax):
+        raise InputError(truncated_too_far(model.mu, model.rmax, F_max))
     if not fixed and not model.farfield and kind == "edge" and model.mu > MU_TRUNCATED:
         raise InputError(f"-adh_farfield: false (the model truncated at r_m) is traced in the physical frame, up to "
                          f"mu = {MU_TRUNCATED:g}, got mu = {model.mu:g}: leave it true (the half-infinite model, r_m's "
                          f"error in the bar) or take -grid_type uniform")
+
+
+def truncated_too_far(mu: float, rmax: float, F_max: float) -> str:
+    """The line refusing -cont_F_max beyond the truncated model's domain (:func:`domain_load`)."""
+    need = (1.5 * math.pi * mu**1.5 * F_max) ** (1.0 / 3.0)
+    return (f"-cont_F_max: {F_max:g} lies beyond the truncated model's domain at mu = {mu:g}: even Hertz's contact, "
+            f"the narrowest at a given load, reaches r_m = {rmax:g} at F = {domain_load(mu, rmax):.4g}; expected at "
+            f"most that, or -adh_rmax above {need:.4g}, or -adh_farfield true (the half-infinite model)")
 
 
 #: Where a control group states the memory its processes may use, and what they use now (v2, then v1).
