@@ -31,7 +31,7 @@ from ..model.parameters import Model
 from ..model.physical import Bodies
 from ..tracing.curve import Program
 from ..tracing.trace import GridChoice
-from .options.checks import check_petsc_values, check_unused
+from .options.checks import check_misspelled, check_petsc_values
 from .options.reading import AppOptions, read_grid, read_model_spread, read_solver
 from .options.table import ROUGHNESS_OPTIONS, TABLE
 from .optionsfile import options_files
@@ -139,8 +139,7 @@ def _template(opts: AppOptions, rms: float | None, eps: float) -> Model:
 
 def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
     """Read and check a fit's options before any work (see the module)."""
-    opts.read_all()
-    check_unused(lambda n: n.startswith(("adh_", "grid_", "cont_", "fit_")) or n in TABLE)
+    check_misspelled(opts)          # before the options required together: a misspelling named as such
     check_petsc_values(opts.db)
     pull, path = opts.real("fit_pull_off"), opts.string("fit_curve")
     if pull is not None and path is not None:

@@ -41,6 +41,7 @@ from ..tracing.trace import (
 from .checkpoint import open_checkpoint
 from .options.checks import (
     check_consistency,
+    check_misspelled,
     check_memory,
     check_petsc_values,
     check_unused,
@@ -60,7 +61,6 @@ from .progress import Progress
 
 __all__ = ["Request", "read", "execute", "main", "is_study", "refuse_study_options"]
 
-_APP = ("adh_", "grid_", "cont_")
 _OUTPUTS = ("out", "summary", "plot", "csv", "csv_events")
 
 
@@ -68,10 +68,6 @@ def is_study(opts: AppOptions) -> bool:
     """Whether the options describe a study of many cases (:mod:`petsc_adhesion.app.study`)."""
     return any(opts.db.hasName(n) for n in ("study_mu", "study_sigma", "study_option")) or \
         opts.choice("study_compute") == "critical"
-
-
-def _is_app(name: str) -> bool:
-    return name.startswith(_APP) or name in TABLE
 
 
 @dataclass
@@ -93,14 +89,13 @@ class Request:
 def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False) -> Request:
     """Read and check every option before any work (PETSc's solver options too, as far as they can be judged
     before the solvers exist); ``kinds`` and ``profiles``: what a study's case reports."""
+    check_misspelled(opts)          # before the options required together: a misspelling named as such
     model = read_model(opts)
     grid_choice = read_grid(opts, model)
     lam = opts.real("adh_lambda")
     check_memory(grid_choice, opts.choice("adh_pmat"), lam is None, comm.getSize())
     if opts.string("adh_guess") is not None and lam is None:
         raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
-    opts.read_all()
-    check_unused(_is_app, opts.db)
     check_consistency(opts, model)
     check_petsc_values(opts.db)
     targets = {k: opts.string(k) for k in _OUTPUTS if opts.string(k)}
