@@ -105,7 +105,7 @@ def test_solve_and_rms(tmp_path):
     (("-phys_radius", 1e-3, "-phys_young1", 1e3, "-phys_poisson1", 0, "-phys_gamma", 1, "-phys_epsilon", 1e-10),
      "-phys_young1: with the other -phys_ options gives mu"),          # the modulus 1e-6 of a polymer's
     (SOFT + ("-phys_rms", 1e-8), "-phys_rms: gives sigma = rms / epsilon = 25"),
-    # a misspelling is named as such, before the option it leaves missing (issue 36)
+    # a misspelling is named as such, before the option it leaves missing
     (("-phys_radis", 1e-6) + SOFT[2:], "-phys_radis: unknown option (did you mean -phys_radius?)"),
     (SOFT[:6] + ("-phys_gama", 0.05) + SOFT[8:], "-phys_gama: unknown option (did you mean -phys_gamma?)"),
     (SOFT + ("-phys_young", 1e9, "-phys_poisson2", 0.3), "-phys_young: unknown option (did you mean -phys_young2?)"),

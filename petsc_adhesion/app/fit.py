@@ -33,6 +33,7 @@ from ..tracing.curve import Program
 from ..tracing.trace import GridChoice
 from .options.checks import check_misspelled, check_petsc_values
 from .options.reading import AppOptions, read_grid, read_model_spread, read_solver
+from .options.plausible import PLAUSIBLE, implausible
 from .options.table import ROUGHNESS_OPTIONS, TABLE
 from .optionsfile import options_files
 
@@ -79,6 +80,7 @@ class FitRequest:
     choice: FitChoice | None    # curve: what is fitted
     targets: dict
     spread_rules: tuple | None = None   # pull_off: the laws of gamma's model spread (None: none)
+    warnings: tuple = ()                # inputs outside what the field measures, one line each (plausible.py)
 
 
 def _given(opts: AppOptions, name: str) -> bool:
@@ -209,7 +211,8 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
                          FitChoice(modulus=fit_modulus, roughness=fit_rough), targets)
     if comm.getRank() == 0:
         check_targets(targets, inputs)
-    return req
+    # last: a fit refused says its one line, not warnings beside it
+    return replace(req, warnings=tuple(implausible({n: opts.real(n) for n in PLAUSIBLE if n in TABLE})))
 
 
 def _fit(req: FitRequest, comm):
@@ -241,7 +244,10 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     not hold (its warnings: a parameter at a bound or undetermined, a misfit; docs/fitting.md), its files
     written all the same; else 0."""
     comm = PETSc.COMM_WORLD
+    from .run import warn
+
     req = collective(comm, read, opts, comm, argv)
+    warn(req.warnings, report)
     fit = _fit(req, comm)
     head = program_record(Program.of(comm))
     head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted

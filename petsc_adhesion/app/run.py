@@ -15,13 +15,14 @@ is :mod:`petsc_adhesion.app.study`'s.
 from __future__ import annotations
 
 import sys
+import warnings
 from contextlib import nullcontext
 from dataclasses import dataclass, replace
 
 from petsc4py import PETSc
 
 from ..core.continuation import Settings
-from ..errors import InputError, Interrupted, collective
+from ..errors import InputError, Interrupted, collective, say
 from ..io.guess import read_guess
 from ..io.report import report_curve, report_solve
 from ..io.resultset import PLOT_FORMATS, check_targets, mark_done, written
@@ -55,6 +56,7 @@ from .options.reading import (
     read_settings,
     read_solver,
 )
+from .options.plausible import PLAUSIBLE, implausible
 from .options.table import TABLE
 from .optionsfile import options_files
 from .progress import Progress
@@ -84,6 +86,7 @@ class Request:
     targets: dict                     # option -> output path
     inputs: dict                      # option -> paths read
     spread_rules: tuple | None = None  # the laws of the model spread (-adh_model_spread), None: none
+    warnings: tuple = ()              # inputs outside what the field measures, one line each (plausible.py)
 
 
 def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False) -> Request:
@@ -113,8 +116,23 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
         spread_rules = None
     else:
         spread_rules = read_model_spread(opts, model)
-    return Request(model, grid_choice, read_solver(opts), read_settings(opts, model), read_request(opts, kinds, profiles, model.bodies),
-                   lam, opts.string("adh_guess"), targets, inputs, spread_rules)
+    req = Request(model, grid_choice, read_solver(opts), read_settings(opts, model),
+                  read_request(opts, kinds, profiles, model.bodies), lam, opts.string("adh_guess"), targets, inputs,
+                  spread_rules)
+    # last: a run refused says its one line, not warnings beside it
+    return replace(req, warnings=tuple(implausible({n: opts.real(n) for n in PLAUSIBLE if n in TABLE})))
+
+
+def warn(lines, report: bool) -> None:
+    """Rank 0 says each warning of the inputs: a line on stderr (``report``, the command line's), else a
+    Python RuntimeWarning (the API's, as its curve's warnings)."""
+    if PETSc.COMM_WORLD.getRank() != 0:
+        return
+    for line in lines:
+        if report:
+            say(f"warning: {line}")
+        else:
+            warnings.warn(f"petsc-adhesion: {line}", RuntimeWarning, stacklevel=5)   # the caller of curve()
 
 
 def execute(opts: AppOptions, argv: list[str], report: bool = True):
@@ -126,6 +144,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     """
     comm = PETSc.COMM_WORLD
     req = collective(comm, read, opts, comm, argv)
+    warn(req.warnings, report)
     ck = None
     result: Curve | Solution
     if req.lam is None:

@@ -288,6 +288,9 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     if mpi.Get_rank() == 0:
         for c in bad:
             say(f"case {c.index + 1} ({c.label}) left out: {c.error}")
+        # the inputs outside what the field measures, each line once (the cases share most options)
+        for line in dict.fromkeys(w for c in todo if c.request for w in c.request[0].warnings):
+            say(f"warning: {line}")
     if helping:
         return 0
     files = None
