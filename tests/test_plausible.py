@@ -114,3 +114,13 @@ def test_the_python_api_warns_alike():
     assert said == ["petsc-adhesion: " + slip("phys_radius", 5e-10)], said
     assert s.model.bodies is not None and s.model.bodies.R == 5e-10          # honoured, not changed
     assert implausible({**BODIES, "phys_spring": None}) == []
+
+
+def test_the_python_api_names_a_misspelling_first():
+    """A misspelt keyword of ours is named with its nearest option before the options it leaves missing."""
+    from petsc_adhesion.errors import InputError
+
+    given = {**BODIES, "phys_radis": BODIES["phys_radius"]}
+    del given["phys_radius"]
+    with pytest.raises(InputError, match=r"^-phys_radis: unknown option \(did you mean -phys_radius\?\)"):
+        pa.solve(-30.0, grid_type="uniform", grid_n=51, **given)
