@@ -247,8 +247,8 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     from .run import warn
 
     req = collective(comm, read, opts, comm, argv)
-    warn(req.warnings, report)
     fit = _fit(req, comm)
+    warn(req.warnings, report)      # with the result: a refusal of the fit (a pull-off no mu makes) stays one line
     head = program_record(Program.of(comm))
     head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted
     given = opts.given()

@@ -144,7 +144,6 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     """
     comm = PETSc.COMM_WORLD
     req = collective(comm, read, opts, comm, argv)
-    warn(req.warnings, report)
     ck = None
     result: Curve | Solution
     if req.lam is None:
@@ -163,6 +162,8 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         result = solve_at(req.lam, req.model, req.grid, req.solver, guess=guess,
                           started=lambda: check_unused(db=opts.db))
     check_unused(db=opts.db)
+    # with the result: a refusal found on the way (a solver's option nobody read) stays its one line
+    warn(req.warnings, report)
     status = 3 if isinstance(result, Curve) and not result.complete else 0     # a curve's (req.lam None)
     files = None
     try:
