@@ -104,8 +104,16 @@ def test_solve_and_rms(tmp_path):
     (SOFT + ("-phys_poisson1", 0.7), "-phys_poisson1: expected"),
     (("-phys_radius", 1e-3, "-phys_young1", 1e3, "-phys_poisson1", 0, "-phys_gamma", 1, "-phys_epsilon", 1e-10),
      "-phys_young1: with the other -phys_ options gives mu"),          # the modulus 1e-6 of a polymer's
-    (SOFT + ("-phys_rms", 1e-8), "-phys_rms: gives sigma = rms / epsilon = 25")])
+    (SOFT + ("-phys_rms", 1e-8), "-phys_rms: gives sigma = rms / epsilon = 25"),
+    # a misspelling is named as such, before the option it leaves missing
+    (("-phys_radis", 1e-6) + SOFT[2:], "-phys_radis: unknown option (did you mean -phys_radius?)"),
+    (SOFT[:6] + ("-phys_gama", 0.05) + SOFT[8:], "-phys_gama: unknown option (did you mean -phys_gamma?)"),
+    (SOFT + ("-phys_young", 1e9, "-phys_poisson2", 0.3), "-phys_young: unknown option (did you mean -phys_young2?)"),
+    (SOFT + ("-phys_sprng", 0.1), "-phys_sprng: unknown option (did you mean -phys_spring?)"),
+    (("-adh_roughness", "measured", "-adh_roughnes_file", "h.txt"),
+     "-adh_roughnes_file: unknown option (did you mean -adh_roughness_file?)")])
 def test_physical_bad_input(tmp_path, args, line):
+    """One line naming the option and what is wrong, exit 2, nothing written."""
     proc = run_cli(*args, "-out", tmp_path / "x.h5")
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
     assert proc.stderr.startswith(f"petsc-adhesion: error: {line}"), proc.stderr

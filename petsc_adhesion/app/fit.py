@@ -32,8 +32,9 @@ from ..model.parameters import Model
 from ..model.physical import Bodies
 from ..tracing.curve import Program
 from ..tracing.trace import GridChoice
-from .options.checks import check_petsc_values, check_unused
+from .options.checks import check_misspelled, check_petsc_values
 from .options.reading import AppOptions, read_grid, read_model_spread, read_solver
+from .options.plausible import PLAUSIBLE, implausible
 from .options.table import ROUGHNESS_OPTIONS, TABLE
 from .optionsfile import options_files
 from .progress import Progress
@@ -85,6 +86,7 @@ class FitRequest:
     choice: FitChoice | None    # curve: what is fitted
     targets: dict
     spread_rules: tuple | None = None   # the laws of gamma's (a curve's: w's and E*'s) model spread (None: none)
+    warnings: tuple = ()                # inputs outside what the field measures, one line each (plausible.py)
 
 
 def _given(opts: AppOptions, name: str) -> bool:
@@ -145,8 +147,7 @@ def _template(opts: AppOptions, rms: float | None, eps: float) -> Model:
 
 def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
     """Read and check a fit's options before any work (see the module)."""
-    opts.read_all()
-    check_unused(lambda n: n.startswith(("adh_", "grid_", "cont_", "fit_")) or n in TABLE)
+    check_misspelled(opts)          # before the options required together: a misspelling named as such
     check_petsc_values(opts.db)
     pull, path = opts.real("fit_pull_off"), opts.string("fit_curve")
     if pull is not None and path is not None:
@@ -230,7 +231,8 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
                          spread)
     if comm.getRank() == 0:
         check_targets(targets, inputs)
-    return req
+    # last: a fit refused says its one line, not warnings beside it
+    return replace(req, warnings=tuple(implausible({n: opts.real(n) for n in PLAUSIBLE if n in TABLE})))
 
 
 def _curve_choice(opts: AppOptions, fit_modulus: bool, fit_rough: bool) -> FitChoice:
@@ -293,6 +295,8 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     not hold (its warnings: a parameter at a bound or undetermined, a misfit; docs/fitting.md), its files
     written all the same; else 0."""
     comm = PETSc.COMM_WORLD
+    from .run import warn
+
     req = collective(comm, read, opts, comm, argv)
     try:
         fit = _fit(req, comm, _progress(opts, comm, req.choice.max_evaluations) if req.kind == "curve" else None)
@@ -300,6 +304,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         say(f"-fit_curve: outside the model's domain: {printable(str(e))}; -fit_outside_domain warn fits it all "
             f"the same")
         return 3, None
+    warn(req.warnings, report)      # with the result: a refusal of the fit (a pull-off no mu makes) stays one line
     head = program_record(Program.of(comm))
     head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted
     given = opts.given()

@@ -15,13 +15,14 @@ is :mod:`petsc_adhesion.app.study`'s.
 from __future__ import annotations
 
 import sys
+import warnings
 from contextlib import nullcontext
 from dataclasses import dataclass, replace
 
 from petsc4py import PETSc
 
 from ..core.continuation import Settings
-from ..errors import InputError, Interrupted, collective
+from ..errors import InputError, Interrupted, collective, say
 from ..io.guess import read_guess
 from ..io.report import report_curve, report_solve
 from ..io.resultset import PLOT_FORMATS, check_targets, mark_done, written
@@ -41,6 +42,7 @@ from ..tracing.trace import (
 from .checkpoint import open_checkpoint
 from .options.checks import (
     check_consistency,
+    check_misspelled,
     check_memory,
     check_petsc_values,
     check_unused,
@@ -54,13 +56,13 @@ from .options.reading import (
     read_settings,
     read_solver,
 )
+from .options.plausible import PLAUSIBLE, implausible
 from .options.table import TABLE
 from .optionsfile import options_files
 from .progress import Progress
 
 __all__ = ["Request", "read", "execute", "main", "is_study", "refuse_study_options"]
 
-_APP = ("adh_", "grid_", "cont_")
 _OUTPUTS = ("out", "summary", "plot", "csv", "csv_events")
 
 
@@ -68,10 +70,6 @@ def is_study(opts: AppOptions) -> bool:
     """Whether the options describe a study of many cases (:mod:`petsc_adhesion.app.study`)."""
     return any(opts.db.hasName(n) for n in ("study_mu", "study_sigma", "study_option")) or \
         opts.choice("study_compute") == "critical"
-
-
-def _is_app(name: str) -> bool:
-    return name.startswith(_APP) or name in TABLE
 
 
 @dataclass
@@ -88,19 +86,19 @@ class Request:
     targets: dict                     # option -> output path
     inputs: dict                      # option -> paths read
     spread_rules: tuple | None = None  # the laws of the model spread (-adh_model_spread), None: none
+    warnings: tuple = ()              # inputs outside what the field measures, one line each (plausible.py)
 
 
 def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False) -> Request:
     """Read and check every option before any work (PETSc's solver options too, as far as they can be judged
     before the solvers exist); ``kinds`` and ``profiles``: what a study's case reports."""
+    check_misspelled(opts)          # before the options required together: a misspelling named as such
     model = read_model(opts)
     grid_choice = read_grid(opts, model)
     lam = opts.real("adh_lambda")
     check_memory(grid_choice, opts.choice("adh_pmat"), lam is None, comm.getSize())
     if opts.string("adh_guess") is not None and lam is None:
         raise InputError("-adh_guess: only with -adh_lambda (the curve starts from the rigid state)")
-    opts.read_all()
-    check_unused(_is_app, opts.db)
     check_consistency(opts, model)
     check_petsc_values(opts.db)
     targets = {k: opts.string(k) for k in _OUTPUTS if opts.string(k)}
@@ -118,8 +116,23 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
         spread_rules = None
     else:
         spread_rules = read_model_spread(opts, model)
-    return Request(model, grid_choice, read_solver(opts), read_settings(opts, model), read_request(opts, kinds, profiles, model.bodies),
-                   lam, opts.string("adh_guess"), targets, inputs, spread_rules)
+    req = Request(model, grid_choice, read_solver(opts), read_settings(opts, model),
+                  read_request(opts, kinds, profiles, model.bodies), lam, opts.string("adh_guess"), targets, inputs,
+                  spread_rules)
+    # last: a run refused says its one line, not warnings beside it
+    return replace(req, warnings=tuple(implausible({n: opts.real(n) for n in PLAUSIBLE if n in TABLE})))
+
+
+def warn(lines, report: bool) -> None:
+    """Rank 0 says each warning of the inputs: a line on stderr (``report``, the command line's), else a
+    Python RuntimeWarning (the API's, as its curve's warnings)."""
+    if PETSc.COMM_WORLD.getRank() != 0:
+        return
+    for line in lines:
+        if report:
+            say(f"warning: {line}")
+        else:
+            warnings.warn(f"petsc-adhesion: {line}", RuntimeWarning, stacklevel=5)   # the caller of curve()
 
 
 def execute(opts: AppOptions, argv: list[str], report: bool = True):
@@ -149,6 +162,8 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         result = solve_at(req.lam, req.model, req.grid, req.solver, guess=guess,
                           started=lambda: check_unused(db=opts.db))
     check_unused(db=opts.db)
+    # with the result: a refusal found on the way (a solver's option nobody read) stays its one line
+    warn(req.warnings, report)
     status = 3 if isinstance(result, Curve) and not result.complete else 0     # a curve's (req.lam None)
     files = None
     try:

@@ -48,7 +48,7 @@ from ..io.write import write_critical, write_study
 from ..tracing.curve import Program
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
-from .options.checks import check_petsc_values, check_unused
+from .options.checks import check_misspelled, check_petsc_values, check_unused
 from .options.reading import ROLE_PREFIXES, SOLVER_OPTIONS, AppOptions, Given, read_model, read_petsc
 from .options.table import TABLE
 from .optionsfile import options_files
@@ -269,6 +269,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     """
     world = PETSc.COMM_WORLD
     mpi = world.tompi4py()
+    collective(world, check_misspelled, opts)     # before the options required together: named as such
     axes, _ = collective(world, _check, opts)
     compute = opts.choice("study_compute")
     if compute == "critical":
@@ -287,6 +288,9 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     if mpi.Get_rank() == 0:
         for c in bad:
             say(f"case {c.index + 1} ({c.label}) left out: {c.error}")
+        # the inputs outside what the field measures, each line once (the cases share most options)
+        for line in dict.fromkeys(w for c in todo if c.request for w in c.request[0].warnings):
+            say(f"warning: {line}")
     if helping:
         return 0
     files = None

@@ -37,7 +37,10 @@ def markdown() -> str:
            "(`-options_file FILE`, one `-name value` a line, `#` comments), into `PETSC_OPTIONS`, or",
            "from Python as keywords without the dash (`petsc_adhesion.curve(grid_n=201)`, docs/python.md).",
            "A bare flag means true.  A bad value, an unknown option or one the run would ignore is",
-           "refused in one line naming it, before any work (exit status 2)."]
+           "refused in one line naming it, before any work (exit status 2); a misspelt one of ours",
+           "(`-phys_radis`) is named with the nearest known name before any option it leaves missing.",
+           "A physical input outside what the field measures (a work of adhesion above 1 J/m^2, ...)",
+           "is taken, with one warning line naming the likely slip of units (docs/materials.md)."]
     for title, members in help_groups():
         out += ["", f"## {title[0].upper()}{title[1:]}", "", "| option | default | accepts | what it does |",
                 "|---|---|---|---|"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 from ..errors import tell
 from ..tracing.curve import Curve, Cycle, Event, Solution
 from ..tracing.measured import Measured, Missing
+from ..tracing.turning_points import EventGroup, TurningPoints, rigid_turning_points, spring_turning_points
 from .summary import summary_of
 
 
@@ -35,6 +36,34 @@ def _energy(c: Cycle) -> str:
     return f"{_pm('energy', c.energy, 8)}  ({loops})"
 
 
+def _fold(f: Event, name: str) -> str:
+    """A turning point under displacement control, its landing and bar."""
+    to = f"  -> lands at {_pm('F', f.landing.F)}" if f.landing else ""
+    return f"  {name:<23}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}{_note(f)}"
+
+
+def _jump(f: Event, K: float) -> str:
+    """A jump behind the spring of stiffness K, its landing and bar."""
+    assert f.Z is not None, "a jump behind the spring has its Z"
+    land = f.landing
+    to = f"  -> lands at {_pm('lambda', land.lam)}  {_pm('F', land.F)}" if land else ""
+    return f"  {f.kind:<8} (K = {K:.4g})  {_pm('Z', f.Z)}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}{_note(f)}"
+
+
+def _groups(tp: TurningPoints, kinds: str) -> list[str]:
+    """One line a group of secondary turning points: how many, where, how wide against the hysteresis."""
+    return [_group(g, tp, kinds) for g in tp.groups]
+
+
+def _group(g: EventGroup, tp: TurningPoints, kinds: str) -> str:
+    assert tp.scale is not None, "a curve with groups has its scales"
+    pairs = f" ({g.count // 2} fold pair{'s' * (g.count // 2 != 1)})" if g.count % 2 == 0 else ""
+    bars = "" if not g.without_bar else f"; {len(g.without_bar)} without an error bar (the files say why)"
+    return (f"  {g.count} further {kinds}{pairs} within {g.width / 2:.2g} of {g.control} = {g.centre:.6g} "
+            f"(width {g.width:.2g}, {g.width / tp.scale:.1%} of the hysteresis), F from {g.F_lo:.6g} to "
+            f"{g.F_hi:.6g}: on the branch the jumps pass over{bars}")
+
+
 def report_curve(curve: Curve) -> None:
     """The console lines of a curve (rank 0)."""
     out = []
@@ -42,31 +71,32 @@ def report_curve(curve: Curve) -> None:
     extra = f" + {d.error_estimate.wall_time_s:.3g} s for the error bars" if d.error_estimate is not None else ""
     out.append(f"mu = {curve.model.mu:g}  sigma = {curve.model.sigma:g}  N = {curve.grid.largest}  steps {d.steps} "
                f"(rejected {d.rejected_steps})  {d.wall_time_s:.3g} s{extra}; stopped: {d.stop_reason}")
-    if po:
-        out.append(f"  pull-off (load control)  {_pm('lambda', po.lam)}  {_pm('F', po.F)}{_note(po)}")
-    for f in curve.events:
-        if f.kind not in ("snap_on", "snap_off"):
-            continue
-        to = f"  -> lands at {_pm('F', f.landing.F)}" if f.landing else ""
-        out.append(f"  {f.kind:<23}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}{_note(f)}")
+    rigid = rigid_turning_points(curve)
+    # what an instrument meets first (the primary jump-in, the pull-off, the primary jump-off), then the
+    # turning points the jumps pass over, grouped where they lie close together (tracing/turning_points.py)
+    for i, name in ((rigid.jump_in, "jump-in"), (None, "pull-off"), (rigid.jump_off, "jump-off")):
+        if name == "pull-off" and po:
+            out.append(f"  pull-off (load control)  {_pm('lambda', po.lam)}  {_pm('F', po.F)}{_note(po)}")
+        elif i is not None:
+            out.append(_fold(rigid.points[i], f"{rigid.points[i].kind} ({name})"))
+    out += _groups(rigid, "turning points")
+    out += [_fold(rigid.points[i], rigid.points[i].kind) for i in rigid.ungrouped]
     for e in curve.events_of("equilibrium"):
         out.append(f"  equilibrium F = 0       {_pm('lambda', e.lam)}{_note(e)}")
     for e in curve.events_of("lambda"):
         out.append(f"  at lambda               {_pm('lambda', e.lam)}  {_pm('F', e.F)}{_note(e)}")
     out.append(f"  energy of a cycle       {_energy(curve.rigid)}  (rigid machine)")
-    sp = curve.spring
-    if sp is not None:
-        for f in sp.jumps:
-            assert f.Z is not None, "a jump behind the spring has its Z"
-            land = f.landing
-            to = f"  -> lands at {_pm('lambda', land.lam)}  {_pm('F', land.F)}" if land else ""
-            out.append(f"  {f.kind:<8} (K = {sp.K:.4g})  {_pm('Z', f.Z)}  {_pm('lambda', f.lam)}  {_pm('F', f.F)}{to}"
-                       f"{_note(f)}")
+    sp, behind = curve.spring, spring_turning_points(curve)
+    if sp is not None and behind is not None:
+        primary = [i for i in (behind.jump_in, behind.jump_off) if i is not None]
+        out += [_jump(behind.points[i], sp.K) for i in primary]
+        out += _groups(behind, "turning points of Z")
+        out += [_jump(behind.points[i], sp.K) for i in behind.ungrouped]
         out.append(f"  energy of a cycle       {_energy(sp.cycle)}  (spring K = {sp.K:.4g})")
     if curve.spread is not None:        # the model's spread, apart from the numerical bars above
         out += [f"  {line}" for line in spread_lines(curve.spread)]
     if curve.model.bodies is not None:
-        out += _physical_lines(summary_of(curve)["physical"])
+        out += _physical_lines(summary_of(curve)["physical"], rigid, behind)
     for w in curve.warnings:
         out.append(f"  WARNING: {w}")
     tell("\n".join(out))
@@ -78,25 +108,42 @@ def _nm_nN(e: dict, key: str, unit: str) -> str:
     return f"{key} = {e[k]:.5g} {unit}" + (f" +- {bar:.1g}" if bar else "")
 
 
-def _physical_lines(p: dict) -> list[str]:
-    """The events again in nm and nN, under the inputs that made mu (and sigma)."""
+def _physical_lines(p: dict, rigid: TurningPoints, behind: TurningPoints | None) -> list[str]:
+    """The events again in nm and nN, under the inputs that made mu (and sigma): the primary ones first, the
+    groups of secondary turning points as their spans, as above."""
     sigma = f", sigma = {p['sigma']:.4g}" if "sigma" in p else ""
     radius = f"{p['R_m'] * 1e6:.4g} um" if p["R_m"] >= 1e-6 else f"{p['R_m'] * 1e9:.4g} nm"
     out = [f"  in physical units: R = {radius}, E = {p['E_Pa'] / 1e9:.4g} GPa, gamma = "
            f"{p['gamma_J_m2'] * 1e3:.4g} mJ/m^2, epsilon = {p['epsilon_m'] * 1e9:.4g} nm: mu = {p['mu']:.4g}{sigma}"]
-    events = ([("pull-off", p["pull_off"])] if p["pull_off"] else []) + \
-        [(e["kind"], e) for k in ("folds", "equilibria", "at_lambda") for e in p[k]] + \
-        [(e["kind"], e) for e in p.get("spring", {}).get("jumps", [])]
-    for name, e in events:
+    folds, jumps = p["folds"], p.get("spring", {}).get("jumps", [])
+    events = [(f"{folds[i]['kind']} ({name})", folds[i]) for i, name in ((rigid.jump_in, "jump-in"),
+                                                                        (rigid.jump_off, "jump-off")) if i is not None]
+    if p["pull_off"]:
+        events.insert(1 if rigid.jump_in is not None else 0, ("pull-off", p["pull_off"]))
+    groups = [_group_nm(g, "lambda") for g in p["fold_groups"]]
+    rest = [(folds[i]["kind"], folds[i]) for i in rigid.ungrouped] + \
+        [(e["kind"], e) for k in ("equilibria", "at_lambda") for e in p[k]]
+    if behind is not None:
+        rest += [(jumps[i]["kind"], jumps[i]) for i in (behind.jump_in, behind.jump_off) if i is not None]
+        rest += [(jumps[i]["kind"], jumps[i]) for i in behind.ungrouped]
+    def line(name: str, e: dict) -> str:
         force = f"  {_nm_nN(e, 'F', 'nN')}" if "F_nN" in e and name != "equilibrium" else ""
         base = f"  {_nm_nN(e, 'Z', 'nm')}" if "Z_nm" in e else ""
-        out.append(f"    {name:<21}{base}  {_nm_nN(e, 'lambda', 'nm')}{force}  contact radius "
-                   f"{e['contact_radius_nm']:.4g} nm")
+        return f"    {name:<21}{base}  {_nm_nN(e, 'lambda', 'nm')}{force}  contact radius {e['contact_radius_nm']:.4g} nm"
+
+    out += [line(n, e) for n, e in events] + groups + [line(n, e) for n, e in rest]
+    out += [_group_nm(g, "Z") for g in p.get("spring", {}).get("jump_groups", [])]
     for name, q in (("rigid machine", p), (f"spring k = {p['spring']['k_N_m']:.4g} N/m", p.get("spring")) if "spring" in p
                     else (None, None)):
         if name and q is not None and "energy_aJ" in q:
             out.append(f"    energy of a cycle, {name}: {_nm_nN(q, 'energy', 'aJ')}")
     return out
+
+
+def _group_nm(g: dict, control: str) -> str:
+    """A group of secondary turning points in nm and nN."""
+    return (f"    further turning points   within {g['width_nm'] / 2:.2g} nm of {control} = {g[f'{control}_nm']:.5g} nm, "
+            f"F from {g['F_lo_nN']:.5g} to {g['F_hi_nN']:.5g} nN")
 
 
 def report_solve(s: Solution) -> None:

@@ -21,13 +21,15 @@ from ..model.physical import in_units
 from ..model.pressure import pressure_law
 from ..tracing.curve import Curve, Cycle, Profile, Program, Solution
 from ..tracing.measured import Measured, Missing
+from ..tracing.turning_points import TurningPoints, rigid_turning_points, spring_turning_points
 
 if TYPE_CHECKING:                    # tracing.critical loads PETSc, which a file reader need not
     from ..tracing.critical import Critical
     from ..tracing.model_spread import ModelSpread
 
 __all__ = ["event_record", "branch_record", "program_record", "model_record", "head_of", "summary_of",
-           "solve_summary", "cycle_summary", "critical_record", "spread_record", "legs_record", "LEG_KEYS", "KEYS"]
+           "solve_summary", "cycle_summary", "critical_record", "spread_record", "legs_record", "LEG_KEYS",
+           "primary_record", "groups_record", "KEYS"]
 
 #: A field's name -> the key the files have always used for it.
 KEYS = {"lam": "lambda", "note": "error_note"}
@@ -183,6 +185,39 @@ def _trigger(legs) -> dict:
     return {"trigger": legs.trigger, "trigger_reached": legs.reached}
 
 
+def primary_record(tp: TurningPoints, pull_off=None) -> dict:
+    """The primary jump-in, (a rigid machine's: the load-control pull-off,) and jump-off of ``tp``
+    (:class:`~petsc_adhesion.tracing.turning_points.TurningPoints`), each its event's record with its
+    ``index`` among the turning points (``folds``, or a spring's ``jumps``), null where the curve has none."""
+    def one(i):
+        return None if i is None else {"index": i, **event_record(tp.points[i], profiles=False)}
+
+    out: dict[str, object] = {"jump_in": one(tp.jump_in)}
+    if tp.control == "lambda":
+        out["pull_off"] = event_record(pull_off, profiles=False) if pull_off is not None else None
+    out["jump_off"] = one(tp.jump_off)
+    return out
+
+
+def groups_record(tp: TurningPoints) -> list[dict]:
+    """The groups of secondary turning points of ``tp``: each its ``count``, its ``members`` and those
+    ``without_bar`` (indices among the turning points, whose records hold their bars or why not), the
+    control's span (``lambda_lo``, ``lambda_hi``, the middle ``lambda`` and the ``width``; ``Z_...`` behind
+    a spring), the load's (``F_lo``, ``F_hi``) and the ``share`` of the curve's scales it spans."""
+    c = tp.control
+    return [{"count": g.count, "members": list(g.members), "without_bar": list(g.without_bar),
+             f"{c}_lo": g.lo, f"{c}_hi": g.hi, c: g.centre, "width": g.width, "F_lo": g.F_lo, "F_hi": g.F_hi,
+             "share": g.share} for g in tp.groups]
+
+
+def _physical_groups(groups: list[dict], control: str, d: dict) -> list[dict]:
+    """Group records in nm and nN."""
+    nm, nN = d["approach_nm"], d["force_nN"]
+    return [{f"{control}_lo_nm": g[f"{control}_lo"] * nm, f"{control}_hi_nm": g[f"{control}_hi"] * nm,
+             f"{control}_nm": g[control] * nm, "width_nm": g["width"] * nm, "F_lo_nN": g["F_lo"] * nN,
+             "F_hi_nN": g["F_hi"] * nN} for g in groups]
+
+
 def summary_of(curve: Curve) -> dict:
     """The JSON summary of a traced curve (docs/output.md)."""
     def brief(e):
@@ -191,7 +226,11 @@ def summary_of(curve: Curve) -> dict:
     ev, d, a = curve.events, curve.diagnostics, curve.assessment
     spread = cast("ModelSpread | Missing | None", curve.spread)
     spread_warnings = spread.warnings if spread is not None and not isinstance(spread, Missing) else []
+    rigid, behind = rigid_turning_points(curve), spring_turning_points(curve)
     s = {**_common(curve),
+         # first what an instrument meets; then every event, with its bar or why it has none
+         "primary": primary_record(rigid, curve.pull_off),
+         "fold_groups": groups_record(rigid),
          "pull_off": brief(curve.pull_off) if curve.pull_off else None,
          "folds": [brief(e) for e in ev if e.kind in ("snap_on", "snap_off")],
          "equilibria": [{k: v for k, v in brief(e).items() if k not in ("F", "F_err", "F_grid")}
@@ -199,9 +238,10 @@ def summary_of(curve: Curve) -> dict:
          "load_extrema": [brief(e) for e in ev if e.kind in ("F_min", "F_max")],
          "at_lambda": [brief(e) for e in ev if e.kind == "lambda"],
          **cycle_summary(curve.rigid),
-         **({"spring": {"K": curve.spring.K, "jumps": [brief(e) for e in curve.spring.jumps],
+         **({"spring": {"K": curve.spring.K, "primary": primary_record(behind),
+                        "jump_groups": groups_record(behind), "jumps": [brief(e) for e in curve.spring.jumps],
                         **cycle_summary(curve.spring.cycle), **_trigger(curve.spring.legs)}}
-            if curve.spring is not None else {}),
+            if curve.spring is not None and behind else {}),
          "wall_gap": d.wall_gap, "steps": d.steps, "rejected_steps": d.rejected_steps, "regrids": d.regrids,
          "guard_activations": d.guard_activations, "smallest_step": d.smallest_step,
          "most_newton_its": d.most_newton_its, "most_ksp_its": d.most_ksp_its, "stop_reason": d.stop_reason,
@@ -214,7 +254,17 @@ def summary_of(curve: Curve) -> dict:
         s["error_estimate"] = {"wall_time_s": est.wall_time_s, "target_error": est.target_error,
                                "levels": list(est.levels)}
     if curve.model.bodies is not None:
-        s["physical"] = in_units(s, curve.model.bodies.describe())
+        units = curve.model.bodies.describe()
+        phys = s["physical"] = in_units(s, units)
+        # the primary events as the physical lists hold them, by their index; the groups' spans in nm and nN
+        phys["primary"] = {k: None if v is None else {"index": v["index"], **phys["folds"][v["index"]]}
+                           if k != "pull_off" else phys["pull_off"] for k, v in s["primary"].items()}
+        phys["fold_groups"] = _physical_groups(s["fold_groups"], "lambda", units)
+        if "spring" in s:
+            phys["spring"]["primary"] = {k: None if v is None else {"index": v["index"],
+                                                                     **phys["spring"]["jumps"][v["index"]]}
+                                         for k, v in s["spring"]["primary"].items()}
+            phys["spring"]["jump_groups"] = _physical_groups(s["spring"]["jump_groups"], "Z", units)
     if spread is not None:               # after physical: in_units reads the events, not the spread
         s["model_spread"] = spread_record(spread)
     return _plain(s)

@@ -22,7 +22,7 @@ from ...tracing.edge_grids import MU_TRUNCATED, domain_load
 from .reading import _NUMBER, AppOptions, _strict_float, _strict_int
 from .table import ROUGHNESS_OPTIONS, SOLVER_PREFIXES, TABLE, Option
 
-__all__ = ["truncated_too_far", "DOMAIN_SHARE", "smallest_domain", "check_consistency", "check_memory", "memory_limits", "petsc_error", "PETSC_GLOBAL", "petsc_names", "check_unused", "check_petsc_values"]
+__all__ = ["truncated_too_far", "APP_PREFIXES", "is_application", "check_misspelled", "DOMAIN_SHARE", "smallest_domain", "check_consistency", "check_memory", "memory_limits", "petsc_error", "PETSC_GLOBAL", "petsc_names", "check_unused", "check_petsc_values"]
 
 
 #: The attraction beyond r_m may carry at most this share of the DMT pull-off at contact.
@@ -261,6 +261,24 @@ def petsc_names() -> list[str]:
 
 def _prefixes() -> tuple:
     return tuple(p for p, _ in SOLVER_PREFIXES)
+
+
+#: The beginnings of the application's option names (adh_, phys_, fit_, ...): an option given with one of them
+#: that is not in the table is a misspelling of ours, never one of PETSc's.
+APP_PREFIXES = tuple(sorted({name.split("_")[0] + "_" for name in TABLE}))
+
+
+def is_application(name: str) -> bool:
+    """Whether ``name`` is (or misspells) an application option: one of the table, or under its prefixes."""
+    return name in TABLE or name.startswith(APP_PREFIXES)
+
+
+def check_misspelled(opts: AppOptions) -> None:
+    """Read every application option (each value checked) and refuse one under the application's prefixes
+    that is not in the table, naming the nearest known one: first, before the checks of options required
+    together (``-phys_radis`` is named as a misspelling, not reported as a missing ``-phys_radius``)."""
+    opts.read_all()
+    check_unused(is_application, opts.db)
 
 
 def check_unused(judged=lambda name: True, db=None) -> None:

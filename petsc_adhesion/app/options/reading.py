@@ -23,6 +23,7 @@ from ...core.newton import PetscSettings
 from ...tracing.legs import default_trigger, figure_step, rigid_pull_off
 from ...tracing.model_spread import Rule, default_rules, parse_rules
 from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, step_scale
+from .plausible import slip
 from .table import TABLE, Option
 
 __all__ = ["AppOptions", "Given", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
@@ -290,15 +291,22 @@ def read_physical(opts: AppOptions) -> Bodies | None:
     if not mu <= TABLE["adh_mu"].hi:       # an overflow of eq. (9) too: its log says by how much
         name = max(shares, key=shares.__getitem__)
         raise InputError(f"-{name}: with the other -phys_ options gives mu = {math.exp(min(logmu, 700)):.3g} by "
-                         f"eq. (9), outside [0, {TABLE['adh_mu'].hi:g}]")
+                         f"eq. (9), outside [0, {TABLE['adh_mu'].hi:g}]{_slip(opts, name)}")
     if mu < MU_SMALLEST:
         name = min(shares, key=shares.__getitem__)
         raise InputError(f"-{name}: with the other -phys_ options gives mu = {mu:.3g} by eq. (9), below "
-                         f"{MU_SMALLEST:g}: a rigid sphere to double precision; use -adh_mu 0")
+                         f"{MU_SMALLEST:g}: a rigid sphere to double precision; use -adh_mu 0{_slip(opts, name)}")
     if bodies.sigma is not None and not bodies.sigma <= TABLE["adh_sigma"].hi:
         raise InputError(f"-phys_rms: gives sigma = rms / epsilon = {bodies.sigma:.3g}, above "
                          f"{TABLE['adh_sigma'].hi:g}")
     return bodies
+
+
+def _slip(opts: AppOptions, name: str) -> str:
+    """The likely slip of units of option ``name`` outside what the field measures, as the end of a
+    refusal ("" inside it)."""
+    line = slip(name, opts.real(name))
+    return "" if line is None else f"; {line.split(': ', 1)[1]}"
 
 
 def _finite(value) -> float:
