@@ -22,6 +22,9 @@ def _env():
     if os.geteuid() == 0:
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     env.setdefault("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
+    # a waiting rank yields its core: the suite's workers (pytest-xdist) share the cores with the ranks a test
+    # starts, and Open MPI's busy wait on a machine it does not know is full slows a two-rank run many times
+    env.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
     return env
 
 
