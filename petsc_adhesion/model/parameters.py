@@ -78,6 +78,7 @@ class Model:
     hermite_points: int = 16
     roughness_cutoff: float = 3.0     # truncated_gaussian: highest asperity at K sigma
     roughness_skewness: float = 0.0   # weibull: third standardised moment of the heights
+    lognormal_skewness: float = -1.0  # lognormal: third standardised moment of the heights (< 0: bounded above)
     quadrature_points: int = NEAR_POINTS  # truncated_gaussian, weibull: points of the moving part at the wall
     heights: np.ndarray | None = field(default=None, repr=False, compare=False)  # measured, units of epsilon
     farfield: bool = True      # add the rigid sphere's attraction beyond r_m (the half-infinite model)

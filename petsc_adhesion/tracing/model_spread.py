@@ -27,7 +27,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 
-from ..model.roughness import Weibull
+from ..model.roughness import Lognormal, Weibull
 from .measured import Measured, Missing
 from .trace import CurveRequest, GridChoice, SolverChoice, trace_curve
 
@@ -47,13 +47,15 @@ LAWS = {"hermite": ("hermite_points", int, (2, 400), "points of the Gauss-Hermit
         "truncated_gaussian": ("roughness_cutoff", float, (1e-6, 10.0),
                                "the highest asperity K in standard deviations, in [1e-06, 10]"),
         "weibull": ("roughness_skewness", float, Weibull.SKEWNESS,
-                    "the skewness of the heights, in [%g, %g]" % Weibull.SKEWNESS)}
+                    "the skewness of the heights, in [%g, %g]" % Weibull.SKEWNESS),
+        "lognormal": ("lognormal_skewness", float, Lognormal.SKEWNESS,
+                      "the skewness of the heights, in [%g, %g]" % Lognormal.SKEWNESS)}
 
 
 @dataclass(frozen=True)
 class Rule:
     """A roughness law and its one parameter: ``hermite`` (points of the rule), ``truncated_gaussian`` (the
-    cut-off K), ``weibull`` (the skewness) or ``measured`` (the heights of the model, no parameter)."""
+    cut-off K), ``weibull`` and ``lognormal`` (the skewness) or ``measured`` (the heights of the model, no parameter)."""
 
     law: str
     parameter: float | None = None

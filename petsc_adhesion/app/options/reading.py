@@ -15,7 +15,7 @@ from ...model.heights import HeightFileError, read_heights
 from ...model.parameters import Model, PhysicalBodies
 from ...model.parameters import tabor
 from ...model.physical import Bodies
-from ...model.roughness import Measured
+from ...model.roughness import Lognormal, Measured
 from ...core.bordered import ARCLENGTH_PREFIX
 from ...core.continuation import NATURAL_PREFIX
 from ...core.fold import FOLD_PREFIX
@@ -328,10 +328,15 @@ def read_model(opts: AppOptions) -> Model:
     model = Model(mu=mu, sigma=sigma, rmax=rmax, roughness=rough, hermite_points=opts.int("adh_hermite_points"),
                   roughness_cutoff=opts.real("adh_roughness_cutoff"),
                   roughness_skewness=opts.real("adh_roughness_skewness"),
+                  lognormal_skewness=opts.real("adh_lognormal_skewness"),
                   quadrature_points=opts.int("adh_quadrature_points"), heights=heights,
                   farfield=opts.flag("adh_farfield"), bodies=phys)
     if model.roughness == "none" and model.sigma > 0:
         raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
+    if model.roughness == Lognormal.name and model.sigma > 0 and not Lognormal(sigma, model.lognormal_skewness).wall_pressure > 0:
+        raise InputError(f"-adh_lognormal_skewness: {model.lognormal_skewness:g} at sigma {model.sigma:g} puts the highest "
+                         f"asperity {Lognormal(sigma, model.lognormal_skewness).top:.3g} epsilon up with no weight near it: "
+                         "the heights repel nowhere (P at the wall <= 0); give a more negative skewness or a smaller rms")
     return model
 
 
