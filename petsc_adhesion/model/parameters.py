@@ -81,6 +81,8 @@ class Model:
     lognormal_skewness: float = -1.0  # lognormal: third standardised moment of the heights (< 0: bounded above)
     quadrature_points: int = NEAR_POINTS  # truncated_gaussian, weibull: points of the moving part at the wall
     heights: np.ndarray | None = field(default=None, repr=False, compare=False)  # measured, units of epsilon
+    #: the measured topographies (model.topography.Topography) the heights came from: one surface or two
+    topography: tuple = field(default=(), repr=False, compare=False)
     farfield: bool = True      # add the rigid sphere's attraction beyond r_m (the half-infinite model)
     #: the physical inputs that made mu (and sigma): results are reported in SI too (None: dimensionless only)
     bodies: PhysicalBodies | None = field(default=None, repr=False, compare=False)

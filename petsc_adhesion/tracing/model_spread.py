@@ -27,7 +27,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 
-from ..model.roughness import Lognormal, Weibull
+from ..model.roughness import Lognormal, Measured as Heights, Weibull
 from .measured import Measured, Missing
 from .trace import CurveRequest, GridChoice, SolverChoice, trace_curve
 
@@ -122,11 +122,19 @@ def default_rules(model) -> tuple:
     surfaces fall between, and the reversed Weibull of skewness 0: a bounded law with
     the Gaussian's first three moments but another upper tail (its highest asperity at
     3.24 rms), so that the shape of the tail, not only its end, is varied.
+
+    Under measured heights, first what the Gaussian rule with their rms gives (the paper's
+    16-point Hermite rule) and the truncated Gaussian whose highest asperity is the
+    heights' own (K = highest height / rms, to two decimals, at most 10): the same rms and
+    top, the Gaussian's shape, so that the distance is the measured shape's alone.
     """
     own = Rule.of(model)
     rules: tuple[Rule, ...] = (Rule("hermite", 2 * model.hermite_points),) if own.law == "hermite" else ()
+    if own.law == "measured" and model.heights is not None:
+        heights = Heights(model.heights)
+        rules += (Rule("hermite", 16), Rule("truncated_gaussian", min(10.0, round(heights.top / heights.rms, 2))))
     rules += (Rule("truncated_gaussian", 3.0), Rule("truncated_gaussian", 4.0), Rule("weibull", 0.0))
-    return tuple(r for r in rules if r != own)
+    return tuple(dict.fromkeys(r for r in rules if r != own))
 
 
 @dataclass(frozen=True)

@@ -99,6 +99,16 @@ TABLE = {o.name: o for o in [
            "(Gwyddion ASCII export, '# Value units: m'), .gsf or .npy height map; it sets sigma itself"),
     Option("adh_roughness_unit", "real", None, "measured: metres per value of a file that states no unit "
            "(needs -phys_epsilon)", 0.0, 1.0, lo_open=True),
+    Option("adh_topography", "string", None, "measured: a topography file (an AFM image, a profilometer map or "
+           "profile, text with a header: any format SurfaceTopography reads, with its units and size), detrended; its "
+           "heights (with -adh_topography2's, combined) are the gap's; needs -phys_epsilon and SurfaceTopography"),
+    Option("adh_topography2", "string", None, "measured: the second surface's topography file (the sphere's); the "
+           "gap's heights are the sum of the two surfaces' (their distributions convolved)"),
+    Option("adh_topography_detrend", "choice", "plane", "measured: what is removed from a topography before its "
+           "heights are taken: the mean only, the least-squares plane (tilt is mounting, not roughness), or the "
+           "second-order polynomial (a bent sample, a scanner's bow)", choices=("none", "plane", "curvature")),
+    Option("adh_topography_unit", "choice", None, "measured: the length unit of the values of a topography file "
+           "that states none (refused for one that does)", choices=("m", "mm", "um", "nm", "A", "pm")),
     Option("adh_quadrature_points", "int", Model.quadrature_points, "truncated_gaussian, weibull, lognormal: "
            "points of the quadrature's moving part at the wall (its fixed panels get 2/3 as many; lognormal has "
            "fixed panels only)", 2, 400),
@@ -247,4 +257,6 @@ TABLE = {o.name: o for o in [
 ROUGHNESS_OPTIONS = {"adh_hermite_points": RULES_HERMITE, "adh_roughness_cutoff": ("truncated_gaussian",),
                      "adh_roughness_skewness": ("weibull",), "adh_lognormal_skewness": ("lognormal",),
                      "adh_quadrature_points": ("truncated_gaussian", "weibull", "lognormal"),
-                     "adh_roughness_file": ("measured",), "adh_roughness_unit": ("measured",)}
+                     "adh_roughness_file": ("measured",), "adh_roughness_unit": ("measured",),
+                     "adh_topography": ("measured",), "adh_topography2": ("measured",),
+                     "adh_topography_detrend": ("measured",), "adh_topography_unit": ("measured",)}
