@@ -399,29 +399,42 @@ class Measured:
         Heights in units of epsilon, any shape.
     bins
         Number of bins; default Freedman-Diaconis, at most :attr:`MAX_BINS`.
+    weights
+        The probability of each height (a distribution given on points, e.g. the gap's
+        convolution of two surfaces, :func:`~.topography.gap_heights`); None: equal.
     """
 
     name = "measured"
     MAX_BINS = 128
 
-    def __init__(self, heights: np.ndarray, bins: int | None = None):
+    def __init__(self, heights: np.ndarray, bins: int | None = None, weights: np.ndarray | None = None):
         S = np.asarray(heights, dtype=float).ravel()
         _check(S, "heights")
-        S = S - S.mean()
+        w = np.full(S.size, 1.0 / S.size) if weights is None else np.asarray(weights, dtype=float).ravel()
+        if w.shape != S.shape or not np.all(w > 0) or not np.isfinite(w.sum()):
+            raise ValueError("weights: one positive weight a height")
+        w = w / w.sum()
+        S = S - w @ S
         self.samples = S.size
-        self.rms = self.sigma = float(np.sqrt(np.mean(S * S)))
+        self.rms = self.sigma = float(np.sqrt(w @ (S * S)))
         if not self.rms >= SMALLEST_RMS:
             raise HeightFileError(f"heights: rms {self.rms:.3g} epsilon, below {SMALLEST_RMS:g}: the histogram's average "
                                   f"would round to more than the roughness changes (a smooth surface: -adh_roughness none)")
-        self.skewness = float(np.mean(S ** 3)) / self.rms ** 3
+        self.skewness = float(w @ S ** 3) / self.rms ** 3
         self.top, self.bottom = float(S.max()), float(S.min())
-        if bins is None:
+        if bins is None and weights is None:
             bins = min(np.histogram_bin_edges(S, "fd").size - 1, self.MAX_BINS)
+        elif bins is None:          # Freedman-Diaconis on the weighted quartiles
+            order = np.argsort(S)
+            q1, q3 = np.interp([0.25, 0.75], np.cumsum(w[order]), S[order])
+            width = 2 * (q3 - q1) / S.size ** (1 / 3)
+            bins = self.MAX_BINS if width <= 0 else int(min(self.MAX_BINS, max(1, math.ceil((self.top - self.bottom)
+                                                                                            / width))))
         if not (isinstance(bins, (int, np.integer)) and bins >= 1):
             raise ValueError(f"bins must be an integer >= 1, got {bins}")
         self.edges = np.linspace(self.bottom, self.top, bins + 1)
-        counts, _ = np.histogram(S, self.edges)
-        self.density = counts / (S.size * np.diff(self.edges))
+        mass, _ = np.histogram(S, self.edges, weights=w)
+        self.density = mass / np.diff(self.edges)
 
     def pdf(self, S: np.ndarray) -> np.ndarray:
         """The histogram density (the top edge belongs to the top bin)."""
@@ -437,7 +450,7 @@ DISTRIBUTIONS = (TruncatedGaussian.name, Weibull.name, Lognormal.name, Measured.
 def distribution(model):
     """The height distribution of ``model`` (its ``roughness`` one of :data:`DISTRIBUTIONS`)."""
     if model.roughness == Measured.name:
-        return Measured(model.heights)
+        return Measured(model.heights, weights=model.height_weights)
     if model.roughness == Weibull.name:
         return Weibull(model.sigma, model.roughness_skewness)
     if model.roughness == Lognormal.name:

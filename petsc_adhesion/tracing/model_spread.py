@@ -131,7 +131,7 @@ def default_rules(model) -> tuple:
     own = Rule.of(model)
     rules: tuple[Rule, ...] = (Rule("hermite", 2 * model.hermite_points),) if own.law == "hermite" else ()
     if own.law == "measured" and model.heights is not None:
-        heights = Heights(model.heights)
+        heights = Heights(model.heights, weights=model.height_weights)
         rules += (Rule("hermite", 16), Rule("truncated_gaussian", min(10.0, round(heights.top / heights.rms, 2))))
     rules += (Rule("truncated_gaussian", 3.0), Rule("truncated_gaussian", 4.0), Rule("weibull", 0.0))
     return tuple(dict.fromkeys(r for r in rules if r != own))

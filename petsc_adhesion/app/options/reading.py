@@ -320,16 +320,16 @@ def read_model(opts: AppOptions) -> Model:
     rmax = opts.real("adh_rmax")
     if rmax is None:
         rmax = GridChoice(opts.choice("grid_type")).default_rmax
-    rough, sigma, heights = opts.choice("adh_roughness"), opts.real("adh_sigma"), None
+    rough, sigma, heights, weights = opts.choice("adh_roughness"), opts.real("adh_sigma"), None, None
     if phys and phys.sigma is not None:
         sigma = phys.sigma
     topography: tuple = ()
     if rough == "measured" and (opts.db.hasName("adh_topography") or opts.db.hasName("adh_topography2")):
-        heights, topography = read_topographies(opts, phys.epsilon if phys else None)
+        heights, weights, topography = read_topographies(opts, phys.epsilon if phys else None)
         if heights is None:           # a flat surface: the smooth sphere, the record saying why
             rough, sigma = "none", 0.0
         else:
-            sigma = Measured(heights).rms
+            sigma = Measured(heights, weights=weights).rms
     elif rough == "measured":
         heights = read_measured(opts, phys.epsilon if phys else None)
         sigma = Measured(heights).rms
@@ -337,7 +337,8 @@ def read_model(opts: AppOptions) -> Model:
                   roughness_cutoff=opts.real("adh_roughness_cutoff"),
                   roughness_skewness=opts.real("adh_roughness_skewness"),
                   lognormal_skewness=opts.real("adh_lognormal_skewness"),
-                  quadrature_points=opts.int("adh_quadrature_points"), heights=heights, topography=topography,
+                  quadrature_points=opts.int("adh_quadrature_points"), heights=heights, height_weights=weights,
+                  topography=topography,
                   farfield=opts.flag("adh_farfield"), bodies=phys)
     if model.roughness == "none" and model.sigma > 0:
         raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
@@ -368,8 +369,8 @@ def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
 
 
 def read_topographies(opts: AppOptions, epsilon: float | None) -> tuple:
-    """The gap's heights in units of epsilon from -adh_topography (and -adh_topography2), and the
-    :class:`~petsc_adhesion.model.topography.Topography` of each; the heights None for a flat gap (rms below
+    """The gap's heights in units of epsilon from -adh_topography (and -adh_topography2), their weights (None:
+    equal) and the :class:`~petsc_adhesion.model.topography.Topography` of each; the heights None for a flat gap (rms below
     :data:`~petsc_adhesion.model.roughness.SMALLEST_RMS` epsilon: the smooth sphere)."""
     first, second = opts.string("adh_topography"), opts.string("adh_topography2")
     if first is None:
@@ -392,13 +393,14 @@ def read_topographies(opts: AppOptions, epsilon: float | None) -> tuple:
             why = str(e).replace("give the unit of its values", "give -adh_topography_unit").replace(
                 "give none", "give no -adh_topography_unit")
             raise InputError(f"-{name}: {printable(why)}") from None
-    heights = gap_heights(tuple(surfaces), epsilon)
-    rms = float(np.sqrt(np.mean((heights - heights.mean()) ** 2)))
+    heights, weights = gap_heights(tuple(surfaces), epsilon)
+    w = np.full(heights.size, 1 / heights.size) if weights is None else weights
+    rms = float(np.sqrt(w @ (heights - w @ heights) ** 2))
     if rms < SMALLEST_RMS:
-        return None, tuple(surfaces)
+        return None, None, tuple(surfaces)
     if not rms <= TABLE["adh_sigma"].hi:
         raise InputError(f"-adh_topography: heights of rms {rms:.3g} epsilon, above {TABLE['adh_sigma'].hi:g}")
-    return heights, tuple(surfaces)
+    return heights, weights, tuple(surfaces)
 
 
 def read_grid(opts: AppOptions, model: Model) -> GridChoice:
