@@ -141,14 +141,11 @@ def runs(tmp_path_factory):
             "flat": [*MEASURED, "-adh_topography", write_map(d / "f.txt", 1e-3 * np.add.outer(np.arange(40),
                                                                                              np.arange(50)))],
             "smooth": ["-adh_roughness", "none"]}
-    for k, s in (("up", sigma + err), ("down", sigma - err)):
-        jobs[k] = ["-adh_sigma", str(s), "-adh_roughness", "truncated_gaussian", "-adh_roughness_cutoff",
-                   str(top / s), "-adh_model_spread", "false"]
-    jobs["up"] = [a for a in jobs["up"] if a != "-adh_sigma"]
     procs = run_all({k: ([*PHYS, *GRID, *a, "-summary", str(d / f"{k}.json"), "-out", str(d / f"{k}.h5")], {})
-                     for k, a in jobs.items() if k not in ("up", "down")})
-    tg = run_all({k: (["-adh_mu", str(_mu()), "-adh_sigma", str(s), *GRID, "-adh_roughness", "truncated_gaussian",
-                       "-adh_roughness_cutoff", str(top / s), "-adh_model_spread", "false", "-summary",
+                     for k, a in jobs.items()})
+    # the Gaussian cut at the same highest point, its rms one bar up and down (K to two decimals, as the spread's)
+    tg = run_all({k: (["-adh_mu", str(_mu()), "-adh_sigma", f"{s:.6g}", *GRID, "-adh_roughness", "truncated_gaussian",
+                       "-adh_roughness_cutoff", f"{top / s:.2f}", "-adh_model_spread", "false", "-summary",
                        str(d / f"{k}.json")], {}) for k, s in (("up", sigma + err), ("down", sigma - err))})
     out = {"sigma": sigma, "err": err, "top": top}
     for k, p in {**procs, **tg}.items():
@@ -180,9 +177,10 @@ def test_a_gaussian_surface_gives_the_gaussian_law_within_its_sampling_error(run
     t = m["topography"]
     s = t["surfaces"][0]
     assert s["kind"] == "map" and s["pixels"] == [128, 128] and s["unit"] == "nm" and s["detrend"] == "plane"
-    assert s["size_m"] == pytest.approx([256e-9, 256e-9]) and s["rms_m"] == pytest.approx(0.08e-9, rel=1e-9)
+    # 0.08 nm before the plane was removed
+    assert s["size_m"] == pytest.approx([256e-9, 256e-9]) and s["rms_m"] == pytest.approx(0.08e-9, rel=0.01)
     assert abs(s["skewness"]) < 3 * s["skewness_err"] and abs(s["kurtosis"] - 3) < 3 * s["kurtosis_err"]
-    assert t["gap_rms_epsilon"] == pytest.approx(m["sigma"], rel=1e-9) == pytest.approx(0.2, rel=1e-9)
+    assert t["gap_rms_epsilon"] == pytest.approx(m["sigma"], rel=1e-9) and m["sigma"] == pytest.approx(0.2, rel=0.01)
     assert "topography" in runs["measured_stdout"] and "independent samples" in runs["measured_stdout"]
 
 

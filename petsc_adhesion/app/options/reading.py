@@ -352,6 +352,9 @@ def read_model(opts: AppOptions) -> Model:
 def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
     """The heights of -adh_roughness_file in units of epsilon (:func:`~.roughness.read_heights`)."""
     path = opts.string("adh_roughness_file")
+    for name in ("adh_topography_detrend", "adh_topography_unit"):
+        if opts.db.hasName(name):
+            raise InputError(f"-{name}: applies to -adh_topography, not to -adh_roughness_file")
     if path is None:
         raise InputError("-adh_roughness_file: required with -adh_roughness measured: a file of heights")
     if opts.db.hasName("adh_sigma"):
