@@ -220,6 +220,8 @@ def read_topography(path: str, detrend: str = "plane", unit: str | None = None) 
     name = f"'{os.path.basename(str(path))}'"
     if detrend not in DETRENDS:
         raise ValueError(f"detrend must be one of {', '.join(DETRENDS)}, got {detrend!r}")
+    if unit is not None and unit not in LENGTH_UNITS:
+        raise ValueError(f"unit must be one of {', '.join(LENGTH_UNITS)}, got {unit!r}")
     try:
         import SurfaceTopography
     except ImportError:
@@ -250,7 +252,8 @@ def read_topography(path: str, detrend: str = "plane", unit: str | None = None) 
         raise TopographyError(f"{name}: its unit '{stated}' is not a length")
     sizes = channel.physical_sizes
     try:
-        kw = {} if stated is not None else {"unit": "m"}
+        # a file without a unit: read as stated in metres, and scaled by the user's unit below
+        kw: dict[str, object] = {} if stated is not None else {"unit": "m"}
         if sizes is None:       # the heights are read all the same, the lateral size stays unknown
             kw["physical_sizes"] = tuple(float(n) for n in channel.nb_grid_pts)
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
@@ -277,7 +280,8 @@ def read_topography(path: str, detrend: str = "plane", unit: str | None = None) 
     else:
         with contextlib.redirect_stdout(io.StringIO()):
             flat = np.ma.getdata(topo.detrend(detrend_mode=DETRENDS[detrend]).heights()).astype(float)
-    scale = _length_units()[stated] if stated is not None else LENGTH_UNITS[unit]
+    given = str(stated) if stated is not None else str(unit)
+    scale = _length_units()[given] if stated is not None else LENGTH_UNITS[given]
     z = flat * scale
     z = z - z.mean()
     pixel = None if sizes is None else tuple(float(s) * scale / n for s, n in zip(sizes, data.shape))
@@ -287,8 +291,7 @@ def read_topography(path: str, detrend: str = "plane", unit: str | None = None) 
                            (float(data.size),) * 3, 0.0, 0.0, "a flat surface: no roughness")
     else:
         stats = statistics(z)
-    return Topography(z, pixel, str(path), stated if stated is not None else unit,
-                      "file" if stated is not None else "option", detrend, stats)
+    return Topography(z, pixel, str(path), given, "file" if stated is not None else "option", detrend, stats)
 
 
 def _length_units() -> dict:
