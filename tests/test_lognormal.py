@@ -154,3 +154,15 @@ def test_through_the_program(cli, tmp_path):
     assert bad.returncode == 2 and "-adh_lognormal_skewness" in bad.stderr and "repel nowhere" in bad.stderr
     bad = cli(*args[:-3], "weibull", "-adh_lognormal_skewness", "-1", "-adh_lambda", "-1")
     assert bad.returncode == 2 and "-adh_lognormal_skewness" in bad.stderr and "lognormal" in bad.stderr
+
+
+def test_a_model_spread_rule():
+    """lognormal:skewness among the model spread's laws: the model it makes, its range refused."""
+    from petsc_adhesion.model.parameters import Model
+    from petsc_adhesion.tracing.model_spread import Rule, parse_rules
+    (rule,) = parse_rules("lognormal:-2")
+    m = rule.model(Model(mu=1.0, sigma=0.3))
+    assert (m.roughness, m.lognormal_skewness, m.sigma, rule.label) == ("lognormal", -2.0, 0.3, "lognormal:-2")
+    assert Rule.of(m) == rule
+    with pytest.raises(ValueError, match=r"\[-4, -0.25\]"):
+        parse_rules("lognormal:0")

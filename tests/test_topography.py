@@ -201,6 +201,8 @@ def test_a_flat_surface_is_the_smooth_sphere(runs):
     """A tilted plane, detrended, has no roughness: the smooth sphere's curve, the record saying why."""
     flat, smooth = runs["flat"], runs["smooth"]
     assert flat["sigma"] == 0 and "smooth" in flat["topography"] and "model_spread" not in flat
+    s = flat["topography"]["surfaces"][0]
+    assert s["rms_m"] == 0 and "skewness" not in s and "flat" in s["note"]
     assert flat["pull_off"]["F"] == smooth["pull_off"]["F"] and flat["pull_off"]["lambda"] == smooth["pull_off"]["lambda"]
 
 

@@ -131,4 +131,6 @@ def report_solve(s: Solution) -> None:
                     "H0_nm": s.H0 * d["approach_nm"]}
         line += (f"\n  in physical units (mu = {physical['mu']:.4g}): lambda = {physical['lambda_nm']:.5g} nm  "
                  f"F = {physical['F_nN']:.5g} nN  H0 = {physical['H0_nm']:.5g} nm")
+    if s.model.topography:
+        line += "\n" + "\n".join(topography_lines(s.model))
     tell(line)

@@ -28,7 +28,9 @@ Gwyddion).  A line profile is accepted: its heights sample the same distribution
 map of an isotropic surface, with fewer independent samples (its own autocorrelation,
 in one dimension).  A file that states no length unit takes the user's (``unit``);
 one that states no lateral size has its heights read and its size and correlation
-length absent (the statistics counted in pixels).
+length absent (the statistics counted in pixels).  Heights that the detrending leaves
+within 1e-6 of the data's range (a plane, up to float32 rounding) are a flat surface:
+zero, with no moments.
 
 :func:`gap_heights` gives the heights of the gap between two surfaces: the sum of
 their independent heights, whose distribution is the convolution of theirs.
@@ -284,6 +286,8 @@ def read_topography(path: str, detrend: str = "plane", unit: str | None = None) 
     scale = _length_units()[given] if stated is not None else LENGTH_UNITS[given]
     z = flat * scale
     z = z - z.mean()
+    if np.ptp(z) <= 1e-6 * np.ptp(data) * scale:     # a plane (or curvature) up to float32 rounding: flat
+        z = np.zeros_like(z)
     pixel = None if sizes is None else tuple(float(s) * scale / n for s, n in zip(sizes, data.shape))
     if not np.any(z):                 # a flat surface: moments undefined, the gap smooth
         zero = Moment(0.0, 0.0)
