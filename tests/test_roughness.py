@@ -85,7 +85,7 @@ def test_weibull_shapes_and_range():
             Weibull(1.0, bad)
     with pytest.raises(ValueError, match="cutoff"):
         TruncatedGaussian(1.0, 0.0)
-    assert set(DISTRIBUTIONS) == {"truncated_gaussian", "weibull", "measured"}
+    assert set(DISTRIBUTIONS) == {"truncated_gaussian", "weibull", "lognormal", "measured"}
 
 
 # -- the wall quadrature ------------------------------------------------------------

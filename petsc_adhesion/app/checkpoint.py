@@ -74,7 +74,7 @@ def default_path(targets: dict) -> str | None:
 def fingerprint(opts, comm, inputs: dict | None = None) -> dict:
     """What must not change between a run and its restart: the program's version, the ranks (a block
     preconditioner has one block a rank), every application option's value but FREE's (defaults
-    included), PETSc's options as given but those that only print, and the contents of the heights file."""
+    included), PETSc's options as given but those that only print, and the contents of the heights and topography files."""
     fp = {"version": __version__, "mpi_ranks": comm.getSize()}
     values = opts.values()
     for name, value in values.items():
@@ -83,7 +83,7 @@ def fingerprint(opts, comm, inputs: dict | None = None) -> dict:
     for name, value in sorted(opts.db.getAll().items()):       # getAll marks nothing used
         if name not in values and name not in FREE and not _PRINTING.search(name):
             fp[name] = "" if value is None else str(value)
-    for path in (inputs or {}).get("adh_roughness_file", ()):
+    for path in [*(inputs or {}).get("adh_roughness_file", ()), *(inputs or {}).get("adh_topography", ())]:
         if path and os.path.isfile(path):
             with open(path, "rb") as f:
                 fp[f"contents of {path}"] = hashlib.sha256(f.read()).hexdigest()

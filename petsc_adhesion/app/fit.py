@@ -130,7 +130,7 @@ def _template(opts: AppOptions, rms: float | None, eps: float) -> Model:
     rough = opts.choice("adh_roughness")
     if rough == "measured":
         raise InputError("-adh_roughness: measured is not fitted (its heights set sigma); give -phys_rms with "
-                         "hermite, truncated_gaussian or weibull")
+                         "hermite, truncated_gaussian, weibull or lognormal")
     sigma = 0.0 if rms is None else rms / eps
     if rough == "none" and sigma > 0:
         raise InputError("-phys_rms: not with -adh_roughness none (a smooth surface)")
@@ -142,6 +142,7 @@ def _template(opts: AppOptions, rms: float | None, eps: float) -> Model:
     return Model(mu=1.0, sigma=sigma, rmax=rmax, roughness=rough, hermite_points=opts.int("adh_hermite_points"),
                  roughness_cutoff=opts.real("adh_roughness_cutoff"),
                  roughness_skewness=opts.real("adh_roughness_skewness"),
+                 lognormal_skewness=opts.real("adh_lognormal_skewness"),
                  quadrature_points=opts.int("adh_quadrature_points"), farfield=opts.flag("adh_farfield"))
 
 

@@ -105,7 +105,8 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
     if "plot" in targets and not targets["plot"].lower().endswith(tuple(PLOT_FORMATS)):
         raise InputError(f"-plot: expected a file name ending in {', '.join(PLOT_FORMATS)}, got '{targets['plot']}'")
     inputs = {"options_file": options_files(argv), "adh_guess": [opts.string("adh_guess") or ""],
-              "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
+              "adh_roughness_file": [opts.string("adh_roughness_file") or ""],
+              "adh_topography": [opts.string(n) or "" for n in ("adh_topography", "adh_topography2")]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
     if is_study(opts) or lam is not None:    # no spread of a study's cases nor of one solve: asking is refused

@@ -35,6 +35,15 @@ DESCRIBE = {
                  "unit of the model in nN, nm and MPa"),
     "physical/inputs": ("radius*: m; young*: Pa; poisson*: 1; gamma: J/m^2; hamaker: J; hamaker_cutoff: m; "
                         "epsilon: m; rms: m", "the -phys_ options as given (SI)"),
+    "topography": ("*_m: m; *_epsilon: epsilon; correlation_length_pixels: pixels", "the measured topographies "
+                   "the gap's heights came from (-adh_topography, docs/topography.md): the gap's rms and how it was "
+                   "made; why the model is smooth when the gap is flat"),
+    "topography/surfaces": ("", "one group per topography file"),
+    "topography/surfaces/*": ("*_m: m; correlation_length_pixels: pixels; skewness, kurtosis: 1",
+                              "one topography: its file, kind (map or profile), pixels, size, unit and where it "
+                              "came from, detrending, and its heights' rms, skewness and kurtosis with their sampling "
+                              "uncertainty (from the heights' own autocorrelation) and the independent samples for "
+                              "each"),
     "grid": ("", "the collocation grid (of the last segment when the grid followed the contact edge)"),
     "grid/r": (_RAD, "the nodes r_i on [0, r_m]"),
     "grid/lambda": (_EPS, "approach where each segment of the curve, on its own grid, starts"),
@@ -123,8 +132,9 @@ DESCRIBE = {
 # -- layout ---------------------------------------------------------------------
 def with_options(head: dict, options: dict) -> dict:
     """A result's head with the options of its run after the program's keys, as the files hold them."""
-    program = {k: v for k, v in head.items() if k not in ("model", "grid", "physical")}
-    return {**program, "options": options, **{k: head[k] for k in ("model", "grid", "physical") if k in head}}
+    program = {k: v for k, v in head.items() if k not in ("model", "grid", "physical", "topography")}
+    return {**program, "options": options,
+            **{k: head[k] for k in ("model", "grid", "physical", "topography") if k in head}}
 
 
 def _h5_summary(summary: dict) -> dict:

@@ -5,7 +5,7 @@ from ..errors import tell
 from ..tracing.curve import Curve, Cycle, Event, Solution
 from ..tracing.measured import Measured, Missing
 from ..tracing.turning_points import EventGroup, TurningPoints, rigid_turning_points, spring_turning_points
-from .summary import summary_of
+from .summary import summary_of, topography_record
 
 
 def spread_lines(spread) -> list[str]:
@@ -15,7 +15,7 @@ def spread_lines(spread) -> list[str]:
 
     return report_lines(spread)
 
-__all__ = ["report_curve", "report_solve"]
+__all__ = ["report_curve", "report_solve", "topography_lines"]
 
 
 def _pm(name: str, m: Measured, digits: int = 8) -> str:
@@ -93,6 +93,8 @@ def report_curve(curve: Curve) -> None:
         out += _groups(behind, "turning points of Z")
         out += [_jump(behind.points[i], sp.K) for i in behind.ungrouped]
         out.append(f"  energy of a cycle       {_energy(sp.cycle)}  (spring K = {sp.K:.4g})")
+    if curve.model.topography:
+        out += topography_lines(curve.model)
     if curve.spread is not None:        # the model's spread, apart from the numerical bars above
         out += [f"  {line}" for line in spread_lines(curve.spread)]
     if curve.model.bodies is not None:
@@ -100,6 +102,26 @@ def report_curve(curve: Curve) -> None:
     for w in curve.warnings:
         out.append(f"  WARNING: {w}")
     tell("\n".join(out))
+
+
+def topography_lines(model) -> list[str]:
+    """The console lines of a model's topographies: each file's size, pixels, detrending and moments with their
+    sampling uncertainty; the gap's rms in epsilon; why the model is smooth where the gap is flat."""
+    rec = topography_record(model)
+    out = []
+    for s in rec["surfaces"]:
+        size = (" x ".join(f"{x * 1e6:.4g}" for x in s["size_m"]) + " um") if "size_m" in s else "size not stated"
+        moments = ""
+        if "skewness" in s:
+            moments = (f", skewness {s['skewness']:.3g} +- {s['skewness_err']:.2g}, kurtosis {s['kurtosis']:.3g} +- "
+                       f"{s['kurtosis_err']:.2g} (about {s['independent_samples'][0]:.0f} independent samples)")
+        out.append(f"  topography {s['file']}: a {s['kind']} of {' x '.join(map(str, s['pixels']))} pixels, {size}, "
+                   f"detrend {s['detrend']}: rms {s['rms_m'] * 1e9:.4g} +- {s['rms_err_m'] * 1e9:.2g} nm{moments}")
+        if "note" in s:
+            out.append(f"    note: {s['note']}")
+    out.append(f"  the gap ({rec['gap']}): rms {rec['gap_rms_epsilon']:.4g} +- {rec['gap_rms_err_epsilon']:.2g} "
+               "epsilon" + (f"; {rec['smooth']}" if "smooth" in rec else ""))
+    return out
 
 
 def _nm_nN(e: dict, key: str, unit: str) -> str:
@@ -156,4 +178,6 @@ def report_solve(s: Solution) -> None:
                     "H0_nm": s.H0 * d["approach_nm"]}
         line += (f"\n  in physical units (mu = {physical['mu']:.4g}): lambda = {physical['lambda_nm']:.5g} nm  "
                  f"F = {physical['F_nN']:.5g} nN  H0 = {physical['H0_nm']:.5g} nm")
+    if s.model.topography:
+        line += "\n" + "\n".join(topography_lines(s.model))
     tell(line)

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..model.physical import in_units
 from ..model.pressure import pressure_law
+from ..model.roughness import SMALLEST_RMS
 from ..tracing.curve import Curve, Cycle, Profile, Program, Solution
 from ..tracing.measured import Measured, Missing
 from ..tracing.turning_points import TurningPoints, rigid_turning_points, spring_turning_points
@@ -29,7 +30,7 @@ if TYPE_CHECKING:                    # tracing.critical loads PETSc, which a fil
 
 __all__ = ["event_record", "branch_record", "program_record", "model_record", "head_of", "summary_of",
            "solve_summary", "cycle_summary", "critical_record", "spread_record", "legs_record", "LEG_KEYS",
-           "primary_record", "groups_record", "KEYS"]
+           "primary_record", "groups_record", "topography_record", "KEYS"]
 
 #: A field's name -> the key the files have always used for it.
 KEYS = {"lam": "lambda", "note": "error_note"}
@@ -104,6 +105,47 @@ def model_record(model) -> dict:
             else "truncated at r_m (the paper's model)"}
 
 
+def _moment(name: str, m, unit: str = "") -> dict:
+    """A sample moment and its uncertainty as keys (the uncertainty absent where there is none)."""
+    return {f"{name}{unit}": m.value, **({f"{name}_err{unit}": m.err} if m.err is not None else {})}
+
+
+def topography_record(model) -> dict:
+    """The topographies a measured model's heights came from (docs/topography.md): per surface its file,
+    kind, pixels, size, unit, detrending and moments with their sampling uncertainty; the gap's rms in
+    epsilon; where the gap is flat, why the model is the smooth sphere.  {} without a topography."""
+    if not model.topography:
+        return {}
+    surfaces = []
+    for t in model.topography:
+        st = t.stats
+        r = {"file": t.path, "kind": t.kind, "pixels": list(t.pixels), "unit": t.unit, "unit_source": t.unit_source,
+             "detrend": t.detrend, **_moment("rms", st.rms, "_m"), "highest_m": st.highest, "lowest_m": st.lowest}
+        if st.rms.value > 0:
+            r |= {**_moment("skewness", st.skewness), **_moment("kurtosis", st.kurtosis),
+                  "correlation_length_pixels": list(st.correlation_length),
+                  "independent_samples": list(st.independent)}
+        if t.size is not None:
+            r |= {"size_m": list(t.size), "pixel_size_m": list(t.pixel_size)}
+        else:
+            r["size_note"] = "the file states no lateral size: the correlation length in pixels only"
+        if st.note:
+            r["note"] = st.note
+        surfaces.append(r)
+    eps = model.bodies.scales()["approach_m"]
+    rms = float(np.sqrt(sum(t.stats.rms.value ** 2 for t in model.topography)))
+    err = float(np.sqrt(sum((t.stats.rms.value * t.stats.rms.err) ** 2 for t in model.topography))) / rms \
+        if rms > 0 else 0.0
+    out = {"surfaces": surfaces, "gap_rms_m": rms, "gap_rms_err_m": err, "gap_rms_epsilon": rms / eps,
+           "gap_rms_err_epsilon": err / eps,
+           "gap": "one surface's heights" if len(surfaces) == 1 else
+           "the sum of the two surfaces' heights: their distributions convolved"}
+    if model.roughness == "none":
+        out["smooth"] = (f"the gap's rms {rms / eps:.3g} epsilon is below {SMALLEST_RMS:g}: the model is the smooth "
+                         "sphere")
+    return out
+
+
 def _grid(result) -> dict:
     g = result.grid
     out = {"r": g.r}
@@ -117,6 +159,8 @@ def head_of(result) -> dict:
     head = {**program_record(result.program), "model": model_record(result.model), "grid": _grid(result)}
     if result.model.bodies is not None:
         head["physical"] = result.model.bodies.describe()
+    if result.model.topography:
+        head["topography"] = topography_record(result.model)
     return head
 
 
@@ -267,6 +311,8 @@ def summary_of(curve: Curve) -> dict:
             phys["spring"]["jump_groups"] = _physical_groups(s["spring"]["jump_groups"], "Z", units)
     if spread is not None:               # after physical: in_units reads the events, not the spread
         s["model_spread"] = spread_record(spread)
+    if curve.model.topography:
+        s["topography"] = topography_record(curve.model)
     return _plain(s)
 
 
@@ -285,6 +331,8 @@ def solve_summary(solution: Solution) -> dict:
         d = solution.model.bodies.describe()
         summ["physical"] = {**d, "lambda_nm": res["lambda"] * d["approach_nm"], "F_nN": res["F"] * d["force_nN"],
                             "H0_nm": res["H0"] * d["approach_nm"]}
+    if solution.model.topography:
+        summ["topography"] = topography_record(solution.model)
     return _plain(summ)
 
 

@@ -78,8 +78,13 @@ class Model:
     hermite_points: int = 16
     roughness_cutoff: float = 3.0     # truncated_gaussian: highest asperity at K sigma
     roughness_skewness: float = 0.0   # weibull: third standardised moment of the heights
+    lognormal_skewness: float = -1.0  # lognormal: third standardised moment of the heights (< 0: bounded above)
     quadrature_points: int = NEAR_POINTS  # truncated_gaussian, weibull: points of the moving part at the wall
     heights: np.ndarray | None = field(default=None, repr=False, compare=False)  # measured, units of epsilon
+    #: measured: the probability of each height (the gap of two surfaces, their convolution); None: equal
+    height_weights: np.ndarray | None = field(default=None, repr=False, compare=False)
+    #: the measured topographies (model.topography.Topography) the heights came from: one surface or two
+    topography: tuple = field(default=(), repr=False, compare=False)
     farfield: bool = True      # add the rigid sphere's attraction beyond r_m (the half-infinite model)
     #: the physical inputs that made mu (and sigma): results are reported in SI too (None: dimensionless only)
     bodies: PhysicalBodies | None = field(default=None, repr=False, compare=False)
@@ -93,7 +98,8 @@ class Model:
             raise ValueError(f"no parameter '{name}': mu or sigma")
         if self.roughness == "measured":
             assert self.heights is not None, "a measured roughness without its heights"
-            return replace(self, heights=self.heights * (value / Measured(self.heights).rms), bodies=None)
+            rms = Measured(self.heights, weights=self.height_weights).rms
+            return replace(self, heights=self.heights * (value / rms), bodies=None)
         return replace(self, sigma=value, bodies=None)
 
     @property

@@ -138,7 +138,7 @@ class WallLaw:
     Parameters
     ----------
     dist
-        :class:`~.roughness.TruncatedGaussian` or :class:`~.roughness.Weibull`; zero
+        :class:`~.roughness.TruncatedGaussian`, :class:`~.roughness.Weibull` or :class:`~.roughness.Lognormal`; zero
         rms gives the smooth law.
     points
         Points of the moving part of the rule; its fixed panels get
@@ -171,6 +171,7 @@ class WallLaw:
         if self.smooth:
             return {}
         shape = {"roughness_cutoff": self.dist.cutoff} if self.rule == "truncated_gaussian" else \
+            {"lognormal_skewness": self.dist.skewness} if self.rule == "lognormal" else \
             {"roughness_skewness": self.dist.skewness}
         return {"roughness": self.rule, **shape, "rms": self.dist.rms, "highest_asperity": self.dist.top,
                 "quadrature_points": self.points}

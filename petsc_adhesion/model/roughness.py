@@ -27,6 +27,9 @@ Families, by name (:data:`DISTRIBUTIONS`):
     eq. (3) cut at +-K sigma (:class:`TruncatedGaussian`);
 ``weibull``
     reversed Weibull heights, skewed and bounded above by construction (:class:`Weibull`);
+``lognormal``
+    heights whose depth below the highest asperity is lognormal (:class:`Lognormal`), the
+    distribution the paper suggests, its long tail in the valleys;
 ``measured``
     the histogram of heights read from a file (:class:`Measured`, :func:`read_heights`),
     averaged exactly by ``pressure.HistogramLaw``.
@@ -41,7 +44,7 @@ from scipy.special import gamma, roots_jacobi
 from .. import brent
 from .heights import HeightFileError, _check
 
-__all__ = ["TruncatedGaussian", "Weibull", "Measured", "WallQuadrature", "DISTRIBUTIONS", "NEAR_POINTS", "PANEL_POINTS", "panel_points", "distribution"]
+__all__ = ["TruncatedGaussian", "Weibull", "Lognormal", "Measured", "WallQuadrature", "DISTRIBUTIONS", "NEAR_POINTS", "PANEL_POINTS", "panel_points", "distribution"]
 
 #: Points of the moving rule on [0, b]: relative error below 1e-11 while b/d <= 5e3.
 NEAR_POINTS = 24
@@ -229,6 +232,102 @@ def _skewness(k: float) -> float:
     return -(g3 - 3 * g1 * g2 + 2 * g1 ** 3) / (g2 - g1 * g1) ** 1.5
 
 
+class Lognormal:
+    """Heights whose depth below the highest asperity is lognormal: S = S_max - W, log W ~ N(m, s^2).
+
+    The paper suggests a lognormal height distribution.  A lognormal is bounded on one
+    side only, and the side decides whether the average of eq. (7) exists: with the
+    long tail upwards (S = W - c) some heights close any gap and the average diverges
+    as the Gaussian's does; with the tail downwards, into the valleys, the heights are
+    bounded above by S_max = E[W] (zero mean) and the average converges.  We take the
+    second: a surface of plateaus and deep valleys, skewness negative.  The density
+    vanishes at the top faster than any power of the depth, so the repulsion stays
+    finite at the wall itself, P(wall) = E[W^-9] - E[W^-3] = e^(-9 m + 81 s^2/2) -
+    e^(-3 m + 9 s^2/2) (:attr:`wall_pressure`); the law refuses H at or below the wall
+    all the same (a state there would put the highest asperity through the other
+    surface).  So a lognormal surface carries no pressure above P(wall): a curve that
+    needs more ends there, and where P(wall) <= 0 (at sigma = 0.2 a skewness above
+    -0.6, at sigma = 1 above -1.2) the heights cannot even hold the surfaces apart
+    against their attraction, and the option reader refuses them.
+
+    The moments: Var W = (e^(s^2) - 1) e^(2 m + s^2) = rms^2 and skewness
+    -(e^(s^2) + 2) sqrt(e^(s^2) - 1), which fixes s; then S_max = rms / sqrt(e^(s^2) - 1)
+    (3.10 rms at skewness -1, 12.0 rms at -0.25, 1.00 rms at -4: as the skewness goes to 0 the law
+    becomes the Gaussian, with no highest asperity).
+
+    In t = log W the weight is the Gaussian phi((t - m)/s)/s dt and the gap d + e^t is
+    analytic in the strip |Im t| < pi whatever d >= 0: Gauss panels in t, fixed, serve
+    every d including the wall (no moving part, :attr:`near_width` 0).
+
+    Parameters
+    ----------
+    sigma
+        Root mean square height (units of epsilon).
+    skewness
+        Third standardised moment of the heights, in :attr:`SKEWNESS`.
+    """
+
+    name = "lognormal"
+    SKEWNESS = (-4.0, -0.25)
+    wall_exponent = 0.0
+    near_width = 0.0
+
+    def __init__(self, sigma: float, skewness: float = -1.0):
+        if not (math.isfinite(sigma) and sigma >= 0):
+            raise ValueError(f"sigma must be finite and >= 0, got {sigma:g}")
+        lo, hi = self.SKEWNESS
+        if not lo <= skewness <= hi:
+            raise ValueError(f"the skewness of lognormal heights must lie in [{lo:g}, {hi:g}], got {skewness:g}")
+        self.sigma = self.rms = float(sigma)
+        self.skewness = float(skewness)
+        self.shape = s = brent.root(lambda s: _lognormal_skewness(s) + skewness, 1e-3, 3.0, xtol=1e-15)
+        spread = math.expm1(s * s)
+        self.top, self.bottom = self.sigma / math.sqrt(spread), -math.inf
+        self.log_median = math.log(self.top) - s * s / 2 if self.sigma > 0 else -math.inf
+
+    @property
+    def wall_pressure(self) -> float:
+        """The repulsion at the wall, E[W^-9] - E[W^-3] = e^(-9 m + 81 s^2/2) - e^(-3 m + 9 s^2/2) (inf when smooth).
+
+        Finite: no state is compressed harder than this.  Not positive (the highest asperity
+        more than about 1.2 epsilon above the few at small depths: large rms, small skewness)
+        it does not even hold the surfaces apart against their attraction.
+        """
+        if self.sigma == 0:
+            return math.inf
+        m, s = self.log_median, self.shape
+        return math.exp(-9 * m + 40.5 * s * s) - math.exp(-3 * m + 4.5 * s * s)
+
+    def pdf(self, S: np.ndarray) -> np.ndarray:
+        """Density of the heights: the lognormal density of the depth u = S_max - S > 0, 0 at and above the top."""
+        u = self.top - np.asarray(S, dtype=float)
+        return np.where(u > 0, self.depth_pdf(np.where(u > 0, u, 1.0)), 0.0)
+
+    def depth_pdf(self, u: np.ndarray) -> np.ndarray:
+        """Density q(u) = exp(-(log u - m)^2 / (2 s^2)) / (u s sqrt(2 pi)) of the depth u > 0."""
+        z = (np.log(u) - self.log_median) / self.shape
+        return np.exp(-0.5 * z * z) / (u * self.shape * math.sqrt(2 * math.pi))
+
+    def far_rule(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Depths e^t and their weights (density included), Gauss panels of at most min(2 s, 1) in t.
+
+        From t = m - 9 s^2 - 9 s, 9 s below where (d + e^t)^-9 phi peaks at the wall
+        (t = m - 9 s^2), to m + 9 s: the weight left out is below 1e-18 of P for every
+        d >= 0.  The panels resolve the weight (width s) and the gap (strip pi) alike.
+        """
+        m, s = self.log_median, self.shape
+        lo, hi = m - 9 * s * s - 9 * s, m + 9 * s
+        t, w = _panels(np.linspace(lo, hi, math.ceil((hi - lo) / min(2 * s, 1.0)) + 1), n)
+        z = (t - m) / s
+        return np.exp(t), w * np.exp(-0.5 * z * z) / (s * math.sqrt(2 * math.pi))
+
+
+def _lognormal_skewness(s: float) -> float:
+    """Skewness (e^(s^2) + 2) sqrt(e^(s^2) - 1) of a lognormal of log-spread s."""
+    x = math.expm1(s * s)
+    return (x + 3) * math.sqrt(x)
+
+
 class WallQuadrature:
     """Rule for E[f(d + u)] over the depth u below the highest asperity, f ~ g^-k at g = 0.
 
@@ -255,7 +354,9 @@ class WallQuadrature:
 
     def __init__(self, dist, near_points: int = NEAR_POINTS, panel_points: int = PANEL_POINTS):
         self.near_width, self.beta = dist.near_width, dist.wall_exponent
-        x, w = roots_jacobi(near_points, 0.0, self.beta)
+        if self.near_width == 0:        # a density that vanishes faster than any power at the top: no moving part
+            near_points = 0
+        x, w = roots_jacobi(near_points, 0.0, self.beta) if near_points else (np.zeros(0), np.zeros(0))
         # the rule on [0, V] is V^(1+beta) sum w_i phi(V t_i) with phi = q g / v^beta, v^beta = V^beta t^beta
         self._t = (1 + x) / 2
         self._w = w / 2 ** (1 + self.beta) / self._t ** self.beta
@@ -298,29 +399,42 @@ class Measured:
         Heights in units of epsilon, any shape.
     bins
         Number of bins; default Freedman-Diaconis, at most :attr:`MAX_BINS`.
+    weights
+        The probability of each height (a distribution given on points, e.g. the gap's
+        convolution of two surfaces, :func:`~.topography.gap_heights`); None: equal.
     """
 
     name = "measured"
     MAX_BINS = 128
 
-    def __init__(self, heights: np.ndarray, bins: int | None = None):
+    def __init__(self, heights: np.ndarray, bins: int | None = None, weights: np.ndarray | None = None):
         S = np.asarray(heights, dtype=float).ravel()
         _check(S, "heights")
-        S = S - S.mean()
+        w = np.full(S.size, 1.0 / S.size) if weights is None else np.asarray(weights, dtype=float).ravel()
+        if w.shape != S.shape or not np.all(w > 0) or not np.isfinite(w.sum()):
+            raise ValueError("weights: one positive weight a height")
+        w = w / w.sum()
+        S = S - w @ S
         self.samples = S.size
-        self.rms = self.sigma = float(np.sqrt(np.mean(S * S)))
+        self.rms = self.sigma = float(np.sqrt(w @ (S * S)))
         if not self.rms >= SMALLEST_RMS:
             raise HeightFileError(f"heights: rms {self.rms:.3g} epsilon, below {SMALLEST_RMS:g}: the histogram's average "
                                   f"would round to more than the roughness changes (a smooth surface: -adh_roughness none)")
-        self.skewness = float(np.mean(S ** 3)) / self.rms ** 3
+        self.skewness = float(w @ S ** 3) / self.rms ** 3
         self.top, self.bottom = float(S.max()), float(S.min())
-        if bins is None:
+        if bins is None and weights is None:
             bins = min(np.histogram_bin_edges(S, "fd").size - 1, self.MAX_BINS)
+        elif bins is None:          # Freedman-Diaconis on the weighted quartiles
+            order = np.argsort(S)
+            q1, q3 = np.interp([0.25, 0.75], np.cumsum(w[order]), S[order])
+            width = 2 * (q3 - q1) / S.size ** (1 / 3)
+            bins = self.MAX_BINS if width <= 0 else int(min(self.MAX_BINS, max(1, math.ceil((self.top - self.bottom)
+                                                                                            / width))))
         if not (isinstance(bins, (int, np.integer)) and bins >= 1):
             raise ValueError(f"bins must be an integer >= 1, got {bins}")
         self.edges = np.linspace(self.bottom, self.top, bins + 1)
-        counts, _ = np.histogram(S, self.edges)
-        self.density = counts / (S.size * np.diff(self.edges))
+        mass, _ = np.histogram(S, self.edges, weights=w)
+        self.density = mass / np.diff(self.edges)
 
     def pdf(self, S: np.ndarray) -> np.ndarray:
         """The histogram density (the top edge belongs to the top bin)."""
@@ -330,13 +444,15 @@ class Measured:
 
 
 #: The distributions of -adh_roughness bounded above, by name.
-DISTRIBUTIONS = (TruncatedGaussian.name, Weibull.name, Measured.name)
+DISTRIBUTIONS = (TruncatedGaussian.name, Weibull.name, Lognormal.name, Measured.name)
 
 
 def distribution(model):
     """The height distribution of ``model`` (its ``roughness`` one of :data:`DISTRIBUTIONS`)."""
     if model.roughness == Measured.name:
-        return Measured(model.heights)
+        return Measured(model.heights, weights=model.height_weights)
     if model.roughness == Weibull.name:
         return Weibull(model.sigma, model.roughness_skewness)
+    if model.roughness == Lognormal.name:
+        return Lognormal(model.sigma, model.lognormal_skewness)
     return TruncatedGaussian(model.sigma, model.roughness_cutoff)

@@ -27,7 +27,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 
-from ..model.roughness import Weibull
+from ..model.roughness import Lognormal, Measured as Heights, Weibull
 from .measured import Measured, Missing
 from .trace import CurveRequest, GridChoice, SolverChoice, trace_curve
 
@@ -47,13 +47,15 @@ LAWS = {"hermite": ("hermite_points", int, (2, 400), "points of the Gauss-Hermit
         "truncated_gaussian": ("roughness_cutoff", float, (1e-6, 10.0),
                                "the highest asperity K in standard deviations, in [1e-06, 10]"),
         "weibull": ("roughness_skewness", float, Weibull.SKEWNESS,
-                    "the skewness of the heights, in [%g, %g]" % Weibull.SKEWNESS)}
+                    "the skewness of the heights, in [%g, %g]" % Weibull.SKEWNESS),
+        "lognormal": ("lognormal_skewness", float, Lognormal.SKEWNESS,
+                      "the skewness of the heights, in [%g, %g]" % Lognormal.SKEWNESS)}
 
 
 @dataclass(frozen=True)
 class Rule:
     """A roughness law and its one parameter: ``hermite`` (points of the rule), ``truncated_gaussian`` (the
-    cut-off K), ``weibull`` (the skewness) or ``measured`` (the heights of the model, no parameter)."""
+    cut-off K), ``weibull`` and ``lognormal`` (the skewness) or ``measured`` (the heights of the model, no parameter)."""
 
     law: str
     parameter: float | None = None
@@ -120,11 +122,19 @@ def default_rules(model) -> tuple:
     surfaces fall between, and the reversed Weibull of skewness 0: a bounded law with
     the Gaussian's first three moments but another upper tail (its highest asperity at
     3.24 rms), so that the shape of the tail, not only its end, is varied.
+
+    Under measured heights, first what the Gaussian rule with their rms gives (the paper's
+    16-point Hermite rule) and the truncated Gaussian whose highest asperity is the
+    heights' own (K = highest height / rms, to two decimals, at most 10): the same rms and
+    top, the Gaussian's shape, so that the distance is the measured shape's alone.
     """
     own = Rule.of(model)
     rules: tuple[Rule, ...] = (Rule("hermite", 2 * model.hermite_points),) if own.law == "hermite" else ()
+    if own.law == "measured" and model.heights is not None:
+        heights = Heights(model.heights, weights=model.height_weights)
+        rules += (Rule("hermite", 16), Rule("truncated_gaussian", min(10.0, round(heights.top / heights.rms, 2))))
     rules += (Rule("truncated_gaussian", 3.0), Rule("truncated_gaussian", 4.0), Rule("weibull", 0.0))
-    return tuple(r for r in rules if r != own)
+    return tuple(dict.fromkeys(r for r in rules if r != own))
 
 
 @dataclass(frozen=True)

@@ -60,6 +60,8 @@ def check_consistency(opts: AppOptions, model: Model) -> None:
         ignored += [(n, f"is a -grid_type paper option (this run's grid is {kind})")
                     for n in _given(opts, [n for n in TABLE if n.startswith("grid_paper_")])]
     for name, kinds in ROUGHNESS_OPTIONS.items():
+        if opts.db.hasName(name) and name.startswith("adh_topography") and model.topography:
+            continue        # a flat topography: the smooth sphere, from the options that said so
         if opts.db.hasName(name):
             if model.roughness not in kinds:
                 ignored.append((name, f"applies to -adh_roughness {' or '.join(kinds)}"))

@@ -15,7 +15,8 @@ from ...model.heights import HeightFileError, read_heights
 from ...model.parameters import Model, PhysicalBodies
 from ...model.parameters import tabor
 from ...model.physical import Bodies
-from ...model.roughness import Measured
+from ...model.roughness import SMALLEST_RMS, Lognormal, Measured
+from ...model.topography import gap_heights, read_topography
 from ...core.bordered import ARCLENGTH_PREFIX
 from ...core.continuation import NATURAL_PREFIX
 from ...core.fold import FOLD_PREFIX
@@ -26,7 +27,7 @@ from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_setti
 from .plausible import slip
 from .table import TABLE, Option
 
-__all__ = ["AppOptions", "Given", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_grid", "read_solver",
+__all__ = ["AppOptions", "Given", "PHYSICAL", "read_physical", "read_model", "read_measured", "read_topographies", "read_grid", "read_solver",
            "read_petsc", "ROLE_PREFIXES", "SOLVER_OPTIONS",
            "read_request", "read_settings", "read_spring", "read_trigger", "read_model_spread"]
 
@@ -328,25 +329,41 @@ def read_model(opts: AppOptions) -> Model:
     rmax = opts.real("adh_rmax")
     if rmax is None:
         rmax = GridChoice(opts.choice("grid_type")).default_rmax
-    rough, sigma, heights = opts.choice("adh_roughness"), opts.real("adh_sigma"), None
+    rough, sigma, heights, weights = opts.choice("adh_roughness"), opts.real("adh_sigma"), None, None
     if phys and phys.sigma is not None:
         sigma = phys.sigma
-    if rough == "measured":
+    topography: tuple = ()
+    if rough == "measured" and (opts.db.hasName("adh_topography") or opts.db.hasName("adh_topography2")):
+        heights, weights, topography = read_topographies(opts, phys.epsilon if phys else None)
+        if heights is None:           # a flat surface: the smooth sphere, the record saying why
+            rough, sigma = "none", 0.0
+        else:
+            sigma = Measured(heights, weights=weights).rms
+    elif rough == "measured":
         heights = read_measured(opts, phys.epsilon if phys else None)
         sigma = Measured(heights).rms
     model = Model(mu=mu, sigma=sigma, rmax=rmax, roughness=rough, hermite_points=opts.int("adh_hermite_points"),
                   roughness_cutoff=opts.real("adh_roughness_cutoff"),
                   roughness_skewness=opts.real("adh_roughness_skewness"),
-                  quadrature_points=opts.int("adh_quadrature_points"), heights=heights,
+                  lognormal_skewness=opts.real("adh_lognormal_skewness"),
+                  quadrature_points=opts.int("adh_quadrature_points"), heights=heights, height_weights=weights,
+                  topography=topography,
                   farfield=opts.flag("adh_farfield"), bodies=phys)
     if model.roughness == "none" and model.sigma > 0:
         raise InputError(f"-adh_sigma: must be 0 with -adh_roughness none, got {model.sigma:g}")
+    if model.roughness == Lognormal.name and model.sigma > 0 and not Lognormal(sigma, model.lognormal_skewness).wall_pressure > 0:
+        raise InputError(f"-adh_lognormal_skewness: {model.lognormal_skewness:g} at sigma {model.sigma:g} puts the highest "
+                         f"asperity {Lognormal(sigma, model.lognormal_skewness).top:.3g} epsilon up with no weight near it: "
+                         "the heights repel nowhere (P at the wall <= 0); give a more negative skewness or a smaller rms")
     return model
 
 
 def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
     """The heights of -adh_roughness_file in units of epsilon (:func:`~.roughness.read_heights`)."""
     path = opts.string("adh_roughness_file")
+    for name in ("adh_topography_detrend", "adh_topography_unit"):
+        if opts.db.hasName(name):
+            raise InputError(f"-{name}: applies to -adh_topography, not to -adh_roughness_file")
     if path is None:
         raise InputError("-adh_roughness_file: required with -adh_roughness measured: a file of heights")
     if opts.db.hasName("adh_sigma"):
@@ -361,6 +378,41 @@ def read_measured(opts: AppOptions, epsilon: float | None) -> np.ndarray:
     if not np.sqrt(np.mean((heights - heights.mean()) ** 2)) <= TABLE["adh_sigma"].hi:
         raise InputError(f"-adh_roughness_file: heights of rms above {TABLE['adh_sigma'].hi:g} epsilon")
     return heights
+
+
+def read_topographies(opts: AppOptions, epsilon: float | None) -> tuple:
+    """The gap's heights in units of epsilon from -adh_topography (and -adh_topography2), their weights (None:
+    equal) and the :class:`~petsc_adhesion.model.topography.Topography` of each; the heights None for a flat gap (rms below
+    :data:`~petsc_adhesion.model.roughness.SMALLEST_RMS` epsilon: the smooth sphere)."""
+    first, second = opts.string("adh_topography"), opts.string("adh_topography2")
+    if first is None:
+        raise InputError("-adh_topography2: the second surface's, only with -adh_topography (the first's)")
+    for name in ("adh_roughness_file", "adh_roughness_unit", "adh_sigma"):
+        if opts.db.hasName(name):
+            raise InputError(f"-{name}: not with -adh_topography, whose heights set the roughness")
+    if epsilon is None:
+        raise InputError("-adh_topography: heights in metres need -phys_epsilon (with the other -phys_ options) to "
+                         "become sigma in units of epsilon")
+    surfaces = []
+    for name, path in (("adh_topography", first), ("adh_topography2", second)):
+        if path is None:
+            continue
+        check_input(name, path)
+        try:
+            surfaces.append(read_topography(path, opts.choice("adh_topography_detrend"),
+                                            opts.choice("adh_topography_unit")))
+        except HeightFileError as e:
+            why = str(e).replace("give the unit of its values", "give -adh_topography_unit").replace(
+                "give none", "give no -adh_topography_unit")
+            raise InputError(f"-{name}: {printable(why)}") from None
+    heights, weights = gap_heights(tuple(surfaces), epsilon)
+    w = np.full(heights.size, 1 / heights.size) if weights is None else weights
+    rms = float(np.sqrt(w @ (heights - w @ heights) ** 2))
+    if rms < SMALLEST_RMS:
+        return None, None, tuple(surfaces)
+    if not rms <= TABLE["adh_sigma"].hi:
+        raise InputError(f"-adh_topography: heights of rms {rms:.3g} epsilon, above {TABLE['adh_sigma'].hi:g}")
+    return heights, weights, tuple(surfaces)
 
 
 def read_grid(opts: AppOptions, model: Model) -> GridChoice:

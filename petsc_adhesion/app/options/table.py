@@ -18,7 +18,7 @@ from ...core.newton import PC_REUSE_ITS
 from ...discretization import grid, preconditioning
 from ...model.parameters import Model
 from ...model.physical import HAMAKER_CUTOFF
-from ...model.roughness import DISTRIBUTIONS, Weibull
+from ...model.roughness import DISTRIBUTIONS, Lognormal, Weibull
 from ...tracing.edge_grids import RMAX
 from ...tracing.trace import F_MAX
 
@@ -85,25 +85,40 @@ TABLE = {o.name: o for o in [
     Option("adh_sigma", "real", Model.sigma, "roughness: standard deviation of the heights / epsilon", 0.0, 5.0),
     Option("adh_roughness", "choice", Model.roughness, "height distribution averaged over (eq. 7, 10): the "
            "paper's Gaussian by its Gauss-Hermite rule (eq. 14), whose rule is the model; Gaussian truncated at "
-           "the highest asperity; skewed (reversed Weibull); measured heights; none (smooth)",
+           "the highest asperity; skewed (reversed Weibull); depths below the highest asperity lognormal; measured "
+           "heights; none (smooth)",
            choices=("none", *RULES_HERMITE, *DISTRIBUTIONS)),
     Option("adh_hermite_points", "int", Model.hermite_points, "points of the Gauss-Hermite rule (eq. 14)", 2, 200),
     Option("adh_roughness_cutoff", "real", Model.roughness_cutoff, "truncated_gaussian: the highest asperity, "
            "in standard deviations (-adh_sigma) of the untruncated Gaussian", 1e-6, 10.0),
     Option("adh_roughness_skewness", "real", Model.roughness_skewness, "weibull: skewness of the heights "
            "(-2: exponential valleys, 0.5: the most symmetric bounded)", *Weibull.SKEWNESS),
+    Option("adh_lognormal_skewness", "real", Model.lognormal_skewness, "lognormal: skewness of the heights "
+           "(negative: the long tail in the valleys, the heights bounded above)", *Lognormal.SKEWNESS),
     Option("adh_roughness_file", "string", None, "measured: heights, one a line in units of epsilon; a table "
            "(Gwyddion ASCII export, '# Value units: m'), .gsf or .npy height map; it sets sigma itself"),
     Option("adh_roughness_unit", "real", None, "measured: metres per value of a file that states no unit "
            "(needs -phys_epsilon)", 0.0, 1.0, lo_open=True),
-    Option("adh_quadrature_points", "int", Model.quadrature_points, "truncated_gaussian, weibull: points of "
-           "the quadrature's moving part at the wall (its fixed panels get 2/3 as many)", 2, 400),
+    Option("adh_topography", "string", None, "measured: a topography file (an AFM image, a profilometer map or "
+           "profile, text with a header: any format SurfaceTopography reads, with its units and size), detrended; its "
+           "heights (with -adh_topography2's, combined) are the gap's; needs -phys_epsilon and SurfaceTopography"),
+    Option("adh_topography2", "string", None, "measured: the second surface's topography file (the sphere's); the "
+           "gap's heights are the sum of the two surfaces' (their distributions convolved)"),
+    Option("adh_topography_detrend", "choice", "plane", "measured: what is removed from a topography before its "
+           "heights are taken: the mean only, the least-squares plane (tilt is mounting, not roughness), or the "
+           "second-order polynomial (a bent sample, a scanner's bow)", choices=("none", "plane", "curvature")),
+    Option("adh_topography_unit", "choice", None, "measured: the length unit of the values of a topography file "
+           "that states none (refused for one that does)", choices=("m", "mm", "um", "nm", "A", "pm")),
+    Option("adh_quadrature_points", "int", Model.quadrature_points, "truncated_gaussian, weibull, lognormal: "
+           "points of the quadrature's moving part at the wall (its fixed panels get 2/3 as many; lognormal has "
+           "fixed panels only)", 2, 400),
     Option("adh_model_spread", "flag", None, "trace a rough curve's events again under other roughness laws "
            "(events only) and say how far they move: the model's spread beside the numerical bar (default: true "
            "when sigma > 0; docs/model.md)"),
     Option("adh_model_spread_rules", "rules", None, "the laws of -adh_model_spread (default: hermite with twice "
            "the points under hermite, truncated_gaussian:3, truncated_gaussian:4, weibull:0; the reference's own "
-           "left out)", choices=(("hermite", "N"), ("truncated_gaussian", "K"), ("weibull", "skewness"))),
+           "left out)", choices=(("hermite", "N"), ("truncated_gaussian", "K"), ("weibull", "skewness"),
+                    ("lognormal", "skewness"))),
     Option("adh_rmax", "real", None, f"end r_m of the computational domain (default: {RMAX:g} on grids that "
            f"follow the contact edge, {grid.PAPER_RMAX:g} as in the paper otherwise)", 0.0, 1e3, lo_open=True),
     Option("adh_farfield", "flag", Model.farfield, "add the rigid sphere's attraction beyond r_m to the load: "
@@ -278,5 +293,8 @@ TABLE = {o.name: o for o in [
 
 #: Options of one roughness model: name -> the -adh_roughness values that use it.
 ROUGHNESS_OPTIONS = {"adh_hermite_points": RULES_HERMITE, "adh_roughness_cutoff": ("truncated_gaussian",),
-                     "adh_roughness_skewness": ("weibull",), "adh_quadrature_points": ("truncated_gaussian", "weibull"),
-                     "adh_roughness_file": ("measured",), "adh_roughness_unit": ("measured",)}
+                     "adh_roughness_skewness": ("weibull",), "adh_lognormal_skewness": ("lognormal",),
+                     "adh_quadrature_points": ("truncated_gaussian", "weibull", "lognormal"),
+                     "adh_roughness_file": ("measured",), "adh_roughness_unit": ("measured",),
+                     "adh_topography": ("measured",), "adh_topography2": ("measured",),
+                     "adh_topography_detrend": ("measured",), "adh_topography_unit": ("measured",)}
