@@ -90,9 +90,11 @@ class Request:
     spread_rules: tuple | None = None  # the laws of the model spread (-adh_model_spread), None: none
 
 
-def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False) -> Request:
+def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False,
+         case: bool = False) -> Request:
     """Read and check every option before any work (PETSc's solver options too, as far as they can be judged
-    before the solvers exist); ``kinds`` and ``profiles``: what a study's case reports."""
+    before the solvers exist); ``kinds`` and ``profiles``: what a study's ``case`` reports (its model spread
+    that of a rough case; a smooth case of a study has none, whatever -adh_model_spread says)."""
     model = read_model(opts)
     grid_choice = read_grid(opts, model)
     lam = opts.real("adh_lambda")
@@ -110,12 +112,14 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
               "adh_roughness_file": [opts.string("adh_roughness_file") or ""]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
-    if is_study(opts) or lam is not None:    # no spread of a study's cases nor of one solve: asking is refused
+    if lam is not None:    # no spread of one solve: asking is refused
         for name in ("adh_model_spread", "adh_model_spread_rules"):
             if opts.db.hasName(name):
-                what = "-adh_lambda (one solve)" if lam is not None else "a study of many cases"
-                raise InputError(f"-{name}: applies to one run's curve or -fit_pull_off, not {what}; remove it")
+                raise InputError(f"-{name}: applies to a curve (one run's, a study's cases) or -fit_pull_off, not "
+                                 f"-adh_lambda (one solve); remove it")
         spread_rules = None
+    elif case and not (model.roughness != "none" and model.sigma > 0):
+        spread_rules = None        # a study's smooth case: no law to vary (the study refuses a spread no case has)
     else:
         spread_rules = read_model_spread(opts, model)
     return Request(model, grid_choice, read_solver(opts), read_settings(opts, model), read_request(opts, kinds, profiles, model.bodies),

@@ -18,7 +18,7 @@ negative when tensile), r and contact radii in sqrt(epsilon R), P in
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -28,9 +28,10 @@ from .measured import Measured, Missing
 
 if TYPE_CHECKING:
     from ..model.parameters import Model
+    from .critical import Critical
 
 __all__ = ["Profile", "Landing", "Event", "Branch", "Cycle", "SpringResult", "ErrorEstimate", "Diagnostics",
-           "Assessment", "Program", "GridRecord", "Curve", "Solution", "EVENT_KINDS"]
+           "Assessment", "Program", "GridRecord", "Curve", "Solution", "CaseResult", "EVENT_KINDS"]
 
 #: The kinds of events of a curve (:mod:`~petsc_adhesion.tracing.results` names them).
 EVENT_KINDS = ("snap_on", "snap_off", "F_min", "F_max", "equilibrium", "lambda", "jump_in", "jump_off")
@@ -313,6 +314,23 @@ class Curve:
         """Behind a spring, its base position Z = lambda + F / K at every computed point (else None)."""
         return self.branch.Z
 
+    def keeping_profiles(self, kinds: tuple | None) -> Curve:
+        """This curve with the profiles (H and P at an event and at its landing) of the events of ``kinds``
+        alone (None: all it has), as a study keeps a case (-study_profiles): the others' arrays are no part
+        of its files, nor of its checkpoint."""
+        if kinds is None:
+            return self
+
+        def kept(e: Event) -> Event:
+            if e.kind in kinds:
+                return e
+            landing = None if e.landing is None else replace(e.landing, profile=None)
+            return replace(e, profile=None, landing=landing)
+
+        spring = None if self.spring is None else replace(self.spring, jumps=tuple(map(kept, self.spring.jumps)))
+        return replace(self, events=tuple(map(kept, self.events)),
+                       pull_off=None if self.pull_off is None else kept(self.pull_off), spring=spring)
+
 
 @dataclass(frozen=True)
 class Solution:
@@ -333,3 +351,35 @@ class Solution:
     model: Model = field(repr=False)
     program: Program = field(repr=False)
     grid: GridRecord = field(repr=False)
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    """One case of a study (:mod:`petsc_adhesion.app.study`): its number ``case``, the options it sets
+    (``values``: (name without the dash, value) pairs in the order of the study's axes), its ``result`` (a
+    :class:`Curve`, with the profiles the study keeps; a critical study's
+    :class:`~.critical.Critical`; or :class:`~.measured.Missing` with the one-line reason it did not
+    run or failed) and ``wall_time_s``, the seconds its group spent on it (None for a case left out before
+    any work)."""
+
+    case: int
+    values: tuple[tuple[str, float], ...]
+    result: Curve | Critical | Missing
+    wall_time_s: float | None = None
+
+    @property
+    def ran(self) -> bool:
+        """Whether the case has a result (it did not fail)."""
+        return not isinstance(self.result, Missing)
+
+    @property
+    def complete(self) -> bool:
+        """Whether the case is what was asked for: it ran and, a curve, is complete (the study's exit status)."""
+        return self.ran and (not isinstance(self.result, Curve) or self.result.complete)
+
+    def value(self, name: str) -> float:
+        """The value the case sets for option ``name`` (KeyError when it sets none)."""
+        for k, v in self.values:
+            if k == name:
+                return v
+        raise KeyError(name)
