@@ -562,7 +562,7 @@ def test_a_study_case_round_trips_through_the_serializer(tmp_path):
     from petsc_adhesion.io.write import write_critical, write_study
     from petsc_adhesion.model.parameters import Model
     from petsc_adhesion.tracing.critical import Critical
-    from petsc_adhesion.tracing.curve import CaseResult
+    from petsc_adhesion.tracing.case import CaseResult
     from petsc_adhesion.tracing.measured import Measured, Missing
     from petsc_adhesion.tracing.model_spread import Rule, model_spread
     from petsc_adhesion.tracing.trace import CurveRequest, GridChoice, trace_curve

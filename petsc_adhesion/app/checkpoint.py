@@ -28,7 +28,7 @@ The error bars' estimates made so far are saved with the tracer in the phase
 "errors" (typed values, :mod:`petsc_adhesion.io.values`): a restart takes them up
 and locates again only the events not yet estimated.  A study saves its finished
 cases alike (:meth:`Checkpoint.save_cases`), each a
-:class:`~petsc_adhesion.tracing.curve.CaseResult` through the same serializer.
+:class:`~petsc_adhesion.tracing.case.CaseResult` through the same serializer.
 """
 from __future__ import annotations
 
@@ -166,8 +166,8 @@ def write_file(path: str, header: dict, tree: dict) -> None:
 
 def _study_cases(tree) -> list | None:
     """A study's saved state read back: its finished cases (each a
-    :class:`~petsc_adhesion.tracing.curve.CaseResult`), or None when ``tree`` is not one."""
-    from ..tracing.curve import CaseResult
+    :class:`~petsc_adhesion.tracing.case.CaseResult`), or None when ``tree`` is not one."""
+    from ..tracing.case import CaseResult
 
     if not isinstance(tree, dict) or tree.get("phase") != "study" or not isinstance(tree.get("cases"), list):
         return None
@@ -350,7 +350,7 @@ class Checkpoint:
     # -- a study: its finished cases ---------------------------------------------------------------------
     def cases(self) -> tuple[set, list]:
         """A study's restart: (the numbers of the cases done, on every rank; their
-        :class:`~petsc_adhesion.tracing.curve.CaseResult` on rank 0, [] elsewhere); collective."""
+        :class:`~petsc_adhesion.tracing.case.CaseResult` on rank 0, [] elsewhere); collective."""
         if self.saved is None:
             return set(), []
         # read back on rank 0 when the checkpoint was opened (a curve's was refused by its fingerprint)
@@ -359,7 +359,7 @@ class Checkpoint:
 
     def save_cases(self, results: list) -> None:
         """Rank 0: save a study's finished cases (``results``, each a
-        :class:`~petsc_adhesion.tracing.curve.CaseResult`) if the interval has passed (not collective: the
+        :class:`~petsc_adhesion.tracing.case.CaseResult`) if the interval has passed (not collective: the
         cases reach rank 0 at their own times)."""
         if not self.path or not self.rank0 or time.perf_counter() - self.last < self.interval:
             return

@@ -45,7 +45,8 @@ from ..io.report import study_spread_line
 from ..io.resultset import check_targets, mark_done, written
 from ..io.summary import program_record
 from ..io.write import write_critical, write_study
-from ..tracing.curve import CaseResult, Curve, Program
+from ..tracing.case import CaseResult
+from ..tracing.curve import Curve, Program
 from ..tracing.measured import Missing
 from ..tracing.model_spread import model_spread
 from ..tracing.trace import trace_curve
@@ -365,7 +366,7 @@ def spread(todo: list[Case], ranks: int, work, brief, journal) -> list[CaseResul
     """``work(case, comm)`` for each case, the cases spread over groups of ``ranks`` ranks (LPT by
     :func:`cost`); a progress line on rank 0 for each finished case (``brief(case, result)``).
 
-    ``work`` returns the case's :class:`~petsc_adhesion.tracing.curve.CaseResult` on its group's rank 0; a
+    ``work`` returns the case's :class:`~petsc_adhesion.tracing.case.CaseResult` on its group's rank 0; a
     case that raises is one whose result is Missing with its one-line error.  ``journal`` (a study's
     :class:`~petsc_adhesion.app.checkpoint.Checkpoint`): the cases of its restart are not run again, rank 0
     saves the finished ones into it.  Returns every case's result on rank 0, in case order (None elsewhere);

@@ -148,7 +148,7 @@ def curve_tree(curve, options: dict) -> dict:
 
 
 def case_tree(case) -> dict:
-    """A study's case (:class:`~petsc_adhesion.tracing.curve.CaseResult` of a curve): its number and values,
+    """A study's case (:class:`~petsc_adhesion.tracing.case.CaseResult` of a curve): its number and values,
     then a curve's tree without the program's keys (the profiles the study kept), and its model spread when
     computed."""
     curve = case.result
@@ -176,7 +176,7 @@ def _spreads(curve) -> tuple:
 
 
 def study_table(done: list, axes: list[str]) -> dict:
-    """Every case's events (``done``: :class:`~petsc_adhesion.tracing.curve.CaseResult` of curves) as
+    """Every case's events (``done``: :class:`~petsc_adhesion.tracing.case.CaseResult` of curves) as
     columns: case, the swept options, kind, best values, bars, grid values; when a case has a model spread,
     the spread of each event's lambda and F (NaN where the event has none: a smooth case, a kind not
     compared)."""

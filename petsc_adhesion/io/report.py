@@ -114,7 +114,7 @@ def report_solve(s: Solution) -> None:
 
 def study_spread_line(done: list) -> str | None:
     """The one line a study says of its cases' model spreads (``done``: its cases that ran, each a
-    :class:`~petsc_adhesion.tracing.curve.CaseResult`): how many of those with a spread warn (the roughness
+    :class:`~petsc_adhesion.tracing.case.CaseResult`): how many of those with a spread warn (the roughness
     law moves an event beyond ten error bars or 10 % of its value), and where to read them; None when no case
     has one.  One line for the study, not one a case: each case's warnings are in its files."""
     spreads = [r for r in done if isinstance(r.result, Curve) and r.result.spread is not None

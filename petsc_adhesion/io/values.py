@@ -26,11 +26,11 @@ def known() -> dict:
     # here, not at the top: the readers of result files (io.summary, plot) need not load PETSc, which
     # tracing.critical and tracing.error_bars do
     from ..model import parameters, physical
-    from ..tracing import critical, curve, error_bars, measured, model_spread
+    from ..tracing import case, critical, curve, error_bars, measured, model_spread
 
     classes = [parameters.Model, physical.Bodies, measured.Measured, measured.Missing, critical.Critical,
                error_bars.Estimate, error_bars.LandingEstimate, model_spread.Rule, model_spread.Quantity,
-               model_spread.ModelSpread]
+               model_spread.ModelSpread, case.CaseResult]
     classes += [getattr(curve, name) for name in curve.__all__ if isinstance(getattr(curve, name), type)]
     return {c.__name__: c for c in classes}
 

@@ -151,7 +151,7 @@ def write_solve(solution, options: dict, files: ResultSet, commit: bool = True) 
 
 
 def _failed(failed: list) -> list[dict]:
-    """The records of the cases that did not run (:class:`~petsc_adhesion.tracing.curve.CaseResult`, its
+    """The records of the cases that did not run (:class:`~petsc_adhesion.tracing.case.CaseResult`, its
     result Missing): number, values, the one-line reason."""
     return [{"case": r.case, "values": dict(r.values), "error": r.result.reason} for r in failed]
 
@@ -159,7 +159,7 @@ def _failed(failed: list) -> list[dict]:
 def write_critical(prog: dict, study: dict, done: list, failed: list, files: ResultSet) -> dict:
     """The files of a critical study (``-study_compute critical``), committed together; returns the summary.
 
-    ``done``: the cases that ran, each a :class:`~petsc_adhesion.tracing.curve.CaseResult` of a
+    ``done``: the cases that ran, each a :class:`~petsc_adhesion.tracing.case.CaseResult` of a
     :class:`~petsc_adhesion.tracing.critical.Critical`; ``failed``: those that did not, in case order.
     """
     brief = {k: v for k, v in prog.items() if k != "options"}
@@ -192,7 +192,7 @@ def write_study(prog: dict, study: dict, done: list, failed: list, files: Result
     """The files of a study (:mod:`petsc_adhesion.app.study`), its table of events as CSV among them (``csv``),
     committed together; returns the summary.
 
-    ``done``: each case that ran, a :class:`~petsc_adhesion.tracing.curve.CaseResult` of its
+    ``done``: each case that ran, a :class:`~petsc_adhesion.tracing.case.CaseResult` of its
     :class:`~petsc_adhesion.tracing.curve.Curve`; ``failed``: those that did not, in case order.
     """
     brief = {k: v for k, v in prog.items() if k != "options"}

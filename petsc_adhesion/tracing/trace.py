@@ -330,7 +330,7 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
         restored = checkpoint.restore(tracer) if checkpoint is not None else None
         phase, spent, made = restored or ("trace", {"trace": 0.0, "errors": 0.0}, ())
         bars: list[tuple[Segment, Found]] = []
-        estimates = {}          # id of a located event (the core's Found) -> its Estimate, or Missing
+        estimates: dict[int, error_bars.Estimate | Missing] = {}   # id of a located Found -> its Estimate, or Missing
         if restored and progress is not None:
             progress.line(f"going on from the checkpoint {checkpoint.name} at lambda "
                           f"{tracer.segments[-1].cont.points[-1].p:.6g}"
