@@ -35,6 +35,7 @@ from .options.checks import check_petsc_values, check_unused
 from .options.reading import AppOptions, read_grid, read_model_spread, read_solver
 from .options.table import ROUGHNESS_OPTIONS, TABLE
 from .optionsfile import options_files
+from .run import is_fit, refuse_fit_options      # here for the fit's callers; in run.py, which every run loads
 
 __all__ = ["FitRequest", "is_fit", "refuse_fit_options", "read", "execute", "main", "FIT_OPTIONS"]
 
@@ -48,19 +49,6 @@ FIT_OPTIONS = {"phys_radius", "phys_radius2", "phys_young1", "phys_poisson1", "p
 _OUTPUTS = ("out", "summary", "plot", "csv")
 #: Points per leg of the fitted model's curve in the files.
 MODEL_POINTS = 400
-
-
-def is_fit(opts: AppOptions) -> bool:
-    """Whether the options ask for a fit of a measurement."""
-    return opts.db.hasName("fit_pull_off") or opts.db.hasName("fit_curve")
-
-
-def refuse_fit_options(opts: AppOptions) -> None:
-    """An InputError for a -fit_ option given without -fit_pull_off or -fit_curve."""
-    stray = [n for n in TABLE if n.startswith("fit_") and opts.db.hasName(n)]
-    if stray:
-        needs = "-fit_pull_off" if stray[0] == "fit_pull_off_err" else "-fit_curve"
-        raise InputError(f"-{stray[0]}: only with {needs}; remove it")
 
 
 @dataclass

@@ -58,7 +58,7 @@ from .options.table import TABLE
 from .optionsfile import options_files
 from .progress import Progress
 
-__all__ = ["Request", "read", "execute", "main", "is_study", "refuse_study_options"]
+__all__ = ["Request", "read", "execute", "main", "is_study", "is_fit", "refuse_study_options", "refuse_fit_options"]
 
 _APP = ("adh_", "grid_", "cont_")
 _OUTPUTS = ("out", "summary", "plot", "csv", "csv_events")
@@ -68,6 +68,20 @@ def is_study(opts: AppOptions) -> bool:
     """Whether the options describe a study of many cases (:mod:`petsc_adhesion.app.study`)."""
     return any(opts.db.hasName(n) for n in ("study_mu", "study_sigma", "study_option")) or \
         opts.choice("study_compute") == "critical"
+
+
+def is_fit(opts: AppOptions) -> bool:
+    """Whether the options ask for a fit of a measurement (:mod:`petsc_adhesion.app.fit`, loaded only then:
+    a curve's run need not import the fitting code)."""
+    return opts.db.hasName("fit_pull_off") or opts.db.hasName("fit_curve")
+
+
+def refuse_fit_options(opts: AppOptions) -> None:
+    """An InputError for a -fit_ option given without -fit_pull_off or -fit_curve."""
+    stray = [n for n in TABLE if n.startswith("fit_") and opts.db.hasName(n)]
+    if stray:
+        needs = "-fit_pull_off" if stray[0] == "fit_pull_off_err" else "-fit_curve"
+        raise InputError(f"-{stray[0]}: only with {needs}; remove it")
 
 
 def _is_app(name: str) -> bool:
