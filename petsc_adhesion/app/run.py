@@ -29,7 +29,6 @@ from ..io.write import write_curve, write_solve
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
 from ..tracing.curve import Curve, Solution
-from ..tracing.model_spread import model_spread
 from ..tracing.trace import (
     CurveRequest,
     GridChoice,
@@ -159,6 +158,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
             result = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, checkpoint=ck,
                                  progress=progress, started=lambda: check_unused(db=opts.db))
             if req.spread_rules is not None:   # the same curve under the other laws, events only
+                from ..tracing.model_spread import model_spread   # only then: a smooth run need not load it
                 result = replace(result, spread=model_spread(result, req.model, req.grid, req.solver, req.settings,
                                                              req.curve, req.spread_rules, comm=comm))
     else:
