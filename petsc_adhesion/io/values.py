@@ -12,6 +12,7 @@ writes it, the shortest text that reads back to the same double, so a value come
 from __future__ import annotations
 
 from dataclasses import fields, is_dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -20,6 +21,7 @@ __all__ = ["encode", "decode", "known"]
 _TYPE, _TUPLE, _DICT = "__type__", "__tuple__", "__dict__"
 
 
+@lru_cache(maxsize=1)
 def known() -> dict:
     """Class name -> class, of every value a checkpoint may hold: a curve and its parts, a critical study's
     cusp, a model spread, an event's estimate, a study's case."""
