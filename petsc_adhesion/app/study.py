@@ -21,9 +21,14 @@ files hold them (exit status 3 when any case is missing).  One HDF5 file (a
 group per case and a table of every case's events with their error bars), one
 JSON summary (``cases``: each case's ``mu``, ``sigma`` and the keys of a single
 curve's summary), the figure of ``-study_plot`` and the table of events as CSV
-(``-csv``, when given) are written together.
+(``-csv``, when given) are written together, by :mod:`petsc_adhesion.io` from each
+case's :class:`~petsc_adhesion.tracing.case.CaseResult` (gathered to rank 0 as values).
+A rough case carries its model spread (:mod:`petsc_adhesion.tracing.model_spread`,
+unless ``-adh_model_spread false``), as a single rough run does; the study says in
+one line how many of them warn.
 
-Rank 0 saves the finished cases into a checkpoint as they reach it (at most
+Rank 0 saves the finished cases (each a CaseResult, through :mod:`petsc_adhesion.io.values`) into a
+checkpoint as they reach it (at most
 every ``-cont_checkpoint_interval`` seconds; by default beside ``-out``):
 after a kill, ``-cont_restart FILE`` with the same options (on any number of
 ranks) runs only the cases not in it, and the study's files equal an
