@@ -38,8 +38,8 @@ def known() -> dict:
 
 
 def encode(value):
-    """``value`` as a tree of JSON values and numpy arrays (see the module); TypeError for anything else
-    (a value of a class :func:`known` does not hold could not be read back)."""
+    """``value`` as a tree of JSON values and numpy arrays (see the module); TypeError for anything but the
+    package's values and plain data (:func:`decode` reads back the classes of :func:`known`)."""
     if value is None or isinstance(value, (bool, int, float, str, np.ndarray)):
         return value
     if isinstance(value, np.generic):
@@ -52,7 +52,9 @@ def encode(value):
         return {_DICT: {str(k): encode(v) for k, v in value.items()}}
     if is_dataclass(value) and not isinstance(value, type):
         name = type(value).__name__
-        if name not in known():
+        # the package's own values; decode reads back only those of known(), which encode need not load
+        # (it imports PETSc's modules: a save of a smooth curve's estimates would load them for nothing)
+        if not type(value).__module__.startswith("petsc_adhesion."):
             raise TypeError(f"{name}: not a result value a checkpoint holds")
         return {_TYPE: name, **{f.name: encode(getattr(value, f.name)) for f in fields(value) if f.init}}
     raise TypeError(f"{type(value).__name__}: not a result value a checkpoint holds")
