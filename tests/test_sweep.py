@@ -21,7 +21,7 @@ ONE_LAW = ("-adh_model_spread_rules", "weibull:0")
 
 def study(tmp_path, *args, np_=1, name="s"):
     out, summ = tmp_path / f"{name}.h5", tmp_path / f"{name}.json"
-    proc = run_cli(*TINY, *args, "-out", out, "-summary", summ, np=np_, timeout=300)
+    proc = run_cli(*TINY, *args, "-out", out, "-summary", summ, np=np_, timeout=900)
     s = json.loads(summ.read_text()) if summ.exists() else None
     return proc, s, out
 
