@@ -9,6 +9,7 @@ the 32-point rule's); each law's values are those of trace_curve run under it di
 and the truncated Gaussian's distance from K to K + 1 falls with the weight of the
 Gaussian's tail beyond K sigma (1.3e-3, 6.3e-5, 5.7e-7 at K = 3, 4, 5).
 """
+import json
 import math
 
 import pytest
@@ -347,21 +348,39 @@ def test_a_rough_pull_off_fit_has_gammas_spread(tmp_path):
         assert f["fit/model_spread"].attrs["description"]
 
 
-def test_a_study_refuses_the_spreads_options(tmp_path):
-    """A study's cases compute no spread: asking for one is refused in one line, exit 2, nothing written;
-    so is asking one solve (-adh_lambda) or a smooth -fit_curve for one."""
+def test_a_study_honours_the_spreads_options(tmp_path):
+    """A study's rough cases compute their spread under the laws asked for (none with -adh_model_spread
+    false: no key, no group, no column, no line); a study with no rough case refuses a spread asked for, as
+    one solve (-adh_lambda) and -fit_curve do: one line, exit 2, nothing written."""
+    import h5py
+
     from conftest import run_cli
 
-    out = tmp_path / "st.json"
-    proc = run_cli("-study_sigma", "0.1,0.2", "-adh_model_spread_rules", "weibull:0", "-grid_type", "uniform",
-                   "-grid_n", "101", "-summary", out)
+    tiny = ("-grid_type", "uniform", "-grid_n", "101", "-study_compute", "pull_off")
+    out, h5, csv = tmp_path / "st.json", tmp_path / "st.h5", tmp_path / "st.csv"
+    proc = run_cli("-study_sigma", "0,0.2", "-adh_model_spread_rules", "weibull:0", *tiny, "-summary", out)
+    assert proc.returncode == 0, proc.stderr
+    smooth, rough = json.loads(out.read_text())["cases"]
+    assert "model_spread" not in smooth and rough["model_spread"]["rules"] == ["weibull:0"]
+    assert rough["model_spread"]["quantities"][1]["name"] == "pull-off F"
+    out.unlink()
+    proc = run_cli("-study_sigma", "0,0.2", "-adh_model_spread", "false", *tiny, "-summary", out, "-out", h5,
+                   "-csv", csv)
+    assert proc.returncode == 0, proc.stderr
+    assert all("model_spread" not in c for c in json.loads(out.read_text())["cases"])
+    assert "model spread" not in proc.stderr and "_spread" not in csv.read_text()
+    with h5py.File(h5) as f:
+        assert "F_spread" not in f["table"] and all("model_spread" not in c for c in f["cases"].values())
+    for f in (out, h5, csv):
+        f.unlink()
+    proc = run_cli("-study_mu", "0.5,1", "-adh_model_spread", "true", *tiny, "-summary", out)
     assert proc.returncode == 2 and not out.exists()
-    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread_rules: applies to one run's curve or "
-                                   "-fit_pull_off, not a study of many cases; remove it")
+    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: no case of the study is rough "
+                                   "(sigma > 0): there is no roughness law to vary")
     proc = run_cli("-adh_sigma", "0.2", "-adh_lambda", "-1", "-adh_model_spread", "true", "-summary", out)
     assert proc.returncode == 2 and not out.exists()
-    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: applies to one run's curve or "
-                                   "-fit_pull_off, not -adh_lambda (one solve); remove it")
+    assert proc.stderr.strip() == ("petsc-adhesion: error: -adh_model_spread: applies to a curve (one run's, a "
+                                   "study's cases) or -fit_pull_off, not -adh_lambda (one solve); remove it")
     # -fit_curve has one with roughness (w's and E*'s, docs/fitting.md); a smooth surface has none to ask for
     proc = run_cli("-fit_curve", tmp_path / "c.csv", "-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9",
                    "-adh_model_spread", "true", "-summary", out)

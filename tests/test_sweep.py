@@ -14,11 +14,14 @@ import pytest
 from conftest import run_cli
 
 TINY = ("-grid_type", "uniform", "-grid_n", "101")
+#: The model spread of the rough cases under one law (the default four are the golden study's,
+#: tests/test_golden.py): a quarter of their cost
+ONE_LAW = ("-adh_model_spread_rules", "weibull:0")
 
 
 def study(tmp_path, *args, np_=1, name="s"):
     out, summ = tmp_path / f"{name}.h5", tmp_path / f"{name}.json"
-    proc = run_cli(*TINY, *args, "-out", out, "-summary", summ, np=np_, timeout=300)
+    proc = run_cli(*TINY, *args, "-out", out, "-summary", summ, np=np_, timeout=900)
     s = json.loads(summ.read_text()) if summ.exists() else None
     return proc, s, out
 
@@ -35,6 +38,22 @@ def events(case: dict, grid: bool = False) -> dict:
     return out
 
 
+def spread_values(case: dict) -> dict:
+    """quantity name -> (its value under each law, None where a law has it not; the spread) of a case's or a
+    curve's model spread."""
+    return {q["name"]: (q["values"], q.get("spread")) for q in case["model_spread"]["quantities"]}
+
+
+def close_spread(a: dict, b: dict, tol: float) -> None:
+    a, b = spread_values(a), spread_values(b)
+    assert a.keys() == b.keys() and a
+    for k in a:
+        (va, sa), (vb, sb) = a[k], b[k]
+        assert [v is None for v in va] == [v is None for v in vb], k
+        assert np.allclose([v for v in va if v is not None], [v for v in vb if v is not None], rtol=0, atol=tol), k
+        assert (sa is None) == (sb is None) and (sa is None or abs(sa - sb) <= tol), (k, sa, sb)
+
+
 def close(a: dict, b: dict, tol: float) -> None:
     assert a.keys() == b.keys()
     for k in a:
@@ -44,7 +63,7 @@ def close(a: dict, b: dict, tol: float) -> None:
 @pytest.fixture(scope="module")
 def serial(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("serial")
-    proc, s, out = study(tmp, "-study_mu", "0.001,1", "-study_sigma", "0,0.3", "-study_compute", "events")
+    proc, s, out = study(tmp, "-study_mu", "0.001,1", "-study_sigma", "0,0.3", "-study_compute", "events", *ONE_LAW)
     assert proc.returncode == 0, proc.stderr
     return proc, s, out
 
@@ -54,14 +73,27 @@ def test_cases_are_the_single_curves(serial, tmp_path):
     assert [(c["mu"], c["sigma"]) for c in s["cases"]] == [(0.001, 0.0), (0.001, 0.3), (1.0, 0.0), (1.0, 0.3)]
     for mu, sigma in ((1.0, 0.3), (0.001, 0.0)):
         single = tmp_path / f"{mu}_{sigma}.json"
-        # a study's case carries no model spread yet (a single rough run does by default): compare the curves
-        spread = ("-adh_model_spread", "false") if sigma > 0 else ()
-        p = run_cli(*TINY, "-adh_mu", mu, "-adh_sigma", sigma, "-cont_F_max", 0, *spread, "-summary", single)
+        # a rough case carries its model spread, as a single rough run does by default: the same laws' curves
+        p = run_cli(*TINY, "-adh_mu", mu, "-adh_sigma", sigma, "-cont_F_max", 0, *(ONE_LAW if sigma else ()),
+                    "-summary", single)
         assert p.returncode == 0, p.stderr
         one = json.loads(single.read_text())
         case = next(c for c in s["cases"] if (c["mu"], c["sigma"]) == (mu, sigma))
         assert set(one) <= set(case) and set(case) - set(one) == {"case", "values"}
         close(events(case), events(one), 1e-12)
+        assert ("model_spread" in case) == (sigma > 0)
+        if sigma > 0:
+            close_spread(case, one, 1e-12)
+            assert case["model_spread"]["rules"] == ["weibull:0"]
+    # one line for the study's spreads, not one a case, counting the rough cases whose spread warns (the
+    # rough case at mu = 1 does: the law moves its pull-off by far more than 10 %, docs/model.md)
+    warned = [c["case"] + 1 for c in s["cases"] if c.get("model_spread", {}).get("warnings")]
+    assert 4 in warned
+    spread_lines = [ln for ln in proc.stderr.splitlines() if "model spread" in ln]
+    assert spread_lines == [f"petsc-adhesion: model spread: {len(warned)} of the 2 rough cases warn (case"
+                            f"{'s' * (len(warned) > 1)} {', '.join(map(str, warned))}): the roughness law moves an "
+                            "event beyond ten error bars or 10% of its value; each case's model_spread in the files "
+                            "says which and by how much"], proc.stderr
     # an independent number: at mu = 0.001 the pull-off is DMT's, F = -1 at lambda = 0, up to O(mu)
     po = s["cases"][0]["pull_off"]
     assert abs(po["F"] + 1) < 2e-3 and abs(po["lambda"]) < 2e-2
@@ -81,6 +113,16 @@ def test_study_file(serial):
         row = (t["case"] == 2) & (t["kind"] == b"F_min") & (t["F"] == po["F"])
         assert row.sum() == 1 and t["F_err"][row][0] == po["F_err"] and t["adh_mu"][row][0] == 1.0
         assert (f["cases/0003/values"].attrs["adh_sigma"], f["cases/0003/model"].attrs["sigma"]) == (0.3, 0.3)
+        # a rough case's model spread: a group, as a single run's file has it, and two columns of the table
+        # (NaN for the smooth cases' rows and for an event kind the spread does not compare)
+        assert "model_spread" in f["cases/0003"] and "model_spread" not in f["cases/0002"]
+        q = s["cases"][3]["model_spread"]["quantities"]
+        assert f["cases/0003/model_spread/quantities/0001/values"].attrs["weibull:0"] == q[1]["values"][0]
+        pull = s["cases"][3]["pull_off"]
+        row = (t["case"] == 3) & (t["kind"] == b"F_min") & (t["F"] == pull["F"])
+        assert q[1]["name"] == "pull-off F" and t["F_spread"][row][0] == q[1]["spread"]
+        assert q[0]["name"] == "pull-off lambda" and t["lambda_spread"][row][0] == q[0]["spread"]
+        assert np.isnan(t["F_spread"][t["adh_sigma"] == 0]).all() and "units" in f["table/F_spread"].attrs
         # no roughness quadrature at sigma = 0: the smooth law, and no rule recorded
         assert "roughness" not in f["cases/0000/model"].attrs and f["cases/0001/model"].attrs["roughness"] == "hermite"
 
@@ -89,10 +131,13 @@ def test_study_file(serial):
 def test_two_ranks_equal_serial(serial, tmp_path, ranks):
     _, s, _ = serial
     proc, p, out = study(tmp_path, "-study_mu", "0.001,1", "-study_sigma", "0,0.3", "-study_compute", "events",
-                         "-study_ranks", ranks, np_=2)
+                         *ONE_LAW, "-study_ranks", ranks, np_=2)
     assert proc.returncode == 0, proc.stderr
     assert [c["mpi_ranks"] for c in p["cases"]] == [ranks] * 4 and p["mpi_ranks"] == 2
     for a, b in zip(s["cases"], p["cases"]):
+        if "model_spread" in a:     # the spread's laws' curves (their events on their own grid) as the serial's
+            close_spread(a, b, 1e-10 if ranks == 1 else 1e-9)
+        assert ("model_spread" in a) == ("model_spread" in b) == (a["sigma"] > 0)
         if ranks == 1:          # the cases spread over two groups: each exactly as the serial study's
             close(events(a), events(b), 1e-10)
         else:
@@ -105,7 +150,8 @@ def test_two_ranks_equal_serial(serial, tmp_path, ranks):
 def test_pull_off_only_leaves_out_the_rest(serial, tmp_path):
     code = ("import sys; from petsc_adhesion.app.cli import main; "
             f"rc = main(['x', *{list(TINY)!r}, '-study_mu', '0.001,1', '-study_sigma', '0,0.3', "
-            f"'-study_compute', 'pull_off', '-study_profiles', 'equilibrium', '-out', '{tmp_path}/p.h5', "
+            f"'-study_compute', 'pull_off', '-study_profiles', 'equilibrium', '-adh_model_spread', 'false', "
+            f"'-out', '{tmp_path}/p.h5', "
             f"'-summary', '{tmp_path}/p.json']); print(rc, 'matplotlib' in sys.modules)")
     import subprocess
     import sys

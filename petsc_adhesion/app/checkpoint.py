@@ -24,7 +24,11 @@ module holds only the file and the fingerprint:
   refused, in one line naming ``-cont_restart``, as is a checkpoint of other
   model, grid or solver options (:func:`fingerprint`).
 
-A study saves its finished cases' records alike (:meth:`Checkpoint.save_cases`).
+The error bars' estimates made so far are saved with the tracer in the phase
+"errors" (typed values, :mod:`petsc_adhesion.io.values`): a restart takes them up
+and locates again only the events not yet estimated.  A study saves its finished
+cases alike (:meth:`Checkpoint.save_cases`), each a
+:class:`~petsc_adhesion.tracing.case.CaseResult` through the same serializer.
 """
 from __future__ import annotations
 
@@ -41,14 +45,16 @@ import numpy as np
 from ..errors import InputError, Interrupted, collective, first_line, printable
 from ..io.inputs import check_input
 from ..io.resultset import ResultSet, atomic_write, check_targets
+from ..io.values import decode, encode
 from ..version import __version__
 
 __all__ = ["Checkpoint", "open_checkpoint", "default_path", "fingerprint", "write_file", "read_file", "is_checkpoint", "MAGIC", "FORMAT", "INTERVAL", "FREE"]
 
 #: The first line of every checkpoint.
 MAGIC = b"petsc-adhesion checkpoint\n"
-#: The layout of the state; a file of another is refused.
-FORMAT = 2
+#: The layout of the state; a file of another is refused.  3: a study's cases and a curve's error-bar
+#: estimates as typed values (:mod:`petsc_adhesion.io.values`).
+FORMAT = 3
 #: Seconds between saves by default.  A save costs about 0.35 s per 10^7 numbers held (2000 points of
 #: 2500 nodes, 80 MB), mostly writing them: under 4 per cent of this for such a curve, 0.1 per cent
 #: for the usual few hundred points of 500 nodes (15 ms a save).
@@ -158,11 +164,18 @@ def write_file(path: str, header: dict, tree: dict) -> None:
         os.close(folder)
 
 
-def _study_state(tree) -> bool:
-    """Whether ``tree`` is a study's saved state: its finished cases, each with its number and values."""
-    return isinstance(tree, dict) and tree.get("phase") == "study" and isinstance(tree.get("cases"), list) and all(
-        isinstance(r, dict) and isinstance(r.get("case"), int) and isinstance(r.get("values"), dict)
-        for r in tree["cases"])
+def _study_cases(tree) -> list | None:
+    """A study's saved state read back: its finished cases (each a
+    :class:`~petsc_adhesion.tracing.case.CaseResult`), or None when ``tree`` is not one."""
+    from ..tracing.case import CaseResult
+
+    if not isinstance(tree, dict) or tree.get("phase") != "study" or not isinstance(tree.get("cases"), list):
+        return None
+    try:
+        cases = [decode(r) for r in tree["cases"]]
+    except (ValueError, TypeError, KeyError):
+        return None
+    return cases if all(isinstance(c, CaseResult) for c in cases) else None
 
 
 def is_checkpoint(path: str) -> bool:
@@ -273,16 +286,18 @@ class Checkpoint:
         return bool(self.path) and self.mpi.bcast(time.perf_counter() - self.last >= self.interval
                                                   if self.rank0 else None, root=0)
 
-    def pause(self, tracer, phase: str, wall: dict) -> None:
+    def pause(self, tracer, phase: str, wall: dict, estimates: tuple = ()) -> None:
         """Save the state of ``tracer`` if due (collective); ``phase``: "trace" or "errors"; ``wall``: the
-        seconds spent so far on each."""
+        seconds spent so far on each; ``estimates``: the error bars' estimates made so far, in the order of
+        the events estimated (:class:`~petsc_adhesion.tracing.error_bars.Estimate` or Missing)."""
         if self.due():
-            self.save(tracer, phase, wall)
+            self.save(tracer, phase, wall, estimates)
 
-    def save(self, tracer, phase: str, wall: dict) -> None:
+    def save(self, tracer, phase: str, wall: dict, estimates: tuple = ()) -> None:
         """Save the state of ``tracer`` now (:meth:`~petsc_adhesion.tracing.tracer.Tracer.state`; after the
-        trace its solvers serve no step again); collective, rank 0 writes."""
-        tree = {"phase": phase, "wall": wall, "tracer": _gather(self.mpi, tracer.state(solvers=phase == "trace"))}
+        trace its solvers serve no step again) and the ``estimates`` made; collective, rank 0 writes."""
+        tree = {"phase": phase, "wall": wall, "tracer": _gather(self.mpi, tracer.state(solvers=phase == "trace")),
+                "estimates": encode(tuple(estimates))}
         if self.rank0:
             last = tracer.segments[-1].cont.points[-1]
             write_file(self.path, {"program": "petsc-adhesion", "version": __version__, "fingerprint": self.fp,
@@ -291,9 +306,10 @@ class Checkpoint:
         self.last = time.perf_counter()
 
     # -- restoring ------------------------------------------------------------------------------------
-    def restore(self, tracer) -> tuple[str, dict] | None:
-        """Rebuild the saved state into ``tracer`` (collective); returns (phase, wall), or None when there is
-        nothing to restore."""
+    def restore(self, tracer) -> tuple[str, dict, tuple] | None:
+        """Rebuild the saved state into ``tracer`` (collective); returns (phase, wall, the error bars'
+        estimates already made, in the order of the events estimated), or None when there is nothing to
+        restore."""
         if self.saved is None:
             return None
         tree = self.saved
@@ -308,23 +324,48 @@ class Checkpoint:
         except (KeyError, TypeError, IndexError, AttributeError) as e:
             raise InputError(f"-cont_restart: the checkpoint '{self.name}' holds a state this version cannot take up "
                              f"({type(e).__name__}: {first_line(e)})") from None
-        return tree["phase"], tree["wall"]
+        estimates = self._estimates(tree.get("estimates"))
+        return tree["phase"], tree["wall"], estimates
+
+    def _estimates(self, saved) -> tuple:
+        """The error bars' estimates of the checkpoint, read on rank 0 and given to every rank (collective)."""
+        from ..tracing.error_bars import Estimate
+        from ..tracing.measured import Missing
+
+        got: tuple | str | None = None
+        if self.rank0:
+            try:
+                got = decode(saved)
+            except (ValueError, TypeError, KeyError) as e:
+                got = f"({first_line(e)})"
+            if not isinstance(got, str) and (not isinstance(got, tuple) or
+                                             not all(isinstance(v, (Estimate, Missing)) for v in got)):
+                got = "(no tuple of estimates)"
+        got = self.mpi.bcast(got, root=0)
+        if isinstance(got, str):
+            raise InputError(f"-cont_restart: the checkpoint '{self.name}' holds error bars this version cannot "
+                             f"take up {got}")
+        return got
 
     # -- a study: its finished cases ---------------------------------------------------------------------
     def cases(self) -> tuple[set, list]:
-        """A study's restart: (the numbers of the cases done, their records on rank 0, [] elsewhere)."""
+        """A study's restart: (the numbers of the cases done, on every rank; their
+        :class:`~petsc_adhesion.tracing.case.CaseResult` on rank 0, [] elsewhere); collective."""
         if self.saved is None:
             return set(), []
-        records = self.saved["cases"]          # a curve's checkpoint was refused by its fingerprint
-        return {r["case"] for r in records}, records if self.rank0 else []
+        # read back on rank 0 when the checkpoint was opened (a curve's was refused by its fingerprint)
+        done = self.mpi.bcast({r.case for r in self.saved["cases"]} if self.rank0 else None, root=0)
+        return done, list(self.saved["cases"]) if self.rank0 else []
 
-    def save_cases(self, records: list[dict]) -> None:
-        """Rank 0: save a study's finished cases (``records``) if the interval has passed (not collective:
-        the cases reach rank 0 at their own times)."""
+    def save_cases(self, results: list) -> None:
+        """Rank 0: save a study's finished cases (``results``, each a
+        :class:`~petsc_adhesion.tracing.case.CaseResult`) if the interval has passed (not collective: the
+        cases reach rank 0 at their own times)."""
         if not self.path or not self.rank0 or time.perf_counter() - self.last < self.interval:
             return
         write_file(self.path, {"program": "petsc-adhesion", "version": __version__, "fingerprint": self.fp,
-                               "phase": "study", "cases": len(records)}, {"phase": "study", "cases": records})
+                               "phase": "study", "cases": len(results)},
+                   {"phase": "study", "cases": [encode(r) for r in results]})
         self.last = time.perf_counter()
 
     # -- the end ----------------------------------------------------------------------------------------
@@ -384,14 +425,20 @@ def open_checkpoint(opts, targets: dict, inputs: dict, comm, study: bool = False
         why = _difference(header.get("fingerprint", {}) if isinstance(header.get("fingerprint"), dict) else {}, fp)
         if why:
             raise InputError(f"-cont_restart: the checkpoint '{printable(restart)}' {why}")
-        if study and not _study_state(tree):
-            raise InputError(f"-cont_restart: the checkpoint '{printable(restart)}' holds no study's cases this "
-                             f"version can take up")
+        if study:
+            cases = _study_cases(tree)
+            if cases is None:
+                raise InputError(f"-cont_restart: the checkpoint '{printable(restart)}' holds no study's cases this "
+                                 f"version can take up")
+            return {"phase": "study", "cases": cases}, None
         return tree, meta
 
     got, saved = collective(comm, check), None
     if restart is not None:
         mpi = comm.tompi4py()
-        meta = mpi.bcast(got[1] if mpi.Get_rank() == 0 else None, root=0)
-        saved = got[0] if mpi.Get_rank() == 0 else _decode(json.loads(meta), None)
+        if study:          # the cases on rank 0 (Checkpoint.cases gives every rank their numbers)
+            saved = got[0] if mpi.Get_rank() == 0 else {"phase": "study", "cases": []}
+        else:
+            meta = mpi.bcast(got[1] if mpi.Get_rank() == 0 else None, root=0)
+            saved = got[0] if mpi.Get_rank() == 0 else _decode(json.loads(meta), None)
     return Checkpoint(path, comm, fp, interval, restart, saved)

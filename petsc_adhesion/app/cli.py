@@ -140,7 +140,7 @@ def _program(argv: list[str]) -> int:
     from petsc4py import PETSc
 
     from ..errors import collective
-    from . import fit, run, study
+    from . import run
     from .options.help import print_help
     from .options.reading import AppOptions
 
@@ -148,10 +148,14 @@ def _program(argv: list[str]) -> int:
     helping = opts.db.hasName("help")
     if helping and PETSc.COMM_WORLD.getRank() == 0:
         print_help()
-    if collective(PETSc.COMM_WORLD, fit.is_fit, opts):
+    # a fit and a study load their modules only when asked for: the fitting code and its scipy parts are
+    # a part of a curve's start-up it does not use (docs/performance.md)
+    if collective(PETSc.COMM_WORLD, run.is_fit, opts):
+        from . import fit
         return fit.main(opts, argv, helping)
-    fit.refuse_fit_options(opts)
+    run.refuse_fit_options(opts)
     if collective(PETSc.COMM_WORLD, run.is_study, opts):
+        from . import study
         return study.main(opts, argv, helping)
     return run.main(opts, argv, helping)
 

@@ -38,6 +38,7 @@ from .options.plausible import PLAUSIBLE, implausible
 from .options.table import ROUGHNESS_OPTIONS, TABLE
 from .optionsfile import options_files
 from .progress import Progress
+from .run import is_fit, refuse_fit_options      # here for the fit's callers; in run.py, which every run loads
 
 __all__ = ["FitRequest", "is_fit", "refuse_fit_options", "read", "execute", "main", "FIT_OPTIONS"]
 
@@ -55,19 +56,6 @@ CURVE_ONLY = ("fit_curve_index", "fit_modulus", "fit_roughness", "fit_invols", "
 _OUTPUTS = ("out", "summary", "plot", "csv")
 #: Points per leg of the fitted model's curve in the files.
 MODEL_POINTS = 400
-
-
-def is_fit(opts: AppOptions) -> bool:
-    """Whether the options ask for a fit of a measurement."""
-    return opts.db.hasName("fit_pull_off") or opts.db.hasName("fit_curve")
-
-
-def refuse_fit_options(opts: AppOptions) -> None:
-    """An InputError for a -fit_ option given without -fit_pull_off or -fit_curve."""
-    stray = [n for n in TABLE if n.startswith("fit_") and opts.db.hasName(n)]
-    if stray:
-        needs = "-fit_pull_off" if stray[0] == "fit_pull_off_err" else "-fit_curve"
-        raise InputError(f"-{stray[0]}: only with {needs}; remove it")
 
 
 @dataclass

@@ -30,7 +30,6 @@ from ..io.write import write_curve, write_solve
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
 from ..tracing.curve import Curve, Solution
-from ..tracing.model_spread import model_spread
 from ..tracing.trace import (
     CurveRequest,
     GridChoice,
@@ -61,7 +60,7 @@ from .options.table import TABLE
 from .optionsfile import options_files
 from .progress import Progress
 
-__all__ = ["Request", "read", "execute", "main", "is_study", "refuse_study_options"]
+__all__ = ["Request", "read", "execute", "main", "is_study", "is_fit", "refuse_study_options", "refuse_fit_options"]
 
 _OUTPUTS = ("out", "summary", "plot", "csv", "csv_events")
 
@@ -70,6 +69,20 @@ def is_study(opts: AppOptions) -> bool:
     """Whether the options describe a study of many cases (:mod:`petsc_adhesion.app.study`)."""
     return any(opts.db.hasName(n) for n in ("study_mu", "study_sigma", "study_option")) or \
         opts.choice("study_compute") == "critical"
+
+
+def is_fit(opts: AppOptions) -> bool:
+    """Whether the options ask for a fit of a measurement (:mod:`petsc_adhesion.app.fit`, loaded only then:
+    a curve's run need not import the fitting code)."""
+    return opts.db.hasName("fit_pull_off") or opts.db.hasName("fit_curve")
+
+
+def refuse_fit_options(opts: AppOptions) -> None:
+    """An InputError for a -fit_ option given without -fit_pull_off or -fit_curve."""
+    stray = [n for n in TABLE if n.startswith("fit_") and opts.db.hasName(n)]
+    if stray:
+        needs = "-fit_pull_off" if stray[0] == "fit_pull_off_err" else "-fit_curve"
+        raise InputError(f"-{stray[0]}: only with {needs}; remove it")
 
 
 @dataclass
@@ -89,9 +102,11 @@ class Request:
     warnings: tuple = ()              # inputs outside what the field measures, one line each (plausible.py)
 
 
-def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False) -> Request:
+def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, profiles: bool = False,
+         case: bool = False) -> Request:
     """Read and check every option before any work (PETSc's solver options too, as far as they can be judged
-    before the solvers exist); ``kinds`` and ``profiles``: what a study's case reports."""
+    before the solvers exist); ``kinds`` and ``profiles``: what a study's ``case`` reports (its model spread
+    that of a rough case; a smooth case of a study has none, whatever -adh_model_spread says)."""
     check_misspelled(opts)          # before the options required together: a misspelling named as such
     model = read_model(opts)
     grid_choice = read_grid(opts, model)
@@ -109,12 +124,14 @@ def read(opts: AppOptions, comm, argv: list[str], kinds: tuple | None = None, pr
               "adh_topography": [opts.string(n) or "" for n in ("adh_topography", "adh_topography2")]}
     if comm.getRank() == 0:                  # only rank 0 writes
         check_targets(targets, inputs)
-    if is_study(opts) or lam is not None:    # no spread of a study's cases nor of one solve: asking is refused
+    if lam is not None:    # no spread of one solve: asking is refused
         for name in ("adh_model_spread", "adh_model_spread_rules"):
             if opts.db.hasName(name):
-                what = "-adh_lambda (one solve)" if lam is not None else "a study of many cases"
-                raise InputError(f"-{name}: applies to one run's curve or -fit_pull_off, not {what}; remove it")
+                raise InputError(f"-{name}: applies to a curve (one run's, a study's cases) or -fit_pull_off, not "
+                                 f"-adh_lambda (one solve); remove it")
         spread_rules = None
+    elif case and not (model.roughness != "none" and model.sigma > 0):
+        spread_rules = None        # a study's smooth case: no law to vary (the study refuses a spread no case has)
     else:
         spread_rules = read_model_spread(opts, model)
     req = Request(model, grid_choice, read_solver(opts), read_settings(opts, model),
@@ -155,6 +172,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
             result = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, checkpoint=ck,
                                  progress=progress, started=lambda: check_unused(db=opts.db))
             if req.spread_rules is not None:   # the same curve under the other laws, events only
+                from ..tracing.model_spread import model_spread   # only then: a smooth run need not load it
                 result = replace(result, spread=model_spread(result, req.model, req.grid, req.solver, req.settings,
                                                              req.curve, req.spread_rules, comm=comm))
     else:

@@ -21,9 +21,14 @@ files hold them (exit status 3 when any case is missing).  One HDF5 file (a
 group per case and a table of every case's events with their error bars), one
 JSON summary (``cases``: each case's ``mu``, ``sigma`` and the keys of a single
 curve's summary), the figure of ``-study_plot`` and the table of events as CSV
-(``-csv``, when given) are written together.
+(``-csv``, when given) are written together, by :mod:`petsc_adhesion.io` from each
+case's :class:`~petsc_adhesion.tracing.case.CaseResult` (gathered to rank 0 as values).
+A rough case carries its model spread (:mod:`petsc_adhesion.tracing.model_spread`,
+unless ``-adh_model_spread false``), as a single rough run does; the study says in
+one line how many of them warn.
 
-Rank 0 saves the finished cases into a checkpoint as they reach it (at most
+Rank 0 saves the finished cases (each a CaseResult, through :mod:`petsc_adhesion.io.values`) into a
+checkpoint as they reach it (at most
 every ``-cont_checkpoint_interval`` seconds; by default beside ``-out``):
 after a kill, ``-cont_restart FILE`` with the same options (on any number of
 ranks) runs only the cases not in it, and the study's files equal an
@@ -41,11 +46,14 @@ from petsc4py import PETSc
 
 from ..core.newton import is_solvers_own
 from ..errors import InputError, Interrupted, collective, say
-from ..io.layout import case_tree
+from ..io.report import study_spread_line
 from ..io.resultset import check_targets, mark_done, written
-from ..io.summary import critical_record, program_record, summary_of
+from ..io.summary import program_record
 from ..io.write import write_critical, write_study
-from ..tracing.curve import Program
+from ..tracing.case import CaseResult
+from ..tracing.curve import Curve, Program
+from ..tracing.measured import Missing
+from ..tracing.model_spread import model_spread
 from ..tracing.trace import trace_curve
 from .checkpoint import open_checkpoint
 from .options.checks import check_misspelled, check_petsc_values, check_unused
@@ -137,11 +145,21 @@ def cases(axes: list) -> list[Case]:
     return [Case(i, dict(zip(names, vals))) for i, vals in enumerate(itertools.product(*(v for _, v in axes)))]
 
 
+#: What a law of the model spread costs against the case's own curve with its error bars: its curve is
+#: traced with the same grids and settings, without error bars, but the bounded laws' wall quadrature costs
+#: more per evaluation (measured: the four default laws 5.8 and 6.8 times the case at mu = 3 and 1, sigma =
+#: 0.3, -study_compute pull_off; docs/studies.md).
+SPREAD_RULE_COST = 1.6
+
+
 def cost(case: Case) -> float:
     """A rough relative run time of a case, for ordering: the contact widens with mu (more steps,
-    larger grids) and roughness adds its quadrature to every evaluation."""
+    larger grids), roughness adds its quadrature to every evaluation, and a rough case's model spread
+    traces its events again under each other law."""
     mu = case.values.get("adh_mu", 1.0)
-    return (1.0 + mu) * (1.5 if case.values.get("adh_sigma", 0.0) > 0 else 1.0)
+    rules = case.request[0].spread_rules if case.request is not None else None
+    return (1.0 + mu) * (1.5 if case.values.get("adh_sigma", 0.0) > 0 else 1.0) * \
+        (1.0 + SPREAD_RULE_COST * len(rules or ()))
 
 
 def assign(todo: list[Case], groups: int) -> list[list[Case]]:
@@ -168,7 +186,7 @@ def _validate(todo: list[Case], study: dict, argv: list[str], compute: str = "cu
     for c in todo:
         try:
             opts = _case(c, study)
-            req = read(opts, PETSc.COMM_SELF, argv, kinds, bool(keep))
+            req = read(opts, PETSc.COMM_SELF, argv, kinds, bool(keep), case=True)
             unread = set(opts.db.left())
             check_unused(lambda name: name in unread, opts.db)
             if stop and not opts.db.hasName("cont_F_max"):
@@ -178,28 +196,35 @@ def _validate(todo: list[Case], study: dict, argv: list[str], compute: str = "cu
             c.error = str(e)
 
 
-def _run(c: Case, comm, keep: tuple) -> dict | None:
-    """One case on ``comm``, from the objects its options were read into: its summary and result tree on the
-    group's rank 0 (None elsewhere)."""
+def _check_spread(opts: AppOptions, good: list[Case]) -> None:
+    """A model spread asked for (-adh_model_spread true, -adh_model_spread_rules) is computed for each rough
+    case; a study with none is refused, as a smooth single run is."""
+    for name in ("adh_model_spread", "adh_model_spread_rules"):
+        if opts.db.hasName(name) and opts.flag("adh_model_spread") is not False and \
+                not any(c.request is not None and c.request[0].model.sigma > 0
+                        and c.request[0].model.roughness != "none" for c in good):
+            raise InputError(f"-{name}: no case of the study is rough (sigma > 0): there is no roughness law to vary")
+
+
+def _run(c: Case, comm, keep: tuple) -> CaseResult | None:
+    """One case on ``comm``, from the objects its options were read into: its result on the group's rank 0
+    (None elsewhere), the curve with the profiles the study keeps and, for a rough case, its model spread
+    (unless -adh_model_spread false)."""
     assert c.request is not None, "_validate has read every case that runs"
     req, profiles = c.request
     # the solvers' own options: one they leave unread (a sub-PC's without a block PC) is refused
     curve = trace_curve(req.model, req.grid, req.solver, req.settings, req.curve, comm=comm,
                         started=lambda: check_unused(is_solvers_own))
+    if req.spread_rules is not None:   # the same curve under the other laws, events only (as app/run.py)
+        curve = replace(curve, spread=model_spread(curve, req.model, req.grid, req.solver, req.settings, req.curve,
+                                                   req.spread_rules, comm=comm))
     if comm.getRank():
         return None
-    tree = case_tree(curve, keep=None if profiles else keep)
-    return {"case": c.index, "values": c.values, "summary": summary_of(curve), "tree": tree,
-            "incomplete": not curve.complete}
+    return CaseResult(c.index, tuple(c.values.items()), curve.keeping_profiles(None if profiles else keep))
 
 
-def _failure(c: Case, why: str) -> dict:
-    return {"case": c.index, "values": c.values, "error": why}
-
-
-def _failures(records: list[dict]) -> list[dict]:
-    """The records of the cases that failed at run time, as the files hold them."""
-    return [_failure(Case(r["case"], r["values"]), r["error"]) for r in records if "error" in r]
+def _failure(c: Case, why: str, wall: float | None = None) -> CaseResult:
+    return CaseResult(c.index, tuple(c.values.items()), Missing(why), wall)
 
 
 class _Progress:
@@ -207,13 +232,13 @@ class _Progress:
     rank 0 also keeps every finished case's record (``records``, those of a restart first) and saves them
     into the ``journal`` as they come."""
 
-    def __init__(self, comm, todo: list[Case], records: list[dict], journal):
+    def __init__(self, comm, todo: list[Case], records: list[CaseResult], journal):
         self.mpi, self.t0, self.total = comm.tompi4py(), time.perf_counter(), sum(cost(c) for c in todo)
         self.done, self.count, self.n = 0.0, len(records), len(records) + len(todo)
         self.sent: list[MPI.Request] = []
         self.records, self.journal = list(records), journal
 
-    def finished(self, rec: dict, brief: dict) -> None:
+    def finished(self, rec: CaseResult, brief: dict) -> None:
         """A group leader's case is done: rank 0 keeps and says it, another leader sends it to rank 0."""
         if self.mpi.Get_rank() == 0:
             self._keep(rec, brief)
@@ -237,27 +262,28 @@ class _Progress:
         for req in self.sent:
             req.wait()
 
-    def _keep(self, rec: dict, record: dict) -> None:
+    def _keep(self, rec: CaseResult, brief: dict) -> None:
         self.records.append(rec)
         self.journal.save_cases(self.records)
         self.count += 1
-        self.done += record["cost"]
+        self.done += brief["cost"]
         elapsed = time.perf_counter() - self.t0
         left = elapsed * max(self.total - self.done, 0.0) / self.done if self.done else float("nan")
-        what = record.get("error") or record.get("what", "")
-        say(f"case {rec['case'] + 1} ({record['label']}) {what}; {self.count}/{self.n} done, "
+        say(f"case {rec.case + 1} ({brief['label']}) {brief['what']}; {self.count}/{self.n} done, "
             f"{clock(elapsed)} elapsed, about {clock(left)} left")
 
 
-def _brief(record: dict) -> dict:
-    """What the progress line says about a finished case."""
-    out = {"label": record["label"], "cost": record["cost"]}
-    if "error" in record:
-        return out | {"error": f"failed: {record['error']}"}
-    po = record["summary"].get("pull_off")
-    what = f"done in {record['summary']['wall_time_s']:.1f} s"
+def _brief(c: Case, rec: CaseResult) -> dict:
+    """What the progress line says about a finished case: its label, its cost (for the time left), what
+    it found."""
+    out = {"label": c.label, "cost": cost(c)}
+    if isinstance(rec.result, Missing):
+        return out | {"what": f"failed: {rec.result.reason}"}
+    assert isinstance(rec.result, Curve), "a study of curves"
+    po = rec.result.pull_off
+    what = f"done in {rec.result.diagnostics.wall_time_s:.1f} s"
     if po:
-        what += f", pull-off F = {po['F']:.6f}" + (f" +- {po['F_err']:.1e}" if po.get("F_err") else "")
+        what += f", pull-off F = {po.F.value:.6f}" + (f" +- {po.F.err:.1e}" if po.F.err else "")
     return out | {"what": what}
 
 
@@ -285,6 +311,7 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     bad = [c for c in todo if c.error]
     if len(bad) == len(todo):
         raise InputError(bad[0].error)
+    _check_spread(opts, [c for c in todo if not c.error])
     if mpi.Get_rank() == 0:
         for c in bad:
             say(f"case {c.index + 1} ({c.label}) left out: {c.error}")
@@ -300,18 +327,22 @@ def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
             records = spread([c for c in todo if not c.error], opts.int("study_ranks"),
                              lambda c, comm: _run(c, comm, keep), _brief, journal)
             if mpi.Get_rank() == 0:
-                assert records is not None, "rank 0 holds every case's record"
-                failed = [_failure(c, c.error) for c in bad if c.error is not None] + _failures(records)
-                done = [r for r in records if "error" not in r]
+                assert records is not None, "rank 0 holds every case's result"
+                failed = [_failure(c, c.error) for c in bad if c.error is not None] + \
+                    [r for r in records if not r.ran]
+                done = [r for r in records if r.ran]
                 study = {"compute": compute, "axes": [n for n, _ in axes], "ranks_per_case": opts.int("study_ranks"),
                          "cases": len(todo), "profiles": list(keep), "plot": opts.choice("study_plot")}
-                status = 3 if failed or any(r["incomplete"] for r in done) else 0
+                status = 3 if failed or not all(r.complete for r in done) else 0
                 if not done:                 # nothing to replace an earlier result set with
                     status = None
                 else:
+                    line = study_spread_line(done)
+                    if line:
+                        say(line)
                     with written(targets, journal.paths()) as files:
                         write_study({**program_record(Program.of(world)), "options": opts.given()}, study, done,
-                                    sorted(failed, key=lambda r: r["case"]), files)
+                                    sorted(failed, key=lambda r: r.case), files)
         status = mpi.bcast(status, root=0)
         if status is None:
             raise RuntimeError(f"none of the {len(todo)} cases ran (each is said above); nothing written")
@@ -342,14 +373,15 @@ def _files(opts: AppOptions, argv: list[str], table: bool = True):
     return targets, open_checkpoint(opts, targets, inputs, world, study=True)
 
 
-def spread(todo: list[Case], ranks: int, work, brief, journal) -> list[dict] | None:
+def spread(todo: list[Case], ranks: int, work, brief, journal) -> list[CaseResult] | None:
     """``work(case, comm)`` for each case, the cases spread over groups of ``ranks`` ranks (LPT by
-    :func:`cost`); a progress line on rank 0 for each finished case (``brief(record)``).
+    :func:`cost`); a progress line on rank 0 for each finished case (``brief(case, result)``).
 
-    ``work`` returns the case's record on its group's rank 0; a case that raises is recorded with its
-    one-line error.  ``journal`` (a study's :class:`~petsc_adhesion.app.checkpoint.Checkpoint`): the cases
-    of its restart are not run again, rank 0 saves the finished ones into it.  Returns every record on
-    rank 0, in case order (None elsewhere).
+    ``work`` returns the case's :class:`~petsc_adhesion.tracing.case.CaseResult` on its group's rank 0; a
+    case that raises is one whose result is Missing with its one-line error.  ``journal`` (a study's
+    :class:`~petsc_adhesion.app.checkpoint.Checkpoint`): the cases of its restart are not run again, rank 0
+    saves the finished ones into it.  Returns every case's result on rank 0, in case order (None elsewhere);
+    they reach rank 0 as values (pickled by mpi4py).
     """
     world = PETSc.COMM_WORLD
     mpi = world.tompi4py()
@@ -371,14 +403,14 @@ def spread(todo: list[Case], ranks: int, work, brief, journal) -> list[dict] | N
             except (InputError, RuntimeError, FloatingPointError, PETSc.Error) as e:
                 rec = _failure(c, _one_line(e))
             if sub.Get_rank() == 0:
-                rec |= {"label": c.label, "cost": cost(c), "wall_s": time.perf_counter() - t0}
-                progress.finished(rec, brief(rec))
+                rec = replace(rec, wall_time_s=time.perf_counter() - t0)
+                progress.finished(rec, brief(c, rec))
             progress.poll()
         progress.poll(block=True)
     finally:
         sub.Free()
     progress.close()
-    return sorted(progress.records, key=lambda r: r["case"]) if mpi.Get_rank() == 0 else None
+    return sorted(progress.records, key=lambda r: r.case) if mpi.Get_rank() == 0 else None
 
 
 def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool) -> int:
@@ -414,9 +446,9 @@ def _critical_main(opts: AppOptions, argv: list[str], axes: list, helping: bool)
             records = spread(todo, opts.int("study_ranks"), lambda c, comm: _cusp(c, model, solver, comm), _cusp_brief,
                              journal)
             if mpi.Get_rank() == 0:
-                assert records is not None, "rank 0 holds every case's record"
-                failed = _failures(records)
-                done = [r for r in records if "error" not in r]
+                assert records is not None, "rank 0 holds every case's result"
+                failed = [r for r in records if not r.ran]
+                done = [r for r in records if r.ran]
                 study = {"compute": "critical", "axes": [n for n, _ in axes],
                          "ranks_per_case": opts.int("study_ranks"), "cases": len(todo), "plot": "critical"}
                 status = 3 if failed else 0
@@ -455,7 +487,7 @@ def _critical_solver(opts: AppOptions):
     return SolverChoice(natural=roles["natural"], arclength=roles["arclength"], fold=roles["fold"])
 
 
-def _cusp(c: Case, model, solver, comm) -> dict | None:
+def _cusp(c: Case, model, solver, comm) -> CaseResult | None:
     """One case of a critical study: sigma_c at its mu, or mu_c at its sigma, its solvers with ``solver``'s
     settings."""
     from ..tracing.critical import mu_c, sigma_c
@@ -466,16 +498,16 @@ def _cusp(c: Case, model, solver, comm) -> dict | None:
             mu_c(model, value, comm=comm, solver=solver)
     except ValueError as e:                        # no cusp in the range searched
         raise RuntimeError(str(e)) from None
-    return {"case": c.index, "values": c.values, "kind": out.kind, **critical_record(out)} \
-        if comm.getRank() == 0 else None
+    return CaseResult(c.index, tuple(c.values.items()), out) if comm.getRank() == 0 else None
 
 
-def _cusp_brief(record: dict) -> dict:
-    out = {"label": record["label"], "cost": record["cost"]}
-    if "error" in record:
-        return out | {"error": f"failed: {record['error']}"}
-    k = record["kind"]
-    return out | {"what": f"{k} = {record[k]:.6f} +- {record[k + '_err']:.1e} in {record['wall_time_s']:.1f} s"}
+def _cusp_brief(c: Case, rec: CaseResult) -> dict:
+    out = {"label": c.label, "cost": cost(c)}
+    if isinstance(rec.result, Missing):
+        return out | {"what": f"failed: {rec.result.reason}"}
+    cusp = rec.result
+    assert not isinstance(cusp, Curve), "a critical study's cases are cusps"
+    return out | {"what": f"{cusp.kind} = {cusp.value.value:.6f} +- {cusp.value.err:.1e} in {cusp.wall_time_s:.1f} s"}
 
 
 def _one_line(e: BaseException) -> str:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tracing.measured import Missing
 from .summary import branch_record, event_record, head_of, legs_record, solve_record, spread_record, summary_of
 
 __all__ = ["DESCRIBE", "curve_tree", "study_table", "CRITICAL_KEYS", "critical_table", "with_options", "case_tree", "solve_tree",
@@ -113,9 +114,11 @@ DESCRIBE = {
     "cases/*": ("", "one case: the options it sets (values), its model, grid, curve, events and summary"),
     "cases/*/values": ("", "the options this case sets (name without the dash: value)"),
     "failed": ("", "the cases of a study that did not run or failed, each with its one-line reason"),
-    "table": (f"{_STATE}; {_ERRORS}", "every case's events, one row each: case number, the swept options, kind, "
+    "table": (f"{_STATE}; {_ERRORS}; lambda_spread: {_EPS}; F_spread: {_LOAD}",
+              "every case's events, one row each: case number, the swept options, kind, "
               "best lambda and F with their error bars (NaN: none), the single-grid values, Z behind a spring, "
-              "the contact radius with its bar"),
+              "the contact radius with its bar; when a case is rough, the model spread of lambda and F (NaN: "
+              "none for that event)"),
     "table/*": ("", "one column of the table (units as the table's)"),
     "critical_roughness": (f"mu: 1; sigma_c*: {_EPS}; lambda_c*: {_EPS}; F_c*: {_LOAD}; wall_time_s: s",
                            "the critical roughness sigma_c(mu), above which the curve has no turning points: one "
@@ -172,13 +175,18 @@ def curve_tree(curve, options: dict) -> dict:
     return tree
 
 
-def case_tree(curve, keep: tuple | None = None) -> dict:
-    """A study's case: a curve's tree without the program's keys; the profiles only of the event kinds in
-    ``keep`` (None: all that were computed)."""
-    events = [event_record(e, keep is None or e.kind in keep) for e in curve.events]
-    tree = {**head_of(curve), "curve": branch_record(curve), "events": events,
+def case_tree(case) -> dict:
+    """A study's case (:class:`~petsc_adhesion.tracing.case.CaseResult` of a curve): its number and values,
+    then a curve's tree without the program's keys (the profiles the study kept), and its model spread when
+    computed."""
+    curve = case.result
+    tree = {**head_of(curve), "curve": branch_record(curve), "events": [event_record(e) for e in curve.events],
             "summary": _h5_summary(summary_of(curve))}
-    return {k: v for k, v in tree.items() if k in ("model", "grid", "curve", "events", "summary", "physical")}
+    out = {"case": case.case, "values": dict(case.values),
+           **{k: v for k, v in tree.items() if k in ("model", "grid", "curve", "events", "summary", "physical")}}
+    if curve.spread is not None:
+        out["model_spread"] = spread_tree(curve.spread)
+    return out
 
 
 def solve_tree(solution, options: dict) -> dict:
@@ -187,15 +195,30 @@ def solve_tree(solution, options: dict) -> dict:
             "solution": {"H": solution.H, "P": solution.P, **solve_record(solution)}}
 
 
-def study_table(done: list[dict], axes: list[str]) -> dict:
-    """Every case's events as columns: case, the swept options, kind, best values, bars, grid values."""
-    rows = [(r, e) for r in done for e in r["tree"]["events"]]
-    cols = {"case": np.array([r["case"] for r, _ in rows], dtype=int)}
-    cols |= {name: np.array([r["values"][name] for r, _ in rows], dtype=float) for name in axes}
-    cols["kind"] = np.array([e["kind"] for _, e in rows], dtype="S12")
+def _spreads(curve) -> tuple:
+    """The model spread of each event's lambda and F (pairs; None where there is none)."""
+    spread = curve.spread
+    if spread is None or isinstance(spread, Missing):
+        return ((None, None),) * len(curve.events)
+    return spread.of_events(curve)
+
+
+def study_table(done: list, axes: list[str]) -> dict:
+    """Every case's events (``done``: :class:`~petsc_adhesion.tracing.case.CaseResult` of curves) as
+    columns: case, the swept options, kind, best values, bars, grid values; when a case has a model spread,
+    the spread of each event's lambda and F (NaN where the event has none: a smooth case, a kind not
+    compared)."""
+    rows = [(r, event_record(e, profiles=False), s) for r in done
+            for e, s in zip(r.result.events, _spreads(r.result))]
+    cols = {"case": np.array([r.case for r, _, _ in rows], dtype=int)}
+    cols |= {name: np.array([r.value(name) for r, _, _ in rows], dtype=float) for name in axes}
+    cols["kind"] = np.array([e["kind"] for _, e, _ in rows], dtype="S12")
     for k in ("lambda", "lambda_err", "F", "F_err", "lambda_grid", "F_grid", "Z", "Z_err", "contact_radius",
               "contact_radius_err"):
-        cols[k] = np.array([e.get(k, np.nan) for _, e in rows], dtype=float)
+        cols[k] = np.array([e.get(k, np.nan) for _, e, _ in rows], dtype=float)
+    if any(r.result.spread is not None for r in done):
+        for i, k in enumerate(("lambda_spread", "F_spread")):
+            cols[k] = np.array([np.nan if s[i] is None else s[i] for _, _, s in rows], dtype=float)
     return cols
 
 

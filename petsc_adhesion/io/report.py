@@ -15,7 +15,7 @@ def spread_lines(spread) -> list[str]:
 
     return report_lines(spread)
 
-__all__ = ["report_curve", "report_solve", "topography_lines"]
+__all__ = ["report_curve", "report_solve", "topography_lines", "study_spread_line"]
 
 
 def _pm(name: str, m: Measured, digits: int = 8) -> str:
@@ -181,3 +181,20 @@ def report_solve(s: Solution) -> None:
     if s.model.topography:
         line += "\n" + "\n".join(topography_lines(s.model))
     tell(line)
+
+
+def study_spread_line(done: list) -> str | None:
+    """The one line a study says of its cases' model spreads (``done``: its cases that ran, each a
+    :class:`~petsc_adhesion.tracing.case.CaseResult`): how many of those with a spread warn (the roughness
+    law moves an event beyond ten error bars or 10 % of its value), and where to read them; None when no case
+    has one.  One line for the study, not one a case: each case's warnings are in its files."""
+    spreads = [r for r in done if isinstance(r.result, Curve) and r.result.spread is not None
+               and not isinstance(r.result.spread, Missing)]
+    if not spreads:
+        return None
+    warned = [r for r in spreads if r.result.spread.warnings]
+    cases = ", ".join(str(r.case + 1) for r in warned)
+    return (f"model spread: {len(warned)} of the {len(spreads)} rough case{'s' * (len(spreads) != 1)} warn"
+            + ("" if not warned else f" (case{'s' * (len(warned) != 1)} {cases}): the roughness law moves an event "
+               "beyond ten error bars or 10% of its value; each case's model_spread in the files says which and "
+               "by how much"))

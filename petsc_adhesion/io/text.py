@@ -45,7 +45,7 @@ EVENT_COLUMNS = (("kind", None), ("lambda", _EPS), ("lambda_err", _EPS), ("F", _
 #: another swept option's column is in the option's own unit, as it takes its values.
 _TABLE_UNITS = {"adh_mu": "1", "adh_sigma": _EPS, "lambda": _EPS, "lambda_err": _EPS, "lambda_grid": _EPS,
                 "F": _LOAD, "F_err": _LOAD, "F_grid": _LOAD, "Z": _EPS, "Z_err": _EPS, "contact_radius": _RAD,
-                "contact_radius_err": _RAD}
+                "contact_radius_err": _RAD, "lambda_spread": _EPS, "F_spread": _LOAD}
 
 
 def _header(name: str, unit: str | None) -> str:

@@ -15,6 +15,7 @@ from .layout import (
     _CRITICAL,
     CRITICAL_KEYS,
     DESCRIBE,
+    case_tree,
     critical_table,
     curve_tree,
     solve_tree,
@@ -22,7 +23,7 @@ from .layout import (
 )
 from .fit import DESCRIBE_FIT, write_fit_csv
 from .resultset import ResultSet, plot_format
-from .summary import solve_summary, summary_of
+from .summary import critical_record, solve_summary, summary_of
 from .text import write_curve_csv, write_events_csv, write_table_csv
 
 __all__ = ["write_h5", "write_json", "write_curve", "write_solve", "write_study", "write_critical", "write_fit"]
@@ -152,23 +153,32 @@ def write_solve(solution, options: dict, files: ResultSet, commit: bool = True) 
         files.commit()
 
 
-def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
+def _failed(failed: list) -> list[dict]:
+    """The records of the cases that did not run (:class:`~petsc_adhesion.tracing.case.CaseResult`, its
+    result Missing): number, values, the one-line reason."""
+    return [{"case": r.case, "values": dict(r.values), "error": r.result.reason} for r in failed]
+
+
+def write_critical(prog: dict, study: dict, done: list, failed: list, files: ResultSet) -> dict:
     """The files of a critical study (``-study_compute critical``), committed together; returns the summary.
 
-    ``done``: the cases that ran, each a record of :func:`~petsc_adhesion.tracing.critical.sigma_c` or
-    :func:`~petsc_adhesion.tracing.critical.mu_c` with its ``kind``; ``failed``: {case, values, error}.
+    ``done``: the cases that ran, each a :class:`~petsc_adhesion.tracing.case.CaseResult` of a
+    :class:`~petsc_adhesion.tracing.critical.Critical`; ``failed``: those that did not, in case order.
     """
     brief = {k: v for k, v in prog.items() if k != "options"}
+    records = [{"case": r.case, "values": dict(r.values), "kind": r.result.kind, **critical_record(r.result)}
+               for r in done]
     def keys(kind):
         return CRITICAL_KEYS[kind] + (f"{kind}_grid", "levels", "n_nodes", "bracket", "roughness", "rmax", "warning")
 
-    lists = {name: [{k: r[k] for k in keys(kind) if k in r} for r in done if r["kind"] == kind]
+    lost = _failed(failed)
+    lists = {name: [{k: r[k] for k in keys(kind) if k in r} for r in records if r["kind"] == kind]
              for name, kind in _CRITICAL}
-    summ = {**brief, "kind": "critical", "study": study, **lists, "failed": failed}
+    summ = {**brief, "kind": "critical", "study": study, **lists, "failed": lost}
     tree = {**prog, "kind": "critical", "study": study,
-            **{name: critical_table(done, kind) for name, kind in _CRITICAL},
-            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in failed]}
-               if failed else {})}
+            **{name: critical_table(records, kind) for name, kind in _CRITICAL},
+            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in lost]}
+               if lost else {})}
     if "out" in files.targets:
         write_h5(files.temp("out"), tree)
     if "plot" in files.targets:
@@ -181,20 +191,22 @@ def write_critical(prog: dict, study: dict, done: list[dict], failed: list[dict]
     return summ
 
 
-def write_study(prog: dict, study: dict, done: list[dict], failed: list[dict], files: ResultSet) -> dict:
+def write_study(prog: dict, study: dict, done: list, failed: list, files: ResultSet) -> dict:
     """The files of a study (:mod:`petsc_adhesion.app.study`), its table of events as CSV among them (``csv``),
     committed together; returns the summary.
 
-    ``done``: each case that ran as {case, values, summary, tree}; ``failed``: {case, values, error}.
+    ``done``: each case that ran, a :class:`~petsc_adhesion.tracing.case.CaseResult` of its
+    :class:`~petsc_adhesion.tracing.curve.Curve`; ``failed``: those that did not, in case order.
     """
     brief = {k: v for k, v in prog.items() if k != "options"}
-    cases = [{"case": r["case"], "values": r["values"], **r["summary"]} for r in done]
-    summ = {**brief, "kind": "study", "study": study, "cases": cases, "failed": failed}
+    cases = [{"case": r.case, "values": dict(r.values), **summary_of(r.result)} for r in done]
+    lost = _failed(failed)
+    summ = {**brief, "kind": "study", "study": study, "cases": cases, "failed": lost}
     tree = {**prog, "kind": "study", "study": study,
-            "cases": [{"case": r["case"], "values": r["values"], **r["tree"]} for r in done],
+            "cases": [case_tree(r) for r in done],
             "table": study_table(done, study["axes"]),
-            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in failed]}
-               if failed else {})}
+            **({"failed": [{"case": f["case"], "error": f["error"], "values": f["values"]} for f in lost]}
+               if lost else {})}
     if "out" in files.targets:
         write_h5(files.temp("out"), tree)
     if "plot" in files.targets:

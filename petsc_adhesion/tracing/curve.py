@@ -18,7 +18,7 @@ negative when tensile), r and contact radii in sqrt(epsilon R), P in
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -323,6 +323,23 @@ class Curve:
         (:class:`~.legs.InstrumentCurve`, or Missing with the reason); None without a spring."""
         return None if self.spring is None else self.spring.legs
 
+    def keeping_profiles(self, kinds: tuple | None) -> Curve:
+        """This curve with the profiles (H and P at an event and at its landing) of the events of ``kinds``
+        alone (None: all it has), as a study keeps a case (-study_profiles): the others' arrays are no part
+        of its files, nor of its checkpoint."""
+        if kinds is None:
+            return self
+
+        def kept(e: Event) -> Event:
+            if e.kind in kinds:
+                return e
+            landing = None if e.landing is None else replace(e.landing, profile=None)
+            return replace(e, profile=None, landing=landing)
+
+        spring = None if self.spring is None else replace(self.spring, jumps=tuple(map(kept, self.spring.jumps)))
+        return replace(self, events=tuple(map(kept, self.events)),
+                       pull_off=None if self.pull_off is None else kept(self.pull_off), spring=spring)
+
 
 @dataclass(frozen=True)
 class Solution:
@@ -343,3 +360,4 @@ class Solution:
     model: Model = field(repr=False)
     program: Program = field(repr=False)
     grid: GridRecord = field(repr=False)
+

@@ -224,6 +224,34 @@ class ModelSpread:
                 return q
         raise KeyError(name)
 
+    def of_events(self, curve) -> tuple:
+        """For each event of ``curve`` (the reference, in its order) the spreads of its lambda and its F, a
+        pair, each None where the spread has not that quantity (an event of a kind not compared, an
+        equilibrium's F, a quantity no other law has); the pull-off (the most tensile F_min) is found by
+        its values, as a study's table lists it among the events."""
+        ref = curve_values(curve)
+        pull = ref.pull_off
+        seen: dict[str, int] = {}
+        counts = _counts(ref)
+        spreads = {q.name: q.spread for q in self.quantities}
+        out = []
+        for e in curve.events:
+            if pull is not None and e.kind == pull.kind and (e.lam, e.F) == (pull.lam, pull.F):
+                name: str | None = "pull-off"
+            elif e.kind in KINDS:
+                seen[e.kind] = seen.get(e.kind, 0) + 1
+                name = _named(e.kind, seen[e.kind], counts[e.kind])
+            else:
+                name = None
+            out.append((None, None) if name is None else
+                       (spreads.get(f"{name} lambda"), spreads.get(f"{name} F")))
+        return tuple(out)
+
+
+def _named(kind: str, k: int, n: int) -> str:
+    """The name of the k-th (from 1) of the ``n`` events of ``kind`` among a spread's quantities."""
+    return kind if n == 1 else f"{kind} #{k}"
+
 
 def _matched(ref: CurveValues, alt: CurveValues) -> tuple[list, list]:
     """(names, (reference, alternative) pairs of EventValues, the alternative None where it has not the
@@ -236,7 +264,7 @@ def _matched(ref: CurveValues, alt: CurveValues) -> tuple[list, list]:
         mine = [e for e in ref.events if e.kind == kind]
         theirs = [e for e in alt.events if e.kind == kind]
         for k, e in enumerate(mine):
-            names.append(kind if len(mine) == 1 else f"{kind} #{k + 1}")
+            names.append(_named(kind, k + 1, len(mine)))
             pairs.append((e, theirs[k] if k < len(theirs) else None))
     return names, pairs
 

@@ -292,8 +292,10 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
         The communicator of every object (PETSc.COMM_WORLD by default): a study runs cases on parts of it.
     checkpoint
         Saves the run as it goes and restores the state it holds first: ``restore(tracer)`` returns
-        (phase, seconds spent by phase) or None, ``pause(tracer, phase, seconds)`` is called where the
-        state is whole (:class:`~petsc_adhesion.app.checkpoint.Checkpoint`).
+        (phase, seconds spent by phase, the error bars' estimates already made) or None,
+        ``pause(tracer, phase, seconds, estimates)`` is called where the state is whole, with the
+        estimates made so far in the order of the events (:class:`~petsc_adhesion.app.checkpoint.Checkpoint`):
+        a restart does not locate again an event already estimated.
     progress
         Says how far the run is: ``due()``, ``update(fraction, text)``, ``line(text)``, ``reset()``
         (:class:`~petsc_adhesion.app.progress.Progress`).
@@ -331,9 +333,9 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
     kept = (lambda label: True) if kinds is None else (lambda label: label in kinds or label == "lambda")
     try:
         restored = checkpoint.restore(tracer) if checkpoint is not None else None
-        phase, spent = restored or ("trace", {"trace": 0.0, "errors": 0.0})
+        phase, spent, made = restored or ("trace", {"trace": 0.0, "errors": 0.0}, ())
         bars: list[tuple[Segment, Found]] = []
-        estimates = {}          # id of a located event (the core's Found) -> its Estimate, or Missing
+        estimates: dict[int, error_bars.Estimate | Missing] = {}   # id of a located Found -> its Estimate, or Missing
         if restored and progress is not None:
             progress.line(f"going on from the checkpoint {checkpoint.name} at lambda "
                           f"{tracer.segments[-1].cont.points[-1].p:.6g}"
@@ -344,7 +346,7 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
             """Where the state is whole: a checkpoint may be saved, progress said."""
             walls = {**spent, stage: spent[stage] + time.perf_counter() - (t0 if stage == "trace" else t1)}
             if checkpoint is not None:
-                checkpoint.pause(tr, stage, walls)
+                checkpoint.pause(tr, stage, walls, tuple(estimates[id(f)] for _, f in bars if id(f) in estimates))
             if progress is not None and progress.due():
                 done = sum(id(f) in estimates for _, f in bars)
                 progress.update(*(_status(tr, lam0, end) if stage == "trace" else
@@ -366,7 +368,11 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
             bars = [(seg, f) for seg in segments for f in seg.finder.found if kept(f.label)]
             if progress is not None:
                 progress.reset()
-            for seg, found in bars:
+            if len(made) > len(bars):
+                raise ValueError(f"{len(made)} error-bar estimates for the {len(bars)} events of the curve restored")
+            # the estimates of the checkpoint first, in the events' order (the restored finders' order)
+            estimates |= {id(f): e for (_, f), e in zip(bars, made)}
+            for seg, found in bars[len(made):]:
                 pause(tracer, "errors")
                 est = error_bars.event_errors(tracer, seg, found, request.target_error)
                 estimates[id(found)] = Missing(results.NO_BAR) if est is None else est

@@ -22,7 +22,6 @@ from ...core.continuation import NATURAL_PREFIX
 from ...core.fold import FOLD_PREFIX
 from ...core.newton import PetscSettings
 from ...tracing.legs import default_trigger, figure_step, rigid_pull_off
-from ...tracing.model_spread import Rule, default_rules, parse_rules
 from ...tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, step_scale
 from .plausible import slip
 from .table import TABLE, Option
@@ -200,6 +199,8 @@ class AppOptions:
         o, raw = TABLE[name], self._raw(name)
         if raw is None:
             return o.default
+        from ...tracing.model_spread import parse_rules     # given: a rough run's spread, which loads it anyway
+
         try:
             return parse_rules(raw)
         except ValueError as why:
@@ -588,6 +589,9 @@ def read_model_spread(opts: AppOptions, model: Model) -> tuple | None:
             name = "adh_model_spread" if wanted else "adh_model_spread_rules"
             raise InputError(f"-{name}: a smooth surface (sigma = 0) has no roughness law to vary")
         return None
+    # here, not at the top: a smooth run need not load the spread's module (docs/performance.md)
+    from ...tracing.model_spread import Rule, default_rules
+
     if rules is not None and Rule.of(model) in rules:
         raise InputError(f"-adh_model_spread_rules: {Rule.of(model).label} is the model's own law, not an "
                          "alternative to it")
