@@ -602,3 +602,36 @@ def test_a_study_case_round_trips_through_the_serializer(tmp_path):
     assert "model_spread" in summary["cases"][0] and summary["failed"][0]["error"] == "the first step failed"
     assert "cases/0000/model_spread" in h5 and "F_spread [2 pi R gamma]" in csv[0]
     assert digests[0][4]["critical_roughness"][0]["sigma_c"] == 0.62
+
+
+def test_a_spring_curve_and_a_topography_round_trip_through_the_serializer(tmp_path):
+    """A curve behind a spring (its instrument's legs) and a model read from a topography file go through the
+    checkpoint's serializer and come back equal: the legs' arrays bit for bit, the curve's summary equal, the
+    topography's heights and statistics equal (a study journals its cases, and their models, this way)."""
+    import dataclasses
+
+    import numpy as np
+    import pytest
+
+    from petsc_adhesion.io.summary import summary_of
+    from petsc_adhesion.io.values import decode, encode
+    from petsc_adhesion.model.parameters import Model
+    from petsc_adhesion.tracing.trace import CurveRequest, GridChoice, trace_curve
+
+    curve = trace_curve(Model(mu=2.0, sigma=0.0), GridChoice("uniform", n=101), request=CurveRequest(spring=0.5))
+    back = decode(encode(curve))
+    assert summary_of(back) == summary_of(curve)
+    legs, legs_back = curve.instrument, back.instrument
+    assert type(legs_back) is type(legs) and len(legs.approach.Z) > 10
+    for a, b in zip(legs.legs, legs_back.legs):
+        assert a.name == b.name and a.jumps == b.jumps
+        for f in ("Z", "F", "lam", "contact_radius"):
+            assert np.array_equal(getattr(a, f), getattr(b, f), equal_nan=True), f
+
+    pytest.importorskip("SurfaceTopography")
+    from petsc_adhesion.model.topography import read_topography
+
+    topo = read_topography(os.path.join(os.path.dirname(__file__), "data", "wsxm-afm-topography.top"))
+    model = dataclasses.replace(Model(mu=1.0, sigma=0.3), topography=(topo,))
+    t = decode(encode(model)).topography[0]
+    assert np.array_equal(t.heights, topo.heights) and t.stats == topo.stats and t.pixel_size == topo.pixel_size

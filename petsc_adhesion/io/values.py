@@ -27,13 +27,17 @@ def known() -> dict:
     cusp, a model spread, an event's estimate, a study's case."""
     # here, not at the top: the readers of result files (io.summary, plot) need not load PETSc, which
     # tracing.critical and tracing.error_bars do
-    from ..model import parameters, physical
-    from ..tracing import case, critical, curve, error_bars, measured, model_spread
+    from ..model import parameters, physical, topography
+    from ..tracing import case, critical, curve, error_bars, legs, measured, model_spread
 
     classes = [parameters.Model, physical.Bodies, measured.Measured, measured.Missing, critical.Critical,
                error_bars.Estimate, error_bars.LandingEstimate, model_spread.Rule, model_spread.Quantity,
                model_spread.ModelSpread, case.CaseResult]
-    classes += [getattr(curve, name) for name in curve.__all__ if isinstance(getattr(curve, name), type)]
+    # a curve's parts, the legs behind its spring, the topography its model was read from: every value class
+    # their modules export
+    for module in (curve, legs, topography):
+        classes += [c for c in (getattr(module, name) for name in module.__all__)
+                    if isinstance(c, type) and is_dataclass(c)]
     return {c.__name__: c for c in classes}
 
 
