@@ -1,4 +1,4 @@
-"""The curve family table against the solver: a small table built here (mu 0.1 to 0.8, sigma 0 and 0.5), its
+"""The curve family table against the solver: a small table built here (mu 0.1 to 0.8, sigma 0 to 0.1), its
 nodes reproducing the solver's sampled curves to round-off, its off-node curves within the error it measured,
 its legs behind a spring against fitting/forward.py's on the same curve, its refusals and its file."""
 import math
@@ -11,12 +11,12 @@ from petsc_adhesion.family.coordinate import NotMonotone, coordinate, sample, st
 from petsc_adhesion.family.legs import spring_legs
 from petsc_adhesion.family.table import FORMAT_VERSION, FamilyTable, OutOfRange, TableError, lagrange
 
-MU, SIGMA = (0.1, 0.2, 0.4, 0.8), (0.0, 0.5)
+MU, SIGMA = (0.1, 0.2, 0.4, 0.8), (0.0, 0.05, 0.1)
 
 
 @pytest.fixture(scope="module")
 def table():
-    """The table of 8 nodes, its error measured at its 3 cell centres behind one spring."""
+    """The table of 12 nodes, its error measured at its 6 cell centres behind one spring."""
     from petsc_adhesion.benchmarks.family import measure
 
     return measure(build(TableGrid(mu=MU, sigma=SIGMA, n_tau=150)), springs=(0.5,))
@@ -81,7 +81,7 @@ def test_the_nodes_reproduce_the_solver_to_round_off(table):
     from petsc_adhesion.discretization.contact import edge_level
     from petsc_adhesion.model.pressure import pressure_law
 
-    for mu, sigma in ((0.4, 0.0), (0.8, 0.5)):
+    for mu, sigma in ((0.4, 0.05), (0.8, 0.1)):
         c = trace_node(mu, sigma)
         b = c.branch
         ref = sample(b.lam, b.F, b.H0, b.contact_radius, edge_level(pressure_law(c.model)), table.F_max,
@@ -97,13 +97,14 @@ def test_the_nodes_reproduce_the_solver_to_round_off(table):
 
 def test_off_node_curves_are_the_solver_s_within_the_measured_error(table):
     """Away from the nodes and the midpoints the error was measured at (a third of the way across a cell),
-    the pull-off and the force behind a spring are the solver's to within the error the table states."""
+    the pull-off and the force behind a spring are the solver's to within the error the table states (twice
+    the largest measured at the cell centres about them)."""
     from petsc_adhesion.benchmarks.family import _spring
 
     worst = table.worst()
-    assert isinstance(worst, TableError) and worst.points == 3
-    assert 0 < worst.event_F < 0.05 and 0 < worst.F_at_Z < 0.05     # measured, and small
-    for mu, sigma in ((0.1 * 2 ** (1 / 3), 0.5 / 3), (0.4 * 2 ** (2 / 3), 0.5 * 2 / 3)):
+    assert isinstance(worst, TableError) and worst.points == 6
+    assert 0 < worst.event_F < 0.02 and 0 < worst.F_at_Z < 0.1      # measured, and small
+    for mu, sigma in ((0.1 * 2 ** (1 / 3), 0.05 / 3), (0.4 * 2 ** (2 / 3), 0.05 + 0.05 * 2 / 3)):
         err = table.error(mu, sigma)
         got = table.curve(mu, sigma)
         (pl, pF), = [(e.lam.value, e.F.value) for e in got.events() if e.kind == "pull_off"]
@@ -147,14 +148,14 @@ def test_the_table_s_legs_at_a_node_are_the_solver_s(table):
     the sampling's alone, below the error measured between nodes."""
     from petsc_adhesion.benchmarks.family import _spring
 
-    eF, eZ, eJ = _spring(table, 0.4, 0.5, 0.5)
+    eF, eZ, eJ = _spring(table, 0.4, 0.05, 0.5)
     worst = table.worst()
-    assert eF < 2e-3 and eZ < 2e-3 and eF <= worst.F_at_Z
+    assert eF < 1e-4 and eF <= worst.F_at_Z and eZ <= worst.jump_Z and eJ <= worst.jump_F
 
 
 @pytest.mark.parametrize("call, says", [
     (lambda t: t.curve(0.05, 0.0), r"^mu 0\.05: the table holds mu in \[0\.1, 0\.8\]$"),
-    (lambda t: t.curve(0.3, 0.7), r"^sigma 0\.7: the table holds sigma in \[0, 0\.5\]$"),
+    (lambda t: t.curve(0.3, 0.7), r"^sigma 0\.7: the table holds sigma in \[0, 0\.1\]$"),
     (lambda t: t.curve(float("nan"), 0.0), r"^mu nan: the table holds mu"),
     (lambda t: t.error(2.0, 0.0), r"^mu 2\.0: the table holds mu"),
     (lambda t: t.curve(0.3, 0.0).behind(0.0), r"^K 0\.0: expected a spring stiffness, a finite real > 0$"),
@@ -178,7 +179,7 @@ def test_the_file_round_trip_keeps_every_value(table, tmp_path):
         assert np.array_equal(getattr(back, name), getattr(table, name)), name
     assert all(np.array_equal(back.errors[f], table.errors[f]) for f in table.errors)
     assert (back.F_max, back.roughness, back.version) == (table.F_max, table.roughness, table.version)
-    a, b = table.curve(0.3, 0.2), back.curve(0.3, 0.2)
+    a, b = table.curve(0.3, 0.07), back.curve(0.3, 0.07)
     assert np.array_equal(a.F, b.F) and a.error == b.error
 
 

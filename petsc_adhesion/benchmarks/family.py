@@ -1,7 +1,7 @@
 """The curve family table: built, its interpolation error measured against the solver, its speed (docs/family.md).
 
     OPENBLAS_NUM_THREADS=1 mpiexec -n 2 python -m petsc_adhesion.benchmarks.family build --out family.npz \\
-        [--mu 1e-3 1e3] [--per-decade 4] [--sigma 0 3] [--sigma-n 7] [--n-tau 300]
+        [--mu 1e-3 1e3] [--per-decade 4] [--sigma 0 0.05 ... 3] [--n-tau 300] [--springs 0.02 0.5 10]
     OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.benchmarks.family speed family.npz [--repeats 20]
 
 ``build`` traces the nodes (:func:`~petsc_adhesion.family.build.build`, spread over the
@@ -14,11 +14,12 @@ are compared (the midpoints spread over the ranks too):
   the pull-off, in lambda and F (their values on the solver's grid);
 - behind each spring of ``--springs`` (units 2 pi R w / epsilon): the solver's curve
   traced behind it (:class:`~petsc_adhesion.fitting.forward.ForwardCurve`) against the
-  table's legs (:meth:`~petsc_adhesion.family.table.FamilyCurve.behind`), F at 400 base
-  positions Z on each leg from the curve's start to where it reaches F_max, leaving out
-  the Z within twice the jumps' error of a jump of either (there a vertical jump makes
-  any difference in Z one of O(1) in F); the jumps' Z and the force at their turning
-  points.
+  table's legs (:meth:`~petsc_adhesion.family.table.FamilyCurve.behind`): F at the
+  solver's own points on the pieces each leg follows (its computed states, no
+  interpolation on its side) up to where the table ends (F_max), leaving out the Z within
+  twice the jumps' error of a jump of either (there a vertical jump makes any difference
+  in Z one of O(1) in F); the jumps' Z and the force at their turning points (the
+  library's located events).
 
 The table is written with these errors (``FamilyTable.with_error``), all or nothing, and
 the report gives the cost per node and the error per midpoint.  ``speed`` times what a
@@ -37,12 +38,15 @@ import time
 import numpy as np
 
 from ..errors import say
-from ..family.build import F_MAX, TableGrid, build, log_nodes, node_cost, spread, trace_node
+from ..family.build import F_MAX, TableGrid, build, log_nodes, node_cost, regrid_points, spread, trace_node
 from ..family.table import APPROACH, ERROR_FIELDS, RETRACT, FamilyTable, OutOfRange
 
 #: The springs the error is measured behind (units 2 pi R w / epsilon): soft (jumps far out, the rigid
 #: sphere's law), middling, stiff (the legs follow the curve's folds).
 SPRINGS = (0.02, 0.5, 10.0)
+#: The default sigma nodes: 0.05 apart up to 0.5, where the pull-off falls fastest (docs/family.md measures the
+#: error of 0.1 against 0.05 apart there), then 0.1 to 1 and 0.25 to 3.
+SIGMA_NODES = tuple(np.round(np.r_[np.arange(0.0, 0.5, 0.05), np.arange(0.5, 1.0, 0.1), np.arange(1.0, 3.01, 0.25)], 10))
 
 
 def midpoints(table: FamilyTable) -> list[tuple[float, float]]:
@@ -113,9 +117,11 @@ def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[floa
                     comm=PETSc.COMM_SELF)
     truth = ForwardCurve(c, K)
     mine = table.curve(mu, sigma).behind(K)
-    z_end = min(mine.Z_max, float(np.interp(table.F_max, c.branch.F[-5:], c.branch.Z[-5:])))
-    z_start = max(truth.pieces[0].Z_lo, mine.legs.pieces[0].Z_lo)
-    Z = np.linspace(z_start, z_end, 400)
+    b = c.branch
+    own = ~regrid_points(b)
+    lam, F = b.lam[own], b.F[own]
+    Z = lam + F / K
+    inside = Z <= mine.Z_max
     eF = eZ = eJ = 0.0
     for leg in (APPROACH, RETRACT):
         js, jt = truth.jumps[leg], mine.legs.jumps[leg]
@@ -126,12 +132,15 @@ def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[floa
             for k, z in enumerate(js):
                 j = int(np.argmin([abs(z - y) for y in jt]))
                 eJ = max(eJ, abs(fs[k][0] - ft[j][0]))
-        away = np.ones(Z.size, bool)
+        # the solver's own points on the pieces this leg follows (no interpolation on its side), away from
+        # the jumps of either
+        piece = truth.assign(Z, leg)
+        on = inside & np.array([truth.pieces[p].lam[0] <= x <= truth.pieces[p].lam[-1] for p, x in zip(piece, lam)])
         w = 2.0 * (dz if math.isfinite(dz) else 0.0) + 1e-9
         for z in js + jt:
-            away &= np.abs(Z - z) > w
-        if away.any():
-            eF = max(eF, float(np.max(np.abs(truth.predict(Z[away], leg) - mine.predict(Z[away], leg)))))
+            on &= np.abs(Z - z) > w
+        if on.any():
+            eF = max(eF, float(np.max(np.abs(F[on] - mine.predict(Z[on], leg)))))
     return eF, eZ, eJ
 
 
@@ -202,8 +211,7 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--out", required=True)
     b.add_argument("--mu", nargs=2, type=float, default=(1e-3, 1e3))
     b.add_argument("--per-decade", type=float, default=4.0)
-    b.add_argument("--sigma", nargs=2, type=float, default=(0.0, 3.0))
-    b.add_argument("--sigma-n", type=int, default=7)
+    b.add_argument("--sigma", nargs="+", type=float, default=list(SIGMA_NODES))
     b.add_argument("--n-tau", type=int, default=300)
     b.add_argument("--springs", nargs="+", type=float, default=list(SPRINGS))
     s = sub.add_parser("speed")
@@ -230,9 +238,8 @@ def main(argv=None) -> int:
     tell = print if rank == 0 else (lambda text: None)
     try:
         lo, hi = args.mu
-        grid = TableGrid(mu=log_nodes(lo, hi, args.per_decade) if hi > lo else (lo,),
-                         sigma=tuple(np.linspace(args.sigma[0], args.sigma[1], args.sigma_n)) if args.sigma_n > 1
-                         else (args.sigma[0],), n_tau=args.n_tau)
+        grid = TableGrid(mu=log_nodes(lo, hi, args.per_decade) if hi > lo else (lo,), sigma=tuple(args.sigma),
+                         n_tau=args.n_tau)
         if not (lo > 0 and hi >= lo):
             raise ValueError(f"--mu {lo:g} {hi:g}: expected 0 < lo <= hi")
         if not all(K > 0 and math.isfinite(K) for K in args.springs):
