@@ -222,3 +222,25 @@ def test_an_unmeasured_table_says_its_error_is_missing():
     e = t.error(1.0, 0.0)
     assert not e and "not measured" in e.reason
     assert math.isfinite(t.curve(1.0, 0.0).F[0])
+
+
+@pytest.mark.parametrize("args, says", [
+    (["build", "--out", "t.npz", "--mu", "3", "1"], "--mu 3 1: expected 0 < lo <= hi"),
+    (["build", "--out", "t.npz", "--sigma", "0.2", "0.1"], "sigma: expected increasing roughnesses >= 0"),
+    (["build", "--out", "t.npz", "--springs", "0"], "--springs [0.0]: expected stiffnesses > 0"),
+    (["build", "--out", "no/such/t.npz"], "--out no/such/t.npz: no folder"),
+    (["build", "--out", "t.npz", "--n-tau", "x"], "argument --n-tau: invalid int value: 'x'"),
+    (["speed", "t.npz"], "t.npz: not a curve family table"),
+])
+def test_the_builder_s_bad_input_is_one_line_and_writes_nothing(tmp_path, args, says):
+    """The builder refuses what it cannot build before any trace: one line, exit 2, no file."""
+    import subprocess
+    import sys
+
+    from conftest import _env
+
+    p = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.family", *args], cwd=tmp_path,
+                       capture_output=True, text=True, env=_env(), timeout=300)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.count("\n") == 1 and says in p.stderr, p.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -20,7 +20,7 @@ import numpy as np
 from ..discretization.contact import edge_level
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
-from .coordinate import NotMonotone, sample, width
+from .coordinate import NotMonotone, Sampled, sample, width
 from .table import FamilyTable
 
 __all__ = ["TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points", "F_MAX", "ROUGHNESS"]
@@ -82,6 +82,7 @@ def _node(mu: float, sigma: float, tau: np.ndarray, F_max: float):
     from petsc4py import PETSc
 
     t0 = time.perf_counter()
+    out: Sampled | str
     try:
         c = trace_node(mu, sigma, F_max, PETSc.COMM_SELF)
         if not c.complete:

@@ -147,14 +147,14 @@ class FamilyTable:
             (self.err_sigma <= hi_s + 1e-12)
         if not near.any():
             near = np.ones(em.size, bool)
-        return TableError(*(SAFETY * float(np.max(self.errors[f][near])) for f in ERROR_FIELDS),
+        return TableError(**{f: SAFETY * float(np.max(self.errors[f][near])) for f in ERROR_FIELDS},
                           points=int(near.sum()))
 
     def worst(self) -> TableError | Missing:
         """The largest interpolation error measured over the whole table (as measured, without SAFETY)."""
         if not self.measured:
             return Missing("the table's interpolation error was not measured (built without its midpoints)")
-        return TableError(*(float(np.max(self.errors[f])) for f in ERROR_FIELDS), points=int(self.err_mu.size))
+        return TableError(**{f: float(np.max(self.errors[f])) for f in ERROR_FIELDS}, points=int(self.err_mu.size))
 
     def with_error(self, mu: np.ndarray, sigma: np.ndarray, springs, errors: dict) -> FamilyTable:
         """This table with the error measured at the midpoints (``mu``, ``sigma``): ``errors`` one array per
