@@ -14,7 +14,8 @@ sphere in contact (H = H(0) + r^2 / 2, a^2 / 2 = level - H(0)) it is level - 2 H
 in deep contact it grows as a^2 / 2, like the approach (Hertz: lambda ~ a^2).
 Measured on the solver's curves (docs/family.md): along every curve traced it only
 falls between two points of one state on two grids (a regrid), by at most 2e-2 at
-mu = 1000 (1e-5 of the curve's range of s), which the sampling leaves out.
+mu = 1000 (3e-6 of the curve's range of s); the sampling leaves those points out (their corrector is
+`regrid`), and along the curves checked no fall is left (docs/family.md).
 
 The curves' ranges of s differ by orders of magnitude (mu = 1000 starts at s = -2005
 and ends at s ~ 4800, with its neck forming within 0.005 of s = 0), so the table's
