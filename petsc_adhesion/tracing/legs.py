@@ -161,7 +161,7 @@ def stable_pieces(lam, F, stable, K: float, jump_in: list[Turn], jump_off: list[
             cols = [np.r_[v, a] for a, v in zip(cols, (start.lam, start.Z(K), start.F, start.contact_radius))]
         if end is not None:
             cols = [np.r_[a, v] for a, v in zip(cols, (end.lam, end.Z(K), end.F, end.contact_radius))]
-        pieces.append(Piece(*cols, start=start, end=end))
+        pieces.append(Piece(cols[0], cols[1], cols[2], cols[3], start, end))
     if not pieces:
         raise ValueError("the branch has no state stable behind the spring")
     notes = [f"{len(ts) - len(used[kind])} {kind} inside one step of the curve left out (a hysteresis loop "
