@@ -39,10 +39,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .curve import Branch, Event
+from .curve import Branch
 
 __all__ = ["APPROACH", "RETRACT", "LEGS", "State", "Turn", "Piece", "Leg", "InstrumentCurve", "turn_of",
-           "stable_pieces", "branch_pieces", "landing_piece", "chain", "instrument_curve", "event_value", "figure_step", "FIGURE_STEPS", "TRIGGER_FACTOR"]
+           "stable_pieces", "branch_pieces", "landing_piece", "chain", "instrument_curve", "figure_step",
+           "FIGURE_STEPS", "TRIGGER_FACTOR"]
 
 APPROACH, RETRACT = "approach", "retract"
 LEGS = (APPROACH, RETRACT)
@@ -61,12 +62,9 @@ def figure_step(trigger: float, pull_off: float) -> float:
     return span / (FIGURE_STEPS * max(1.0, abs(float(trigger))))
 
 
-def event_value(e, key: str, K: float | None = None) -> float:
-    """An event's (or a landing's) ``key`` on its grid (its best value when it has none): lam, F,
-    contact_radius (NaN where it has none), or Z = lam + F / K."""
-    if key == "Z":
-        assert K is not None, "Z = lam + F / K is asked with the spring's K"
-        return event_value(e, "lam") + event_value(e, "F") / K
+def _grid_value(e, key: str) -> float:
+    """An event's (or a landing's) ``key`` on its grid (its best value when it has none): lam, F or
+    contact_radius (NaN where it has none)."""
     m = getattr(e, key)                 # a Measured, or None (a contact radius not computed)
     if m is None:
         return float("nan")
@@ -98,7 +96,7 @@ def turn_of(event) -> Turn:
     """A jump_in or jump_off event (or a landing) as the turning point the legs read: its values on its grid,
     and its landing's where the library found one."""
     land = getattr(event, "landing", None)
-    return Turn(event_value(event, "lam"), event_value(event, "F"), event_value(event, "contact_radius"),
+    return Turn(_grid_value(event, "lam"), _grid_value(event, "F"), _grid_value(event, "contact_radius"),
                 None if land is None else turn_of(land))
 
 
