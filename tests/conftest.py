@@ -39,6 +39,26 @@ def run_cli(*args, np=1, cwd=None, timeout=600):
     return subprocess.run(cmd, cwd=cwd or ROOT, env=_env(), capture_output=True, text=True, timeout=timeout)
 
 
+def drawn_figure(path):
+    """The first figure the plot of the result file ``path`` makes (``io/plot/curve.py``'s ``curve_figure``,
+    drawn to nowhere), for a test to read its panels."""
+    from petsc_adhesion.io.plot import curve as plot_curve
+
+    made = []
+    real = plot_curve.figure
+
+    def keep(**kw):
+        made.append(real(**kw))
+        return made[-1]
+
+    plot_curve.figure = keep
+    try:
+        plot_curve.curve_figure(str(path), os.devnull)
+    finally:
+        plot_curve.figure = real
+    return made[0]
+
+
 @pytest.fixture
 def cli():
     return run_cli

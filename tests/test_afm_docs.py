@@ -10,28 +10,15 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from conftest import ROOT, run_cli
+from conftest import ROOT, drawn_figure, run_cli
 
 matplotlib.use("Agg")
 
 
 def _panels(path):
     """The labels of every panel of the figure of a result file (x label | y label, secondary axes too)."""
-    from petsc_adhesion.io.plot import curve as plot_curve
-
-    made = []
-    real = plot_curve.figure
-
-    def keep(**kw):
-        made.append(real(**kw))
-        return made[-1]
-
-    plot_curve.figure = keep
-    try:
-        plot_curve.curve_figure(str(path), os.devnull)
-    finally:
-        plot_curve.figure = real
-    return [" ".join(a.get_xlabel() + "|" + a.get_ylabel() for a in [ax, *ax.child_axes]) for ax in made[0].axes]
+    return [" ".join(a.get_xlabel() + "|" + a.get_ylabel() for a in [ax, *ax.child_axes])
+            for ax in drawn_figure(path).axes]
 
 
 def test_the_plot_of_a_spring_run_has_its_force_distance_and_contact_panels(tmp_path):

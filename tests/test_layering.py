@@ -22,10 +22,11 @@ ALLOWED = {
     "model": set(),
     "discretization": {"core", "model"},
     "tracing": {"core", "model", "discretization"},
+    "family": {"core", "model", "discretization", "tracing"},
     "io": {"model", "tracing"},
-    "fitting": {"core", "model", "discretization", "tracing"},
-    "app": {"core", "model", "discretization", "tracing", "io", "fitting"},
-    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app", "fitting"},
+    "fitting": {"core", "model", "discretization", "tracing", "family"},
+    "app": {"core", "model", "discretization", "tracing", "io", "fitting", "family"},
+    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app", "fitting", "family"},
 }
 
 

@@ -15,7 +15,7 @@ import matplotlib
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import drawn_figure, run_cli
 
 h5py = pytest.importorskip("h5py")
 matplotlib.use("Agg")
@@ -184,21 +184,7 @@ def test_the_figure_is_force_in_nn_against_piezo_in_nm(tip):
     """The figure drawn from the file: its main panel force (nN) against piezo displacement (nm), approach and
     retract in two colours, the jumps, the pull-off and the energy labelled; the rigid machine's and the contact
     radius's panels beside it."""
-    from petsc_adhesion.io.plot import curve as plot_curve
-
-    made = []
-    real = plot_curve.figure
-
-    def keep(**kw):
-        made.append(real(**kw))
-        return made[-1]
-
-    plot_curve.figure = keep
-    try:
-        plot_curve.curve_figure(str(tip / "t.h5"), os.devnull)
-    finally:
-        plot_curve.figure = real
-    axes = made[0].axes
+    axes = drawn_figure(tip / "t.h5").axes
     main = next(ax for ax in axes if ax.get_xlabel() == "piezo displacement Z (nm)")
     assert main.get_ylabel() == "force (nN)"
     labels = main.get_legend_handles_labels()[1]
@@ -244,3 +230,29 @@ def test_a_trigger_in_newtons(tmp_path):
     assert force_nN == pytest.approx(unit / 1e-9, rel=1e-12)
     step = (trigger + 1.0) / 50
     assert trigger <= last <= trigger + step
+
+
+def test_a_piece_between_two_turning_points_has_them_at_its_ends_from_arrays_or_a_branch():
+    """Three stable runs on a made-up branch (lambda = 0..11, F = 0, K = 1): the middle piece starts at its
+    jump_off and ends at its jump_in, lambda growing along it (the turning points are where its run is left);
+    the same pieces whether made from the arrays and Turns or from a traced-branch-like object and its events."""
+    from types import SimpleNamespace as NS
+
+    from petsc_adhesion.tracing.legs import Turn, branch_pieces, stable_pieces
+
+    lam, F = np.arange(12.0), np.zeros(12)
+    stable = np.array([1, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1, 1], dtype=bool)
+    turns = {"jump_in": [Turn(2.5, 0.0), Turn(7.5, 0.0)], "jump_off": [Turn(3.5, 0.0), Turn(8.5, 0.0)]}
+    pieces, notes = stable_pieces(lam, F, stable, 1.0, turns["jump_in"], turns["jump_off"])
+    assert notes == []
+    assert [p.lam.tolist() for p in pieces] == [[0, 1, 2, 2.5], [3.5, 4, 5, 6, 7, 7.5], [8.5, 9, 10, 11]]
+    assert [(p.start is not None, p.end is not None) for p in pieces] == [(False, True), (True, True), (True, False)]
+
+    def event(kind, t):
+        value = (lambda v: NS(value=v, grid=v, err=None))
+        return NS(kind=kind, lam=value(t.lam), F=value(t.F), contact_radius=None, landing=None)
+
+    branch = NS(lam=lam, F=F, contact_radius=np.full(12, np.nan), stable_spring=stable)
+    again, _ = branch_pieces(branch, [event(k, t) for k, ts in turns.items() for t in ts], 1.0)
+    assert [p.lam.tolist() for p in again] == [p.lam.tolist() for p in pieces]
+    assert all(np.array_equal(a.Z, p.Z) for a, p in zip(again, pieces))

@@ -21,9 +21,14 @@ The legs hold the solver's points and nothing else: the traced points, the
 turning points and their landings at their values on the grid the curve was
 traced on (the best values and bars are the events'); no point is drawn between
 them, so a leg is as fine as the continuation's steps (which a run with a trigger
-bounds by the trigger's range, :func:`figure_step`).  The fit's forward model
-(:mod:`petsc_adhesion.fitting.forward`) builds its F(Z) on the same pieces, landings
-and chains (:func:`stable_pieces`, :func:`landing_piece`, :func:`chain`).
+bounds by the trigger's range, :func:`figure_step`).
+
+The pieces, the pieces their jumps land on and the chains each leg follows are
+made from arrays and turning points (:func:`stable_pieces` of a branch's
+lambda, F and stability and its :class:`Turn` s, :func:`landing_piece`,
+:func:`chain`): one construction for the traced branch (:func:`branch_pieces`,
+the legs here), and for the splines of :mod:`petsc_adhesion.family.legs`, which
+predict F(Z) for the fit's forward model and the family table's curves.
 
 Pieces narrower than one step of the curve (a fold pair inside one step) have no
 traced point of their own: their turning points are left out with a note.
@@ -34,10 +39,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .curve import Branch, Event
+from .curve import Branch
 
-__all__ = ["APPROACH", "RETRACT", "LEGS", "Piece", "Leg", "InstrumentCurve", "stable_pieces", "landing_piece",
-           "chain", "instrument_curve", "event_value", "figure_step", "FIGURE_STEPS", "TRIGGER_FACTOR"]
+__all__ = ["APPROACH", "RETRACT", "LEGS", "State", "Turn", "Piece", "Leg", "InstrumentCurve", "turn_of",
+           "stable_pieces", "branch_pieces", "landing_piece", "chain", "instrument_curve", "figure_step",
+           "FIGURE_STEPS", "TRIGGER_FACTOR"]
 
 APPROACH, RETRACT = "approach", "retract"
 LEGS = (APPROACH, RETRACT)
@@ -56,12 +62,9 @@ def figure_step(trigger: float, pull_off: float) -> float:
     return span / (FIGURE_STEPS * max(1.0, abs(float(trigger))))
 
 
-def event_value(e, key: str, K: float | None = None) -> float:
-    """An event's (or a landing's) ``key`` on its grid (its best value when it has none): lam, F,
-    contact_radius (NaN where it has none), or Z = lam + F / K."""
-    if key == "Z":
-        assert K is not None, "Z = lam + F / K is asked with the spring's K"
-        return event_value(e, "lam") + event_value(e, "F") / K
+def _grid_value(e, key: str) -> float:
+    """An event's (or a landing's) ``key`` on its grid (its best value when it has none): lam, F or
+    contact_radius (NaN where it has none)."""
     m = getattr(e, key)                 # a Measured, or None (a contact radius not computed)
     if m is None:
         return float("nan")
@@ -69,17 +72,46 @@ def event_value(e, key: str, K: float | None = None) -> float:
 
 
 @dataclass(frozen=True)
+class State:
+    """One state of a branch as the legs read it: its ``lam``, ``F`` and ``contact_radius`` (NaN: none)."""
+
+    lam: float
+    F: float
+    contact_radius: float = float("nan")
+
+    def Z(self, K: float) -> float:
+        """The base position behind a spring of stiffness ``K``: Z = lambda + F / K."""
+        return self.lam + self.F / K
+
+
+@dataclass(frozen=True)
+class Turn(State):
+    """A turning point of Z = lambda + F / K (a jump_in or a jump_off) and the ``landing``, the state its jump
+    lands on (None: not known; the next piece holding its Z is taken)."""
+
+    landing: State | None = None
+
+
+def turn_of(event) -> Turn:
+    """A jump_in or jump_off event (or a landing) as the turning point the legs read: its values on its grid,
+    and its landing's where the library found one."""
+    land = getattr(event, "landing", None)
+    return Turn(_grid_value(event, "lam"), _grid_value(event, "F"), _grid_value(event, "contact_radius"),
+                None if land is None else turn_of(land))
+
+
+@dataclass(frozen=True)
 class Piece:
-    """One piece stable behind the spring: its traced points in order (lambda and Z growing), the turning
-    point it starts at (``start``, a jump_off) and ends at (``end``, a
-    jump_in) put at its ends at their grid values, None where the piece starts or ends with the curve."""
+    """One piece stable behind the spring: its points in order (lambda and Z growing), the turning point it
+    starts at (``start``, a jump_off) and ends at (``end``, a jump_in) put at its ends, None where the piece
+    starts or ends with the branch."""
 
     lam: np.ndarray = field(repr=False)
     Z: np.ndarray = field(repr=False)
     F: np.ndarray = field(repr=False)
     contact_radius: np.ndarray = field(repr=False)
-    start: Event | None = None
-    end: Event | None = None
+    start: Turn | None = None
+    end: Turn | None = None
 
     @property
     def Z_lo(self) -> float:
@@ -92,69 +124,66 @@ class Piece:
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """The maximal runs [i0, i1] of True in ``mask``."""
-    out, i, n = [], 0, mask.size
-    while i < n:
-        if mask[i]:
-            j = i
-            while j + 1 < n and mask[j + 1]:
-                j += 1
-            out.append((i, j))
-            i = j + 1
-        else:
-            i += 1
-    return out
+    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
+    return list(zip(np.flatnonzero(edges == 1).tolist(), (np.flatnonzero(edges == -1) - 1).tolist()))
 
 
-def _match(events: list, used: set, lam: float, Z: float, K: float):
-    """The turning point (of ``events``, not yet used) nearest to the end (lam, Z) of a run."""
-    best = min((e for e in events if id(e) not in used),
-               key=lambda e: abs(event_value(e, "lam") - lam) + abs(event_value(e, "Z", K) - Z), default=None)
-    if best is not None:
-        used.add(id(best))
-    return best
+def _match(turns: list[Turn], used: set, lam: float, Z: float, K: float) -> Turn | None:
+    """The turning point (of ``turns``, not yet used) nearest to the end (lam, Z) of a run."""
+    free = [i for i in range(len(turns)) if i not in used]
+    if not free:
+        return None
+    best = min(free, key=lambda i: abs(turns[i].lam - lam) + abs(turns[i].Z(K) - Z))
+    used.add(best)
+    return turns[best]
 
 
-def stable_pieces(branch: Branch, jumps, K: float) -> tuple[list[Piece], list[str]]:
-    """The pieces of ``branch`` stable behind the spring of stiffness ``K``, each with the turning points of
-    ``jumps`` (jump_in and jump_off events) at its ends, and notes on the turning points no piece ends at
-    (ValueError when no point is stable)."""
-    lam, Z, F = (np.asarray(a, dtype=float) for a in (branch.lam, branch.Z, branch.F))
-    radius = np.asarray(branch.contact_radius, dtype=float)
-    stable = np.asarray(branch.stable_spring, dtype=bool)
-    events = {k: [e for e in jumps if e.kind == k] for k in ("jump_in", "jump_off")}
-    used: set[int] = set()
+def stable_pieces(lam, F, stable, K: float, jump_in: list[Turn], jump_off: list[Turn],
+                  contact_radius=None) -> tuple[list[Piece], list[str]]:
+    """The pieces of a branch (its points' ``lam``, ``F``, ``contact_radius`` (None: not known) in its order,
+    ``stable``: dZ/ds > 0 at each behind the spring of stiffness ``K``), each with the turning points of
+    ``jump_in`` and ``jump_off`` at its ends, and notes on the turning points no piece ends at (ValueError when
+    no point is stable)."""
+    lam, F = np.asarray(lam, dtype=float), np.asarray(F, dtype=float)
+    Z = lam + F / K
+    radius = np.full_like(lam, np.nan) if contact_radius is None else np.asarray(contact_radius, dtype=float)
+    turns = {"jump_in": list(jump_in), "jump_off": list(jump_off)}
+    used: dict[str, set[int]] = {k: set() for k in turns}
     pieces = []
-    for i0, i1 in _runs(stable):
+    for i0, i1 in _runs(np.asarray(stable, dtype=bool)):
         keep = slice(i0, i1 + 1)
-        pl, pz, pf, pr = lam[keep], Z[keep], F[keep], radius[keep]
-        start = _match(events["jump_off"], used, pl[0], pz[0], K) if i0 > 0 else None
-        end = _match(events["jump_in"], used, pl[-1], pz[-1], K) if i1 < lam.size - 1 else None
-        for e, at in ((start, 0), (end, pl.size)):
-            if e is not None:
-                pl, pz, pf, pr = (np.insert(a, at, event_value(e, k, K))
-                                  for a, k in ((pl, "lam"), (pz, "Z"), (pf, "F"), (pr, "contact_radius")))
-        pieces.append(Piece(pl, pz, pf, pr, start, end))
+        cols = [lam[keep], Z[keep], F[keep], radius[keep]]
+        start = _match(turns["jump_off"], used["jump_off"], cols[0][0], cols[1][0], K) if i0 > 0 else None
+        end = _match(turns["jump_in"], used["jump_in"], cols[0][-1], cols[1][-1], K) if i1 < lam.size - 1 else None
+        if start is not None:
+            cols = [np.r_[v, a] for a, v in zip(cols, (start.lam, start.Z(K), start.F, start.contact_radius))]
+        if end is not None:
+            cols = [np.r_[a, v] for a, v in zip(cols, (end.lam, end.Z(K), end.F, end.contact_radius))]
+        pieces.append(Piece(cols[0], cols[1], cols[2], cols[3], start, end))
     if not pieces:
-        raise ValueError("the traced curve has no state stable behind the spring")
-    notes = []
-    for kind, evs in events.items():
-        left = [e for e in evs if id(e) not in used]
-        if left:
-            notes.append(f"{len(left)} {kind} inside one step of the curve left out (a hysteresis loop narrower "
-                         f"than a step)")
+        raise ValueError("the branch has no state stable behind the spring")
+    notes = [f"{len(ts) - len(used[kind])} {kind} inside one step of the curve left out (a hysteresis loop "
+             f"narrower than a step)" for kind, ts in turns.items() if len(ts) > len(used[kind])]
     return pieces, notes
 
 
-def landing_piece(pieces, i: int, event, step: int, K: float) -> int | None:
+def branch_pieces(branch: Branch, jumps, K: float) -> tuple[list[Piece], list[str]]:
+    """:func:`stable_pieces` of a traced ``branch`` behind the spring of stiffness ``K`` and its turning points
+    ``jumps`` (the jump_in and jump_off events, with their landings)."""
+    turns = {k: [turn_of(e) for e in jumps if e.kind == k] for k in ("jump_in", "jump_off")}
+    return stable_pieces(branch.lam, branch.F, branch.stable_spring, K, turns["jump_in"], turns["jump_off"],
+                         branch.contact_radius)
+
+
+def landing_piece(pieces, i: int, turn: Turn, step: int, K: float) -> int | None:
     """The index of the piece (of ``pieces``: anything with ``lam`` and ``Z`` arrays, Z non-decreasing) the
-    jump of ``event`` at an end of piece ``i`` lands on, in the direction ``step`` (+1 a jump_in, -1 a
-    jump_off): the one holding the library's landing, else the next that holds the jump's Z (the last, or
-    the first, holding any Z beyond it); None where none does."""
-    Zf = event_value(event, "Z", K)
-    land = event.landing
+    jump of ``turn`` at an end of piece ``i`` lands on, in the direction ``step`` (+1 a jump_in, -1 a
+    jump_off): the one holding its landing, else the next that holds the jump's Z (the last, or the first,
+    holding any Z beyond it); None where none does."""
+    Zf = turn.Z(K)
     others = range(i + step, len(pieces) if step > 0 else -1, step)
-    if land is not None:
-        lam_l = event_value(land, "lam")
+    if turn.landing is not None:
+        lam_l = turn.landing.lam
         for j in others:
             p = pieces[j]
             span = max(p.lam[-1] - p.lam[0], 1.0)
@@ -239,15 +268,15 @@ class InstrumentCurve:
         return float(abs(np.sum((Z[1:] - Z[:-1]) * (F[1:] + F[:-1])) / 2.0))
 
 
-def _landing_point(pieces, j: int, event, K: float, notes: list) -> tuple:
-    """(Z, F, lam, contact radius) where the jump of ``event`` lands on piece ``j``: the library's landing at
-    its grid values, else (none found) the piece's traced points interpolated at the jump's Z, said in a note."""
-    Zf = event_value(event, "Z", K)
-    land = event.landing
+def _landing_point(pieces, j: int, turn: Turn, kind: str, K: float, notes: list) -> tuple:
+    """(Z, F, lam, contact radius) where the jump of ``turn`` (a ``kind``) lands on piece ``j``: its landing at
+    its grid values, else (none found) the piece's points interpolated at the jump's Z, said in a note."""
+    Zf = turn.Z(K)
+    land = turn.landing
     if land is not None:
-        return Zf, event_value(land, "F"), event_value(land, "lam"), event_value(land, "contact_radius")
+        return Zf, land.F, land.lam, land.contact_radius
     p = pieces[j]
-    notes.append(f"the {event.kind} at Z = {Zf:.6g} has no landing located by the solver: its landing is "
+    notes.append(f"the {kind} at Z = {Zf:.6g} has no landing located by the solver: its landing is "
                  f"interpolated between the traced points")
     return Zf, float(np.interp(Zf, p.Z, p.F)), float(np.interp(Zf, p.Z, p.lam)), float("nan")
 
@@ -268,8 +297,8 @@ def _leg(name: str, pieces, order: list[int], step: int, K: float, notes: list) 
         for c, a in zip(cols, (p.Z, p.F, p.lam, p.contact_radius)):
             c.extend(float(v) for v in a[idx])
         if k + 1 < len(order):           # it leaves at the turning point its last point is (put there)
-            fold = p.end if step > 0 else p.start
-            entry = _landing_point(pieces, order[k + 1], fold, K, notes)
+            fold, kind = (p.end, "jump_in") if step > 0 else (p.start, "jump_off")
+            entry = _landing_point(pieces, order[k + 1], fold, kind, K, notes)
     Z, F, lam, radius = (np.array(c, dtype=float) for c in cols)
     return Leg(name, K, Z, F, lam, radius, tuple(jumps))
 
@@ -278,16 +307,15 @@ def instrument_curve(branch: Branch, jumps, K: float, trigger: float | None) -> 
     """The :class:`InstrumentCurve` of a branch traced behind a spring of stiffness ``K``, its turning points
     ``jumps`` (the jump_in and jump_off events, with their landings) and the load ``trigger`` it was traced to
     (None: no stop load).  ValueError when no point is stable behind the spring."""
-    pieces, notes = stable_pieces(branch, jumps, K)
+    pieces, notes = branch_pieces(branch, jumps, K)
     ends = [landing_piece(pieces, i, p.end, +1, K) if p.end is not None else None for i, p in enumerate(pieces)]
     starts = [landing_piece(pieces, i, p.start, -1, K) if p.start is not None else None
               for i, p in enumerate(pieces)]
-    for links, what in ((ends, "end"), (starts, "start")):
+    for links, what, kind in ((ends, "end", "jump_in"), (starts, "start", "jump_off")):
         for i, p in enumerate(pieces):
-            e = getattr(p, what)
-            if e is not None and links[i] is None:
-                notes.append(f"the {e.kind} at Z = {event_value(e, 'Z', K):.6g} lands on no traced piece: the leg "
-                             f"ends there")
+            t = getattr(p, what)
+            if t is not None and links[i] is None:
+                notes.append(f"the {kind} at Z = {t.Z(K):.6g} lands on no traced piece: the leg ends there")
     up, _ = chain(pieces, ends, 0, +1)
     down, _ = chain(pieces, starts, len(pieces) - 1, -1)
     approach = _leg(APPROACH, pieces, up, +1, K, notes)

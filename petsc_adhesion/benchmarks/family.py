@@ -1,0 +1,275 @@
+"""The curve family table: built, its interpolation error measured against the solver, its speed (docs/family.md).
+
+    OPENBLAS_NUM_THREADS=1 mpiexec -n 2 python -m petsc_adhesion.benchmarks.family build --out family.npz \\
+        [--mu 1e-3 1e3] [--per-decade 4] [--sigma 0 0.05 ... 3] [--n-tau 300] [--springs 0.02 0.5 10]
+    OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.benchmarks.family speed family.npz [--repeats 20]
+
+``build`` traces the nodes (:func:`~petsc_adhesion.family.build.build`, spread over the
+ranks), then the error: at the centre of every cell of the grid (in ln mu and sigma;
+the midpoints in ln mu when the table has one sigma) the solver's curve and the table's
+are compared (the midpoints spread over the ranks too):
+
+- the events of a rigid machine: snap-on and snap-off (each of the solver's matched to
+  the table's nearest of its kind; a pair the other lacks counts as its own width) and
+  the pull-off, in lambda and F (their values on the solver's grid);
+- behind each spring of ``--springs`` (units 2 pi R w / epsilon): the solver's curve
+  traced behind it (:class:`~petsc_adhesion.fitting.forward.ForwardCurve`) against the
+  table's legs (:meth:`~petsc_adhesion.family.table.FamilyCurve.behind`): F at the
+  solver's own points on the pieces each leg follows (its computed states, no
+  interpolation on its side) up to where the table ends (F_max), leaving out the Z within
+  twice the jumps' error of a jump of either (there a vertical jump makes any difference
+  in Z one of O(1) in F); the jumps' Z and the force at their turning points (the
+  library's located events).
+
+The table is written with these errors (``FamilyTable.with_error``), all or nothing, and
+the report gives the cost per node and the error per midpoint.  ``speed`` times what a
+fit will call per evaluation: the interpolated curve at (mu, sigma), behind a spring, F at
+500 base positions on both legs (median of ``--repeats``).  A benchmark is a measurement,
+not a test: the machine's load is printed with it.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+from ..errors import say
+from ..family.build import F_MAX, TableGrid, build, log_nodes, node_cost, regrid_points, spread, trace_node
+from ..family.table import APPROACH, ERROR_FIELDS, RETRACT, FamilyTable, OutOfRange
+
+#: The springs the error is measured behind (units 2 pi R w / epsilon): soft (jumps far out, the rigid
+#: sphere's law), middling, stiff (the legs follow the curve's folds).
+SPRINGS = (0.02, 0.5, 10.0)
+#: The default sigma nodes: 0.05 apart up to 0.5, where the pull-off falls fastest (docs/family.md measures the
+#: error of 0.1 against 0.05 apart there), then 0.1 to 1 and 0.25 to 3.
+SIGMA_NODES = tuple(np.round(np.r_[np.arange(0.0, 0.5, 0.05), np.arange(0.5, 1.0, 0.1), np.arange(1.0, 3.01, 0.25)], 10))
+
+
+def midpoints(table: FamilyTable) -> list[tuple[float, float]]:
+    """The centres of the grid's cells in (ln mu, sigma); the midpoints in ln mu with a single sigma."""
+    lm = np.log(table.mu)
+    mids = np.exp(0.5 * (lm[1:] + lm[:-1]))
+    if table.sigma.size == 1:
+        return [(float(m), float(table.sigma[0])) for m in mids]
+    smid = 0.5 * (table.sigma[1:] + table.sigma[:-1])
+    return [(float(m), float(s)) for m in mids for s in smid]
+
+
+def _nearest(a: list[float], b: list[float]) -> float:
+    """The largest distance from an element of the longer list to the nearest of the other; 0 when both are
+    empty, inf when only one is."""
+    if not a and not b:
+        return 0.0
+    if not a or not b:
+        return math.inf
+    long, short = (a, b) if len(a) >= len(b) else (b, a)
+    return max(min(abs(x - y) for y in short) for x in long)
+
+
+def _events(table: FamilyTable, mu: float, sigma: float, solver) -> tuple[float, float]:
+    """(largest error in lambda, in F) of the snap-on, snap-off and pull-off of the table against ``solver``'s
+    traced curve."""
+    def grid(m):
+        return float(m.grid if m.grid is not None else m.value)
+
+    mine = table.curve(mu, sigma).events()
+    el = ef = 0.0
+    for kind, theirs in (("snap_on", "snap_on"), ("snap_off", "snap_off"), ("pull_off", "F_min")):
+        t = [(e.lam.value, e.F.value) for e in mine if e.kind == kind]
+        s = [(grid(e.lam), grid(e.F)) for e in solver.events if e.kind == theirs]
+        if kind == "pull_off":
+            s = [min(s, key=lambda x: x[1])] if s else []
+        if bool(t) != bool(s):
+            # a fold pair one side lacks (about the cusp where it is born): its width is the error
+            both = [(e.lam.value, e.F.value) for e in mine if e.kind in ("snap_on", "snap_off")] or \
+                [(grid(e.lam), grid(e.F)) for e in solver.events if e.kind in ("snap_on", "snap_off")]
+            lams, Fs = [x for x, _ in both], [y for _, y in both]
+            el, ef = max(el, max(lams) - min(lams)), max(ef, max(Fs) - min(Fs))
+            continue
+        for (tl, tf), (sl, sf) in _pairs(t, s):
+            el, ef = max(el, abs(tl - sl)), max(ef, abs(tf - sf))
+    return el, ef
+
+
+def _pairs(t: list, s: list) -> list:
+    """Each of the longer list's events with the other's nearest in lambda."""
+    long, short = (t, s) if len(t) >= len(s) else (s, t)
+    out = [(x, min(short, key=lambda y: abs(y[0] - x[0]))) for x in long]
+    return out if long is t else [(b, a) for a, b in out]
+
+
+def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[float, float, float]:
+    """(F at fixed Z, jump Z, jump F) errors of the table's legs behind K against the solver's."""
+    from petsc4py import PETSc
+
+    from ..discretization.problem import step_scale
+    from ..fitting.forward import ForwardCurve
+    from ..model.parameters import Model
+    from ..tracing.trace import CurveRequest, curve_settings, trace_curve
+
+    model = Model(mu=mu, sigma=sigma)
+    c = trace_curve(model, settings=curve_settings(step_scale(model), observable_max=table.F_max + 0.3),
+                    request=CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=K),
+                    comm=PETSc.COMM_SELF)
+    truth = ForwardCurve(c, K)
+    mine = table.curve(mu, sigma).behind(K)
+    b = c.branch
+    own = ~regrid_points(b)
+    lam, F = b.lam[own], b.F[own]
+    Z = lam + F / K
+    inside = Z <= mine.Z_max
+    eF = eZ = eJ = 0.0
+    for leg in (APPROACH, RETRACT):
+        js, jt = truth.jumps[leg], mine.legs.jumps[leg]
+        dz = _nearest(js, jt)
+        eZ = max(eZ, dz)
+        if math.isfinite(dz) and js:
+            fs, ft = truth.jump_forces(leg), mine.legs.jump_forces(leg)
+            for k, z in enumerate(js):
+                j = int(np.argmin([abs(z - y) for y in jt]))
+                eJ = max(eJ, abs(fs[k][0] - ft[j][0]))
+        # the solver's own points on the pieces this leg follows (no interpolation on its side), away from
+        # the jumps of either
+        piece = truth.assign(Z, leg)
+        on = inside & np.array([truth.pieces[p].lam[0] <= x <= truth.pieces[p].lam[-1] for p, x in zip(piece, lam)])
+        w = 2.0 * (dz if math.isfinite(dz) else 0.0) + 1e-9
+        for z in js + jt:
+            on &= np.abs(Z - z) > w
+        if on.any():
+            eF = max(eF, float(np.max(np.abs(F[on] - mine.predict(Z[on], leg)))))
+    return eF, eZ, eJ
+
+
+def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None) -> FamilyTable:
+    """The table with its interpolation error measured at its midpoints (module docstring); collective."""
+    from petsc4py import PETSc
+
+    def work(case):
+        mu, sigma = case
+        t0 = time.perf_counter()
+        try:
+            solver = trace_node(mu, sigma, table.F_max, PETSc.COMM_SELF)
+            el, ef = _events(table, mu, sigma, solver)
+            per_K = [_spring(table, mu, sigma, K) for K in springs]
+            row = dict(F_at_Z=max(p[0] for p in per_K), jump_Z=max(p[1] for p in per_K),
+                       jump_F=max(p[2] for p in per_K), event_lam=el, event_F=ef)
+        except (RuntimeError, ValueError) as e:
+            row = {f: math.inf for f in ERROR_FIELDS}
+            row["why"] = str(e).splitlines()[0] if str(e) else type(e).__name__
+        row["seconds"] = time.perf_counter() - t0
+        return row
+
+    cases = midpoints(table)
+    rows = spread(cases, work, lambda c: node_cost(c) * (1 + len(springs)), comm)
+    if out is not None:
+        out("| mu | sigma | F at Z | jump Z | jump F | event lambda | event F | solver (s) |")
+        out("|---|---|---|---|---|---|---|---|")
+        for (m, s), r in zip(cases, rows):
+            out(f"| {m:.4g} | {s:.3g} | " + " | ".join(f"{r[f]:.2g}" for f in ERROR_FIELDS) +
+                f" | {r['seconds']:.1f} |" + (f" {r['why']}" if "why" in r else ""))
+    return table.with_error([c[0] for c in cases], [c[1] for c in cases], springs,
+                            {f: [r[f] for r in rows] for f in ERROR_FIELDS})
+
+
+def speed(table: FamilyTable, repeats: int = 20, out=print) -> None:
+    """The time of one evaluation a fit makes: the curve at (mu, sigma), behind a spring, F at 500 Z on both
+    legs (median, min and max of ``repeats``)."""
+    out(f"load average (1 min): {os.getloadavg()[0]:.2f}")
+    out("| mu | sigma | K | curve + legs + 2 x 500 Z: median wall (min-max) ms | median CPU ms | legs' pieces |")
+    out("|---|---|---|---|---|---|")
+    lm = np.log(table.mu)
+    for mu in np.exp(np.linspace(lm[0], lm[-1], 4)):
+        for sigma in (table.sigma[0], table.sigma[-1]):
+            for K in (0.02, 10.0):
+                sc = table.curve(mu, sigma).behind(K)
+                Z = np.linspace(sc.legs.pieces[0].Z_lo - 2.0, sc.Z_max, 500)
+                times, cpu = [], []
+                for _ in range(repeats):
+                    t0, c0 = time.perf_counter(), time.process_time()
+                    sc = table.curve(mu, sigma).behind(K)
+                    sc.predict(Z, APPROACH)
+                    sc.predict(Z, RETRACT)
+                    times.append(time.perf_counter() - t0)
+                    cpu.append(time.process_time() - c0)
+                ms = 1e3 * np.array(times)
+                out(f"| {mu:.4g} | {sigma:g} | {K:g} | {np.median(ms):.2f} ({ms.min():.2f}-{ms.max():.2f}) | "
+                    f"{1e3 * np.median(cpu):.2f} | {len(sc.legs.pieces)} |")
+
+
+def _parser() -> argparse.ArgumentParser:
+    class OneLine(argparse.ArgumentParser):
+        def error(self, message):
+            say(f"benchmarks.family: {message}")
+            sys.exit(2)
+
+    p = OneLine(prog="python -m petsc_adhesion.benchmarks.family")
+    sub = p.add_subparsers(dest="command", required=True)
+    b = sub.add_parser("build")
+    b.add_argument("--out", required=True)
+    b.add_argument("--mu", nargs=2, type=float, default=(1e-3, 1e3))
+    b.add_argument("--per-decade", type=float, default=4.0)
+    b.add_argument("--sigma", nargs="+", type=float, default=list(SIGMA_NODES))
+    b.add_argument("--n-tau", type=int, default=300)
+    b.add_argument("--springs", nargs="+", type=float, default=list(SPRINGS))
+    s = sub.add_parser("speed")
+    s.add_argument("table")
+    s.add_argument("--repeats", type=int, default=20)
+    for q in (b, s):
+        q.error = p.error                                 # type: ignore[method-assign]
+    return p
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
+    if args.command == "speed":
+        try:
+            table = FamilyTable.load(args.table)
+        except ValueError as e:
+            say(str(e))
+            return 2
+        speed(table, args.repeats)
+        return 0
+    from petsc4py import PETSc
+
+    rank = PETSc.COMM_WORLD.getRank()
+    tell = print if rank == 0 else (lambda text: None)
+    try:
+        lo, hi = args.mu
+        grid = TableGrid(mu=log_nodes(lo, hi, args.per_decade) if hi > lo else (lo,), sigma=tuple(args.sigma),
+                         n_tau=args.n_tau)
+        if not (lo > 0 and hi >= lo):
+            raise ValueError(f"--mu {lo:g} {hi:g}: expected 0 < lo <= hi")
+        if not all(K > 0 and math.isfinite(K) for K in args.springs):
+            raise ValueError(f"--springs {args.springs}: expected stiffnesses > 0")
+        out_dir = os.path.dirname(os.path.abspath(args.out))
+        if not os.path.isdir(out_dir):
+            raise ValueError(f"--out {args.out}: no folder {out_dir}")
+    except ValueError as e:
+        say(f"benchmarks.family: {e}")
+        return 2
+    t0 = time.perf_counter()
+    tell(f"load average (1 min): {os.getloadavg()[0]:.2f}; {len(grid.cases)} nodes on "
+         f"{PETSc.COMM_WORLD.getSize()} ranks, F up to {F_MAX:g}")
+    try:
+        table = build(grid, comm=PETSc.COMM_WORLD, say=tell)
+    except RuntimeError as e:
+        say(f"benchmarks.family: {e}")
+        return 3
+    t1 = time.perf_counter()
+    tell(f"nodes: {t1 - t0:.1f} s wall ({np.nansum(table.seconds):.1f} s of traces)")
+    table = measure(table, tuple(args.springs), PETSc.COMM_WORLD, tell)
+    t2 = time.perf_counter()
+    tell(f"error: {t2 - t1:.1f} s wall at {table.err_mu.size} midpoints; largest {table.worst()}")
+    bad = not all(np.all(np.isfinite(v)) for v in table.errors.values())
+    if rank == 0:
+        table.save(args.out)
+        tell(f"written {args.out} ({os.path.getsize(args.out) / 1e6:.2f} MB)")
+    return 3 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

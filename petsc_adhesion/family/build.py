@@ -1,0 +1,151 @@
+"""The curve family table built: one curve traced per node of a (ln mu, sigma) grid, the nodes spread over MPI
+ranks, each curve sampled on the table's coordinate (:mod:`~petsc_adhesion.family.coordinate`).
+
+Each node is the library's default curve (:func:`~petsc_adhesion.tracing.trace.trace_curve`:
+grids that follow the contact edge, the default roughness rule, no error bars) traced
+on one rank (``PETSc.COMM_SELF``) past the table's F_max, so that its end F = F_max
+lies between two traced points.  The nodes go to the ranks the costliest first
+(the cost grows with mu: 0.1 s at mu = 1e-3, 0.7 s at mu = 1, 7 s at mu = 10, 20 s at
+mu = 100, 85 s at mu = 1000 on this machine, docs/family.md), each to the rank with
+the least work so far; rank 0 gathers them.  Collective.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..discretization.contact import edge_level
+from ..model.parameters import Model
+from ..model.pressure import pressure_law
+from .coordinate import NotMonotone, Sampled, sample, width
+from .table import FamilyTable
+
+__all__ = ["TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points", "F_MAX", "ROUGHNESS"]
+
+#: The load the table's curves end at: the library's default stop (-cont_F_max 2).
+F_MAX = 2.0
+#: The roughness rule of the table: the paper's 16-point Gauss-Hermite average (eq. 14), the model's default.
+ROUGHNESS = "hermite"
+#: How far past F_max a node's curve is traced (its end lies between two points).
+_PAST = 0.3
+
+
+@dataclass(frozen=True)
+class TableGrid:
+    """The table's nodes: ``mu`` (increasing, > 0), ``sigma`` (increasing, >= 0) and ``n_tau``, the number of
+    nodes of the curve coordinate on each side of its centre (2 n_tau + 1 in all)."""
+
+    mu: tuple
+    sigma: tuple
+    n_tau: int = 300
+
+    def __post_init__(self):
+        mu, sigma = np.asarray(self.mu, float), np.asarray(self.sigma, float)
+        if mu.size < 1 or not np.all(np.isfinite(mu)) or np.any(mu <= 0) or np.any(np.diff(mu) <= 0):
+            raise ValueError(f"mu: expected increasing Tabor parameters > 0, got {self.mu!r}")
+        if sigma.size < 1 or not np.all(np.isfinite(sigma)) or np.any(sigma < 0) or np.any(np.diff(sigma) <= 0):
+            raise ValueError(f"sigma: expected increasing roughnesses >= 0, got {self.sigma!r}")
+        if isinstance(self.n_tau, bool) or not isinstance(self.n_tau, int) or self.n_tau < 4:
+            raise ValueError(f"n_tau: expected an integer >= 4, got {self.n_tau!r}")
+
+    @property
+    def tau(self) -> np.ndarray:
+        """The coordinate's nodes: uniform on [-1, 0] and on [0, 1], 0 shared."""
+        half = np.linspace(0.0, 1.0, self.n_tau + 1)
+        return np.r_[-half[:0:-1], half]
+
+    @property
+    def cases(self) -> list[tuple[float, float]]:
+        return [(float(m), float(s)) for m in self.mu for s in self.sigma]
+
+
+def trace_node(mu: float, sigma: float, F_max: float = F_MAX, comm=None):
+    """The default curve of (mu, sigma), no error bars, traced past ``F_max`` (a Curve; collective on comm)."""
+    from ..discretization.problem import step_scale
+    from ..tracing.trace import CurveRequest, curve_settings, trace_curve
+
+    model = Model(mu=mu, sigma=sigma, roughness=ROUGHNESS)
+    return trace_curve(model, settings=curve_settings(step_scale(model), observable_max=F_max + _PAST),
+                       request=CurveRequest(error_bars=False), comm=comm)
+
+
+def regrid_points(branch) -> np.ndarray:
+    """The points of a traced branch that repeat the state before them on a new grid (its corrector 'regrid')."""
+    return np.asarray(branch.corrector) == b"regrid"
+
+
+def _node(mu: float, sigma: float, tau: np.ndarray, F_max: float):
+    """(sampled curve or the reason it is not, seconds) of one node, on this rank alone."""
+    from petsc4py import PETSc
+
+    t0 = time.perf_counter()
+    out: Sampled | str
+    try:
+        c = trace_node(mu, sigma, F_max, PETSc.COMM_SELF)
+        if not c.complete:
+            raise ValueError(f"the curve is incomplete: {c.assessment.incomplete[0]}")
+        b = c.branch
+        out = sample(b.lam, b.F, b.H0, b.contact_radius, edge_level(pressure_law(c.model)), F_max, tau, mu,
+                     regrid_points(b))
+    except (NotMonotone, ValueError, RuntimeError) as e:     # said, not raised: the other ranks wait for it
+        out = f"mu {mu:g}, sigma {sigma:g}: {str(e).splitlines()[0] if str(e) else type(e).__name__}"
+    return out, time.perf_counter() - t0
+
+
+def spread(cases: list, work, cost, comm=None) -> list:
+    """``work(case)`` for every case, the cases spread over the ranks of ``comm`` (PETSc.COMM_WORLD), the
+    costliest first, each to the rank with the least ``cost`` so far; every rank gets the results in the
+    cases' order (collective)."""
+    from petsc4py import PETSc
+
+    mpi = (comm or PETSc.COMM_WORLD).tompi4py()
+    size, rank = mpi.Get_size(), mpi.Get_rank()
+    load = [0.0] * size
+    mine = []
+    for i in sorted(range(len(cases)), key=lambda i: -cost(cases[i])):
+        r = int(np.argmin(load))
+        load[r] += cost(cases[i])
+        if r == rank:
+            mine.append(i)
+    done = {i: work(cases[i]) for i in mine}
+    merged: dict = {}
+    for part in mpi.allgather(done):
+        merged.update(part)
+    return [merged[i] for i in range(len(cases))]
+
+
+def node_cost(case: tuple[float, float]) -> float:
+    """A node's relative cost, only to order the work: 0.1 + 0.7 mu^0.7 s, through the measured 0.7 s at mu = 1
+    and 85 s at mu = 1000 (docs/family.md)."""
+    mu = case[0]
+    return 0.1 + 0.7 * mu ** 0.7
+
+
+def build(grid: TableGrid, F_max: float = F_MAX, comm=None, say=None) -> FamilyTable:
+    """The table of ``grid``'s nodes (its error not yet measured: :meth:`FamilyTable.with_error`); RuntimeError
+    naming every node that could not be tabulated.  ``say(text)`` is told of each node as rank 0 gathers."""
+    tau = grid.tau
+    results = spread(grid.cases, lambda c: _node(c[0], c[1], tau, F_max), node_cost, comm)
+    bad = [r for r, _ in results if isinstance(r, str)]
+    if bad:
+        raise RuntimeError(f"{len(bad)} node{'s' * (len(bad) != 1)} could not be tabulated: " + "; ".join(bad))
+    shape = (len(grid.mu), len(grid.sigma))
+    pick = (lambda f: np.array([getattr(r, f) for r, _ in results]).reshape(shape + (-1,)))
+    scalar = (lambda f: np.array([getattr(r, f) for r, _ in results], float).reshape(shape))
+    if say is not None:
+        for (m, s), (_, sec) in zip(grid.cases, results):
+            say(f"mu {m:g} sigma {s:g}: {sec:.2f} s")
+    delta = np.array([width(m) for m, _ in grid.cases]).reshape(shape)
+    return FamilyTable(mu=np.asarray(grid.mu, float), sigma=np.asarray(grid.sigma, float), tau=tau,
+                       lam=pick("lam"), F=pick("F"), s_lo=scalar("s_lo"), s_hi=scalar("s_hi"), s0=scalar("s0"),
+                       delta=delta, F_max=float(F_max), roughness=f"{ROUGHNESS} {Model().hermite_points}",
+                       seconds=np.array([sec for _, sec in results]).reshape(shape))
+
+
+def log_nodes(lo: float, hi: float, per_decade: float) -> tuple:
+    """Nodes from ``lo`` to ``hi`` uniform in ln mu, ``per_decade`` intervals a decade (at least one)."""
+    n = max(int(math.ceil(per_decade * math.log10(hi / lo) - 1e-9)), 1)
+    return tuple(float(x) for x in np.geomspace(lo, hi, n + 1))

@@ -1,0 +1,323 @@
+"""The curve family table: F(lambda; mu, sigma) on a grid of (ln mu, sigma), read back and interpolated, with the
+interpolation error measured against the solver.
+
+In units of 2 pi R w and epsilon the model under the default roughness rule (the
+paper's 16-point Gauss-Hermite average, eq. 14) is a two-parameter family of curves.
+The table holds each node's curve as lambda and F at the nodes tau of the coordinate
+of :mod:`~petsc_adhesion.family.coordinate` (monotone along the whole branch, through
+its folds), from the library's start far out of reach of the forces to F = F_max.  At
+any (mu, sigma) in its range the curve is interpolated at every tau node by the cubic
+Lagrange polynomials through the four nearest nodes in ln mu and in sigma (exact at a
+node), and read as a function of tau by cubic splines: its turning points in lambda
+(snap-on, snap-off), its pull-off (the most tensile F) and, behind a spring of
+stiffness K, the legs of :func:`~petsc_adhesion.family.legs.spring_legs` (Z = lambda +
+F / K, vertical jumps).  Every value carries as its bar the interpolation error
+measured against the solver at the midpoints of the grid's cells about it
+(:class:`TableError`), which the builder writes into the file
+(``python -m petsc_adhesion.benchmarks.family``, docs/family.md).  Out of range
+(mu, sigma, a force past F_max) is refused with one line (:class:`OutOfRange`).
+
+The file: .npz with its format name and version, the program's version, the grid it
+was made on and the measured error; written all together or not at all.
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..tracing.measured import Measured, Missing
+from ..version import __version__
+from .legs import APPROACH, RETRACT, Legs, spring_legs
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "OutOfRange", "TableError", "FamilyTable", "FamilyCurve", "SpringCurve",
+           "TableEvent", "lagrange"]
+
+FORMAT = "petsc-adhesion curve family"
+FORMAT_VERSION = 1
+#: What the error stated about a point is of the largest measured at the cell centres about it: the error varies
+#: within a cell, and at a third of the way across the first cell of a small table (mu 0.126, sigma 0.017) the
+#: pull-off's was 1.4 times the largest at the centres about it (docs/family.md).
+SAFETY = 2.0
+#: The fields of a TableError, as the file's arrays err_<name>.
+ERROR_FIELDS = ("F_at_Z", "jump_Z", "jump_F", "event_lam", "event_F")
+
+
+class OutOfRange(ValueError):
+    """A request outside the table's range: one line naming the quantity and the range it accepts."""
+
+
+@dataclass(frozen=True)
+class TableError:
+    """The interpolation error measured against the solver (the largest over the midpoints it summarizes):
+    ``F_at_Z``, the force at fixed base positions Z behind the springs, away from their jumps; ``jump_Z`` and
+    ``jump_F``, the base position of the springs' jumps and the force at their turning points; ``event_lam``
+    and ``event_F``, lambda and F of the snap-on, snap-off and pull-off; ``points``, how many midpoints."""
+
+    F_at_Z: float
+    jump_Z: float
+    jump_F: float
+    event_lam: float
+    event_F: float
+    points: int
+
+
+def lagrange(nodes: np.ndarray, x: float, order: int = 4) -> tuple[int, np.ndarray]:
+    """(first index, weights) of the Lagrange polynomial through the ``order`` nodes nearest to ``x`` (fewer
+    where there are fewer): a value at ``x`` is the weights' sum over those nodes' values, exactly the node's
+    own at a node."""
+    n = nodes.size
+    m = min(order, n)
+    i0 = int(np.clip(np.searchsorted(nodes, x) - m // 2, 0, n - m))
+    xs = nodes[i0:i0 + m]
+    w = np.ones(m)
+    for j in range(m):
+        for k in range(m):
+            if k != j:
+                w[j] *= (x - xs[k]) / (xs[j] - xs[k])
+    return i0, w
+
+
+@dataclass(frozen=True)
+class TableEvent:
+    """An event of an interpolated curve: ``kind`` (snap_on, snap_off, pull_off), ``lam`` and ``F`` with the
+    table's interpolation error as their bars."""
+
+    kind: str
+    lam: Measured
+    F: Measured
+
+
+@dataclass(frozen=True)
+class FamilyTable:
+    """The tabulated family (module docstring): nodes ``mu`` (increasing, interpolated in ln mu), ``sigma``
+    (increasing), ``tau`` (-1 to 1); ``lam`` and ``F`` of shape (mu, sigma, tau); each node curve's ``s_lo``,
+    ``s_hi``, ``s0`` and ``delta`` of shape (mu, sigma); the force the curves end at, ``F_max``; the roughness
+    rule; the program ``version`` that made it; the cost of each node's trace (``seconds``, wall time); the
+    measured error at the midpoints ``err_mu``, ``err_sigma`` (``errors``: one array per
+    :class:`TableError` field) behind the springs ``springs``, empty until measured."""
+
+    mu: np.ndarray
+    sigma: np.ndarray
+    tau: np.ndarray
+    lam: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)
+    s_lo: np.ndarray = field(repr=False)
+    s_hi: np.ndarray = field(repr=False)
+    s0: np.ndarray = field(repr=False)
+    delta: np.ndarray = field(repr=False)
+    F_max: float
+    roughness: str
+    version: str = __version__
+    seconds: np.ndarray | None = field(default=None, repr=False)
+    springs: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    err_mu: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    err_sigma: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    errors: dict = field(default_factory=dict, repr=False)
+
+    # -- the range and the error -------------------------------------------------------
+    def check(self, mu: float, sigma: float) -> None:
+        """OutOfRange, one line, for (mu, sigma) outside the table."""
+        for name, v, nodes in (("mu", mu, self.mu), ("sigma", sigma, self.sigma)):
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or \
+                    not math.isfinite(v) or not (nodes[0] * (1 - 1e-12) - 1e-15 <= v <= nodes[-1] * (1 + 1e-12) + 1e-15):
+                raise OutOfRange(f"{name} {v!r}: the table holds {name} in [{nodes[0]:g}, {nodes[-1]:g}]")
+
+    @property
+    def measured(self) -> bool:
+        """Whether the interpolation error was measured (the builder's second step)."""
+        return self.err_mu.size > 0
+
+    def error(self, mu: float, sigma: float) -> TableError | Missing:
+        """The interpolation error stated about (mu, sigma): SAFETY times the largest measured at the midpoints of
+        the cells about it (its cell and their neighbours, in ln mu and sigma); Missing where the table was not
+        measured."""
+        self.check(mu, sigma)
+        if not self.measured:
+            return Missing("the table's interpolation error was not measured (built without its midpoints)")
+        lm, nodes = math.log(mu), np.log(self.mu)
+        i = int(np.clip(np.searchsorted(nodes, lm), 1, max(nodes.size - 1, 1)))
+        lo_m, hi_m = nodes[max(i - 2, 0)], nodes[min(i + 1, nodes.size - 1)]
+        j = int(np.clip(np.searchsorted(self.sigma, sigma), 1, max(self.sigma.size - 1, 1)))
+        lo_s, hi_s = self.sigma[max(j - 2, 0)], self.sigma[min(j + 1, self.sigma.size - 1)]
+        em = np.log(self.err_mu)
+        near = (em >= lo_m - 1e-12) & (em <= hi_m + 1e-12) & (self.err_sigma >= lo_s - 1e-12) & \
+            (self.err_sigma <= hi_s + 1e-12)
+        if not near.any():
+            near = np.ones(em.size, bool)
+        return TableError(**{f: SAFETY * float(np.max(self.errors[f][near])) for f in ERROR_FIELDS},
+                          points=int(near.sum()))
+
+    def worst(self) -> TableError | Missing:
+        """The largest interpolation error measured over the whole table (as measured, without SAFETY)."""
+        if not self.measured:
+            return Missing("the table's interpolation error was not measured (built without its midpoints)")
+        return TableError(**{f: float(np.max(self.errors[f])) for f in ERROR_FIELDS}, points=int(self.err_mu.size))
+
+    def with_error(self, mu: np.ndarray, sigma: np.ndarray, springs, errors: dict) -> FamilyTable:
+        """This table with the error measured at the midpoints (``mu``, ``sigma``): ``errors`` one array per
+        :class:`TableError` field, behind the ``springs``."""
+        missing = set(ERROR_FIELDS) - set(errors)
+        if missing:
+            raise ValueError(f"errors: expected the fields {', '.join(ERROR_FIELDS)}; missing {', '.join(sorted(missing))}")
+        return replace(self, err_mu=np.asarray(mu, float), err_sigma=np.asarray(sigma, float),
+                       springs=np.asarray(springs, float),
+                       errors={f: np.asarray(errors[f], float) for f in ERROR_FIELDS})
+
+    # -- a curve -----------------------------------------------------------------------
+    def curve(self, mu: float, sigma: float) -> FamilyCurve:
+        """The interpolated curve at (mu, sigma): lambda and F at the nodes tau (OutOfRange outside the table)."""
+        self.check(mu, sigma)
+        i0, wm = lagrange(np.log(self.mu), math.log(mu))
+        j0, ws = lagrange(self.sigma, float(sigma))
+        w = wm[:, None] * ws[None, :]
+        block = (slice(i0, i0 + wm.size), slice(j0, j0 + ws.size))
+        lam = np.tensordot(w, self.lam[block], axes=([0, 1], [0, 1]))
+        F = np.tensordot(w, self.F[block], axes=([0, 1], [0, 1]))
+        return FamilyCurve(float(mu), float(sigma), self.tau, lam, F, self.F_max, self.error(mu, sigma))
+
+    # -- the file ----------------------------------------------------------------------
+    def save(self, path: str) -> None:
+        """Write the table to ``path`` (.npz), all or nothing: a temporary file beside it, renamed over it."""
+        arrays = dict(format=np.array(FORMAT), format_version=np.array(FORMAT_VERSION),
+                      program_version=np.array(self.version), roughness=np.array(self.roughness),
+                      F_max=np.array(self.F_max), mu=self.mu, sigma=self.sigma, tau=self.tau, lam=self.lam,
+                      F=self.F, s_lo=self.s_lo, s_hi=self.s_hi, s0=self.s0, delta=self.delta,
+                      seconds=np.full(self.s_lo.shape, np.nan) if self.seconds is None else self.seconds,
+                      springs=self.springs, err_mu=self.err_mu, err_sigma=self.err_sigma,
+                      **{f"err_{f}": self.errors.get(f, np.zeros(0)) for f in ERROR_FIELDS})
+        tmp = f"{path}.part{os.getpid()}.npz"
+        try:
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, **arrays)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+
+    @classmethod
+    def load(cls, path: str) -> FamilyTable:
+        """The table in ``path``; ValueError, one line, for a file that is no table of this format version."""
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                d = {k: z[k] for k in z.files}
+        except (OSError, ValueError, EOFError) as e:
+            raise ValueError(f"{path}: not a curve family table ({str(e).splitlines()[0] if str(e) else type(e).__name__})") from None
+        if str(d.get("format", "")) != FORMAT:
+            raise ValueError(f"{path}: not a curve family table (no format '{FORMAT}')")
+        if int(d["format_version"]) != FORMAT_VERSION:
+            raise ValueError(f"{path}: a curve family table of format version {int(d['format_version'])}; this "
+                             f"program reads version {FORMAT_VERSION} (rebuild it)")
+        errors = {f: d[f"err_{f}"] for f in ERROR_FIELDS} if d["err_mu"].size else {}
+        return cls(mu=d["mu"], sigma=d["sigma"], tau=d["tau"], lam=d["lam"], F=d["F"], s_lo=d["s_lo"],
+                   s_hi=d["s_hi"], s0=d["s0"], delta=d["delta"], F_max=float(d["F_max"]),
+                   roughness=str(d["roughness"]), version=str(d["program_version"]), seconds=d["seconds"],
+                   springs=d["springs"], err_mu=d["err_mu"], err_sigma=d["err_sigma"], errors=errors)
+
+
+@dataclass(frozen=True)
+class FamilyCurve:
+    """One interpolated curve: ``lam`` and ``F`` at the nodes ``tau``, ending at F = ``F_max``; ``error`` the
+    table's measured interpolation error about it (a :class:`TableError`, or Missing)."""
+
+    mu: float
+    sigma: float
+    tau: np.ndarray = field(repr=False)
+    lam: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)
+    F_max: float
+    error: TableError | Missing = field(repr=False)
+
+    def _bar(self, name: str) -> tuple[float | None, str | None]:
+        if isinstance(self.error, TableError):
+            return getattr(self.error, name), None
+        return None, self.error.reason
+
+    def events(self) -> tuple[TableEvent, ...]:
+        """The turning points of lambda along tau (snap_on where lambda is largest, snap_off where smallest,
+        in their order) and the pull-off (the most tensile F), each with the table's error as its bars."""
+        from scipy.interpolate import CubicSpline
+
+        L, G = CubicSpline(self.tau, self.lam), CubicSpline(self.tau, self.F)
+        roots = np.asarray(L.derivative().roots(extrapolate=False), dtype=float)
+        curv = L.derivative(2)(roots)
+        el, note = self._bar("event_lam")
+        ef, _ = self._bar("event_F")
+        out = [TableEvent("snap_on" if c < 0 else "snap_off", Measured(float(L(r)), el, note=note),
+                          Measured(float(G(r)), ef, note=note)) for r, c in zip(roots, curv) if c != 0]
+        dG = np.asarray(G.derivative().roots(extrapolate=False), dtype=float)
+        cand = np.r_[dG, self.tau[np.argmin(self.F)]]
+        r = cand[int(np.argmin(G(cand)))]
+        out.append(TableEvent("pull_off", Measured(float(L(r)), el, note=note), Measured(float(G(r)), ef, note=note)))
+        return tuple(out)
+
+    def behind(self, K: float) -> SpringCurve:
+        """The curve behind a spring of stiffness ``K`` (units 2 pi R w / epsilon): its approach and retract.
+
+        The table's curves start where the library's do, out of reach of the forces; behind a spring softer
+        than the forces' gradient there, the approach jumps in before that start, so the far branch is
+        continued out to beyond the spring's start (:func:`~petsc_adhesion.tracing.trace.spring_start`) by the
+        rigid sphere's load (eq. 28) matched to the curve at its start, as
+        :class:`~petsc_adhesion.family.legs.Legs` continues it below a branch's start."""
+        if isinstance(K, bool) or not isinstance(K, (int, float, np.integer, np.floating)) or \
+                not (math.isfinite(K) and K > 0):
+            raise OutOfRange(f"K {K!r}: expected a spring stiffness, a finite real > 0")
+        t, lam, F = self._far(float(K))
+        return SpringCurve(self, float(K), spring_legs(t, lam, F, float(K)))
+
+    def _far(self, K: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(coordinate, lambda, F) of the curve with its far branch continued out to beyond the spring's start:
+        points uniform in ln(1 - lambda) at tau < -1, their coordinate matched to the curve's rate at its start
+        (so that the splines in it do not ring at the seam)."""
+        from ..model.reference.rigid import rigid_load
+        from ..tracing.trace import spring_start
+
+        lam0, F0 = float(self.lam[0]), float(self.F[0])
+        far = min(spring_start(K), lam0) - 2.0
+        rigid0 = float(rigid_load(lam0))
+        factor = F0 / rigid0 if rigid0 < 0 and F0 < 0 else 1.0
+        u0, u1 = math.log(1.0 - lam0), math.log(1.0 - far)
+        rate = (self.lam[1] - self.lam[0]) / (self.tau[1] - self.tau[0])       # d lambda / d tau at the start
+        n = max(int(math.ceil((u1 - u0) * (1.0 - lam0) / max(rate * (self.tau[1] - self.tau[0]), 1e-300))), 8)
+        u = np.linspace(u1, u0, min(n, 200) + 1)[:-1]
+        lam_far = 1.0 - np.exp(u)
+        t_far = self.tau[0] - (u - u0) * (1.0 - lam0) / rate
+        return np.r_[t_far, self.tau], np.r_[lam_far, self.lam], np.r_[factor * rigid_load(lam_far), self.F]
+
+
+@dataclass(frozen=True)
+class SpringCurve:
+    """An interpolated curve behind a spring of stiffness ``K``: the force on the approach and the retract at
+    base positions Z up to ``Z_max`` (where the contact's load reaches the table's F_max), its jumps."""
+
+    curve: FamilyCurve
+    K: float
+    legs: Legs = field(repr=False)
+
+    @property
+    def Z_max(self) -> float:
+        """The largest base position the table covers: where the contact's load reaches F_max."""
+        return float(self.curve.lam[-1] + self.curve.F[-1] / self.K)
+
+    def predict(self, Z, leg: str) -> np.ndarray:
+        """The force at the base positions ``Z`` along ``leg`` (approach or retract); OutOfRange past Z_max."""
+        if leg not in (APPROACH, RETRACT):
+            raise OutOfRange(f"leg '{leg}': expected {APPROACH} or {RETRACT}")
+        Z = np.asarray(Z, dtype=float)
+        if Z.size and not np.all(np.isfinite(Z)):
+            raise OutOfRange("Z: expected finite base positions")
+        if Z.size and Z.max() > self.Z_max + 1e-9 * max(1.0, abs(self.Z_max)):
+            raise OutOfRange(f"Z {Z.max():.6g}: the table holds the curve up to F = {self.curve.F_max:g}, "
+                             f"Z <= {self.Z_max:.6g} behind this spring")
+        return self.legs.predict(Z, leg)
+
+    def jumps(self, leg: str) -> tuple[tuple[Measured, Measured, Measured], ...]:
+        """The jumps of ``leg``: (Z, F before, F after) each, with the table's error as their bars."""
+        ez, note = self.curve._bar("jump_Z")
+        ef, _ = self.curve._bar("jump_F")
+        return tuple((Measured(float(z), ez, note=note), Measured(b, ef, note=note), Measured(a, ef, note=note))
+                     for z, (b, a) in zip(self.legs.jumps[leg], self.legs.jump_forces(leg)))

@@ -1,0 +1,246 @@
+"""The curve family table against the solver: a small table built here (mu 0.1 to 0.8, sigma 0 to 0.1), its
+nodes reproducing the solver's sampled curves to round-off, its off-node curves within the error it measured,
+its legs behind a spring against fitting/forward.py's on the same curve, its refusals and its file."""
+import math
+
+import numpy as np
+import pytest
+
+from petsc_adhesion.family.build import TableGrid, build, regrid_points, trace_node
+from petsc_adhesion.family.coordinate import NotMonotone, coordinate, sample, stretch, unstretch
+from petsc_adhesion.family.legs import spring_legs
+from petsc_adhesion.family.table import FORMAT_VERSION, FamilyTable, OutOfRange, TableError, lagrange
+
+MU, SIGMA = (0.1, 0.2, 0.4, 0.8), (0.0, 0.05, 0.1)
+
+
+@pytest.fixture(scope="module")
+def table():
+    """The table of 12 nodes, its error measured at its 6 cell centres behind one spring."""
+    from petsc_adhesion.benchmarks.family import measure
+
+    return measure(build(TableGrid(mu=MU, sigma=SIGMA, n_tau=150)), springs=(0.5,))
+
+
+def _solver_events(c):
+    """snap_on, snap_off and the pull-off of a traced curve, on its grid."""
+    def grid(m):
+        return m.grid if m.grid is not None else m.value
+    out = {k: [(grid(e.lam), grid(e.F)) for e in c.events if e.kind == k] for k in ("snap_on", "snap_off")}
+    out["pull_off"] = [min(((grid(e.lam), grid(e.F)) for e in c.events if e.kind == "F_min"), key=lambda x: x[1])]
+    return out
+
+
+def test_lagrange_weights_are_exact_for_cubics_and_at_nodes():
+    """Four nodes reproduce a cubic anywhere between them (its interpolant is itself) and a node's value
+    exactly (weights one and zeros)."""
+    nodes = np.log(np.array([0.1, 0.2, 0.4, 0.8, 1.6, 3.2]))
+    p = np.array([0.3, -1.2, 0.7, 2.0])
+    for x in (-2.1, -1.0, 0.05, 1.1):
+        i0, w = lagrange(nodes, x)
+        assert abs(w @ np.polyval(p, nodes[i0:i0 + 4]) - np.polyval(p, x)) < 1e-12
+    for k, x in enumerate(nodes):
+        i0, w = lagrange(nodes, x)
+        assert np.array_equal(w, (np.arange(i0, i0 + 4) == k).astype(float))
+
+
+def test_the_coordinate_of_a_rigid_sphere_and_its_stretch():
+    """On a rigid sphere in contact, H = H(0) + r^2/2 crosses the level at a^2/2 = level - H(0): s is
+    level - 2 H(0) (grows as H(0) falls); tau spans [-1, 1] and unstretch inverts it."""
+    H0 = np.linspace(0.4, -0.3, 8)
+    a = np.sqrt(2 * (0.5 - H0))
+    assert np.allclose(coordinate(H0, a), 0.5 - 2 * H0, rtol=0, atol=1e-14)
+    s = np.linspace(-20.0, 30.0, 101)
+    t = stretch(s, 0.1, -20.0, 30.0, 0.01)
+    assert t[0] == -1.0 and abs(t[-1] - 1.0) < 1e-15 and np.all(np.diff(t) > 0)
+    assert np.allclose(unstretch(t, 0.1, -20.0, 30.0, 0.01), s, rtol=0, atol=1e-10)
+
+
+def test_a_coordinate_that_falls_back_is_refused():
+    """A curve along which s = a^2/2 - H(0) falls by more than a regrid's hair cannot be tabulated."""
+    H0 = np.r_[np.linspace(3.0, 0.0, 20), 1.0, np.linspace(-0.01, -0.1, 10)]
+    a = np.zeros(H0.size)
+    with pytest.raises(NotMonotone, match="falls by"):
+        sample(-H0, np.linspace(-0.1, 2.5, H0.size), H0, a, 0.5, 2.0, np.linspace(-1, 1, 11), 1.0)
+
+
+def test_the_coordinate_grows_along_the_solver_curves():
+    """Along the solver's curves through their folds (mu = 2: a pair; mu = 3, sigma = 0.5), leaving out the
+    second point of a state on two grids (a regrid), s falls by no more than a hair of its range."""
+    for mu, sigma in ((2.0, 0.0), (3.0, 0.5)):
+        b = trace_node(mu, sigma).branch
+        own = ~regrid_points(b)
+        s = coordinate(b.H0[own], b.contact_radius[own])
+        falls = np.diff(s)[np.diff(s) < 0]
+        assert (falls.size == 0 or -falls.min() < 1e-4 * np.ptp(s)), (mu, sigma, falls)
+
+
+def test_the_nodes_reproduce_the_solver_to_round_off(table):
+    """At a node the interpolant is the node's curve: the solver's curve traced again and sampled on the
+    table's coordinate, to round-off; its events are the solver's to the sampling's accuracy."""
+    from petsc_adhesion.discretization.contact import edge_level
+    from petsc_adhesion.model.pressure import pressure_law
+
+    for mu, sigma in ((0.4, 0.05), (0.8, 0.1)):
+        c = trace_node(mu, sigma)
+        b = c.branch
+        ref = sample(b.lam, b.F, b.H0, b.contact_radius, edge_level(pressure_law(c.model)), table.F_max,
+                     table.tau, mu, regrid_points(b))
+        got = table.curve(mu, sigma)
+        assert np.max(np.abs(got.lam - ref.lam)) < 1e-12 and np.max(np.abs(got.F - ref.F)) < 1e-12
+        want = _solver_events(c)
+        mine = {k: [(e.lam.value, e.F.value) for e in got.events() if e.kind == k] for k in want}
+        assert len(mine["snap_on"]) == len(want["snap_on"]) and len(mine["snap_off"]) == len(want["snap_off"])
+        (l, F), = mine["pull_off"]
+        assert abs(F - want["pull_off"][0][1]) < 1e-4          # the pull-off: a minimum, its F well conditioned
+
+
+def test_off_node_curves_are_the_solver_s_within_the_measured_error(table):
+    """Away from the nodes and the midpoints the error was measured at (a third of the way across a cell),
+    the pull-off and the force behind a spring are the solver's to within the error the table states (twice
+    the largest measured at the cell centres about them)."""
+    from petsc_adhesion.benchmarks.family import _spring
+
+    worst = table.worst()
+    assert isinstance(worst, TableError) and worst.points == 6
+    assert 0 < worst.event_F < 0.02 and 0 < worst.F_at_Z < 0.1      # measured, and small
+    for mu, sigma in ((0.1 * 2 ** (1 / 3), 0.05 / 3), (0.4 * 2 ** (2 / 3), 0.05 + 0.05 * 2 / 3)):
+        err = table.error(mu, sigma)
+        got = table.curve(mu, sigma)
+        (pl, pF), = [(e.lam.value, e.F.value) for e in got.events() if e.kind == "pull_off"]
+        want = _solver_events(trace_node(mu, sigma))["pull_off"][0]
+        assert abs(pF - want[1]) <= err.event_F, (mu, sigma, pF, want, err)
+        eF, eZ, eJ = _spring(table, mu, sigma, 0.5)
+        assert eF <= err.F_at_Z and eZ <= err.jump_Z and eJ <= err.jump_F, (mu, sigma, eF, eZ, eJ, err)
+        bars = [e.F.err for e in got.events()]
+        assert all(b == err.event_F for b in bars)                 # the bar every event carries
+
+
+def test_spring_legs_are_forward_py_s_on_the_same_curve():
+    """The legs found from a branch alone (turning points of Z where its spline's rate changes sign) against
+    fitting/forward.py's from the library's located jump events on the same traced curve: the same jumps to
+    the events' accuracy, the same force away from them."""
+    from petsc_adhesion.discretization.problem import step_scale
+    from petsc_adhesion.fitting.forward import ForwardCurve
+    from petsc_adhesion.model.parameters import Model
+    from petsc_adhesion.tracing.trace import CurveRequest, curve_settings, trace_curve
+
+    K = 0.5
+    model = Model(mu=2.0)
+    c = trace_curve(model, settings=curve_settings(step_scale(model), ds_max=0.05),
+                    request=CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=K))
+    truth = ForwardCurve(c, K)
+    b = c.branch
+    own = ~regrid_points(b)                 # a regrid's second point at one state: its grid's values ring
+    lam, F = b.lam[own], b.F[own]
+    s = np.r_[0.0, np.cumsum(np.hypot(np.diff(lam), np.diff(F)))]     # arclength: monotone
+    mine = spring_legs(s, lam, F, K)
+    for leg in ("approach", "retract"):
+        assert len(mine.jumps[leg]) == len(truth.jumps[leg]) >= 1
+        assert np.allclose(mine.jumps[leg], truth.jumps[leg], rtol=0, atol=2e-3), leg
+        Z = np.linspace(b.Z.min() - 1.0, b.Z.max(), 600)
+        away = np.all([np.abs(Z - z) > 0.02 for z in truth.jumps[leg]], axis=0)
+        assert np.max(np.abs(mine.predict(Z[away], leg) - truth.predict(Z[away], leg))) < 2e-3, leg
+
+
+def test_the_table_s_legs_at_a_node_are_the_solver_s(table):
+    """At a node, the table's curve behind a spring against the solver's traced behind it: its error there is
+    the sampling's alone, below the error measured between nodes."""
+    from petsc_adhesion.benchmarks.family import _spring
+
+    eF, eZ, eJ = _spring(table, 0.4, 0.05, 0.5)
+    worst = table.worst()
+    assert eF < 1e-4 and eF <= worst.F_at_Z and eZ <= worst.jump_Z and eJ <= worst.jump_F
+
+
+@pytest.mark.parametrize("call, says", [
+    (lambda t: t.curve(0.05, 0.0), r"^mu 0\.05: the table holds mu in \[0\.1, 0\.8\]$"),
+    (lambda t: t.curve(0.3, 0.7), r"^sigma 0\.7: the table holds sigma in \[0, 0\.1\]$"),
+    (lambda t: t.curve(float("nan"), 0.0), r"^mu nan: the table holds mu"),
+    (lambda t: t.error(2.0, 0.0), r"^mu 2\.0: the table holds mu"),
+    (lambda t: t.curve(0.3, 0.0).behind(0.0), r"^K 0\.0: expected a spring stiffness, a finite real > 0$"),
+    (lambda t: t.curve(0.3, 0.0).behind(1.0).predict([1e3], "approach"),
+     r"^Z 1000: the table holds the curve up to F = 2, Z <= "),
+    (lambda t: t.curve(0.3, 0.0).behind(1.0).predict([0.0], "up"), r"^leg 'up': expected approach or retract$"),
+])
+def test_out_of_range_is_one_line(table, call, says):
+    with pytest.raises(OutOfRange, match=says) as e:
+        call(table)
+    assert "\n" not in str(e.value)
+
+
+def test_the_file_round_trip_keeps_every_value(table, tmp_path):
+    """Saved and loaded: the same nodes, curves, error and versions; the interpolant the same numbers."""
+    path = str(tmp_path / "t.npz")
+    table.save(path)
+    back = FamilyTable.load(path)
+    for name in ("mu", "sigma", "tau", "lam", "F", "s_lo", "s_hi", "s0", "delta", "seconds", "springs",
+                 "err_mu", "err_sigma"):
+        assert np.array_equal(getattr(back, name), getattr(table, name)), name
+    assert all(np.array_equal(back.errors[f], table.errors[f]) for f in table.errors)
+    assert (back.F_max, back.roughness, back.version) == (table.F_max, table.roughness, table.version)
+    a, b = table.curve(0.3, 0.07), back.curve(0.3, 0.07)
+    assert np.array_equal(a.F, b.F) and a.error == b.error
+
+
+def test_a_file_of_another_version_or_no_table_is_one_line(table, tmp_path):
+    path = str(tmp_path / "t.npz")
+    table.save(path)
+    z = dict(np.load(path))
+    z["format_version"] = np.array(FORMAT_VERSION + 1)
+    np.savez(str(tmp_path / "v.npz"), **z)
+    with pytest.raises(ValueError, match=rf"format version {FORMAT_VERSION + 1}; this program reads version "
+                                         rf"{FORMAT_VERSION} \(rebuild it\)$"):
+        FamilyTable.load(str(tmp_path / "v.npz"))
+    (tmp_path / "x.npz").write_text("no table")
+    with pytest.raises(ValueError, match="not a curve family table"):
+        FamilyTable.load(str(tmp_path / "x.npz"))
+
+
+def test_a_failed_save_leaves_the_earlier_file(table, tmp_path, monkeypatch):
+    """A write that fails half-way leaves the table written before it, and no temporary file."""
+    path = str(tmp_path / "t.npz")
+    table.save(path)
+    before = open(path, "rb").read()
+
+    def broken(fh, **arrays):
+        fh.write(b"half")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(np, "savez_compressed", broken)
+    with pytest.raises(OSError):
+        table.save(path)
+    assert open(path, "rb").read() == before and sorted(p.name for p in tmp_path.iterdir()) == ["t.npz"]
+
+
+def test_an_unmeasured_table_says_its_error_is_missing():
+    """Built without its midpoints, a table's error is Missing with its reason, never 0, and its events carry
+    no bar but that reason."""
+    t = FamilyTable(mu=np.array([1.0]), sigma=np.array([0.0]), tau=np.linspace(-1, 1, 5),
+                    lam=np.zeros((1, 1, 5)), F=np.zeros((1, 1, 5)), s_lo=np.zeros((1, 1)), s_hi=np.ones((1, 1)),
+                    s0=np.zeros((1, 1)), delta=np.ones((1, 1)), F_max=2.0, roughness="hermite 16")
+    e = t.error(1.0, 0.0)
+    assert not e and "not measured" in e.reason
+    assert math.isfinite(t.curve(1.0, 0.0).F[0])
+
+
+@pytest.mark.parametrize("args, says", [
+    (["build", "--out", "t.npz", "--mu", "3", "1"], "--mu 3 1: expected 0 < lo <= hi"),
+    (["build", "--out", "t.npz", "--sigma", "0.2", "0.1"], "sigma: expected increasing roughnesses >= 0"),
+    (["build", "--out", "t.npz", "--springs", "0"], "--springs [0.0]: expected stiffnesses > 0"),
+    (["build", "--out", "no/such/t.npz"], "--out no/such/t.npz: no folder"),
+    (["build", "--out", "t.npz", "--n-tau", "x"], "argument --n-tau: invalid int value: 'x'"),
+    (["speed", "t.npz"], "t.npz: not a curve family table"),
+])
+def test_the_builder_s_bad_input_is_one_line_and_writes_nothing(tmp_path, args, says):
+    """The builder refuses what it cannot build before any trace: one line, exit 2, no file."""
+    import subprocess
+    import sys
+
+    from conftest import _env
+
+    p = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.family", *args], cwd=tmp_path,
+                       capture_output=True, text=True, env=_env(), timeout=300)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.count("\n") == 1 and says in p.stderr, p.stderr
+    assert list(tmp_path.iterdir()) == []
