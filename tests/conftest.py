@@ -7,16 +7,30 @@ import sys
 import petsc4py
 import pytest
 
-petsc4py.init([sys.argv[0]])
+# the program's name as the library takes it: in pytest-xdist's workers sys.argv[0] is '-c', an option to PETSc
+petsc4py.init([sys.argv[0] if sys.argv[0] and not sys.argv[0].startswith("-") else "pytest"])
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # the benchmarks read docs/ and options/ of this checkout, wherever pytest runs from
 os.environ.setdefault("PETSC_ADHESION_CHECKOUT", ROOT)
 
 
+#: What Open MPI's start of this process as a singleton puts into its environment (a pytest-xdist worker's
+#: start is not isolated: OMPI_MCA_ess=singleton, the address of its PMIx server, ...): an mpiexec a test starts
+#: with them exits 1 without a word; they are no setting of the user's.
+_MPI_STARTED = ("PMIX_", "PMI_", "OMPI_COMMAND", "OMPI_ARGV", "OMPI_MCA_ess", "OMPI_MCA_orte_", "OMPI_MCA_pmix",
+                "OMPI_COMM_WORLD_", "OMPI_UNIVERSE_SIZE", "OMPI_FILE_LOCATION", "OMPI_APP_CTX", "OMPI_FIRST_RANKS",
+                "OMPI_NUM_APP_CTX", "OMPI_MCA_initial_wdir", "OMPI_MCA_shmem_RUNTIME")
+
+
+def _mpi_started(key: str) -> bool:
+    return key.startswith(_MPI_STARTED)
+
+
 def _env():
     # PETSC_DIR is the environment's business (./run and the venv set it for Debian's PETSc)
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    env = {k: v for k, v in os.environ.items() if not _mpi_started(k)}
+    env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     # this checkout's package, also for a script run from another folder (not the one the venv installed)
     env["PYTHONPATH"] = os.pathsep.join([ROOT, *filter(None, [os.environ.get("PYTHONPATH")])])
     if os.geteuid() == 0:

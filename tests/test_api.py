@@ -290,3 +290,21 @@ def test_python_md_runs_and_prints_what_it_shows(tmp_path, monkeypatch):
     np.testing.assert_allclose(ns["s"].H, ns["s"].r ** 2 / 2 - 0.5, atol=1e-12)   # mu = 0: rigid, eq. (27)
     assert json.loads((tmp_path / "mu2.json").read_text()) == summary_of(ns["f"])
     assert {"mu1.png", "mu2.png", "mu2.json"} <= set(os.listdir(tmp_path))
+
+
+def test_a_program_given_with_python_c_starts_petsc_without_its_name_as_an_option(tmp_path):
+    """``python -c`` gives sys.argv[0] = '-c': the library's start took it for the program's name, and PETSc
+    then held '-c' as an option of the run, which the API refused ('-c: unknown option'); now it starts under
+    its own name and the curve is the command line's (its pull-off to round-off)."""
+    import conftest
+
+    code = ("import json, petsc_adhesion as p\nfrom petsc_adhesion.core.start import start_petsc\nstart_petsc()\n"
+            "c = p.curve(adh_mu=0.5, grid_type='uniform', grid_n=41, cont_F_max=0)\n"
+            "print(json.dumps(c.pull_off.F.value))")
+    run = subprocess.run([sys.executable, "-c", code], env=conftest._env(), cwd=tmp_path, capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-800:]
+    cli = conftest.run_cli("-adh_mu", "0.5", "-grid_type", "uniform", "-grid_n", "41", "-cont_F_max", "0",
+                           "-summary", tmp_path / "s.json", cwd=tmp_path)
+    assert cli.returncode == 0, cli.stderr
+    assert json.loads(run.stdout.strip().splitlines()[-1]) == json.loads((tmp_path / "s.json").read_text())["pull_off"]["F"]

@@ -22,7 +22,7 @@ import threading
 
 from ..singleton import surroundings
 
-__all__ = ["start_petsc", "KEPT_SIGNALS", "StartError"]
+__all__ = ["start_petsc", "program_name", "KEPT_SIGNALS", "StartError"]
 
 #: The signals whose handlers the process keeps through PETSc's start-up.
 KEPT_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP", "SIGPIPE") if hasattr(signal, name))
@@ -30,6 +30,14 @@ KEPT_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SI
 
 class StartError(RuntimeError):
     """MPI cannot start in these surroundings: one line naming what and the remedy."""
+
+
+def program_name() -> str:
+    """The program's name PETSc is started with: sys.argv[0], except where Python gives none that is a name
+    (``python -c`` gives '-c', a script on standard input '-', an embedding interpreter ''), which PETSc would
+    take for an option of the run (the API then refused '-c: unknown option')."""
+    name = sys.argv[0] if sys.argv else ""
+    return name if name and not name.startswith("-") else "petsc_adhesion"
 
 
 def start_petsc(argv: list[str] | None = None) -> bool:
@@ -46,7 +54,7 @@ def start_petsc(argv: list[str] | None = None) -> bool:
     import petsc4py
 
     kept = {s: signal.getsignal(s) for s in KEPT_SIGNALS}
-    argv = list(argv if argv is not None else [sys.argv[0] if sys.argv and sys.argv[0] else "petsc_adhesion"])
+    argv = list(argv if argv is not None else [program_name()])
     asked = "-no_signal_handler" in argv
     # -help is put in the database after the start-up: PETSc's start-up would print its banner and its
     # debugger options first (ours follow from app/options), and from 3.21 on fail before any handler of
