@@ -8,6 +8,7 @@ approach's last force within one step of the load; the rigid sphere's pull-off a
 and against the Gauss-Hermite average of eq. (28) computed here; the CSV against the HDF5 file bit for bit.
 """
 import csv
+import json
 import os
 import warnings
 
@@ -230,6 +231,11 @@ def test_a_trigger_in_newtons(tmp_path):
     assert force_nN == pytest.approx(unit / 1e-9, rel=1e-12)
     step = (trigger + 1.0) / 50
     assert trigger <= last <= trigger + step
+    # the stop is named as the user gave it, not as -cont_F_max (which was not given)
+    proc = run_cli(*TIP, "-phys_trigger", "5e-9", "-cont_error_estimate", "false", "-summary", tmp_path / "n.json")
+    assert proc.returncode == 0, proc.stderr
+    stopped = json.loads((tmp_path / "n.json").read_text())
+    assert "-phys_trigger 5e-9" in stopped["stop_reason"] and "-cont_F_max" not in stopped["stop_reason"], stopped
 
 
 def test_a_piece_between_two_turning_points_has_them_at_its_ends_from_arrays_or_a_branch():

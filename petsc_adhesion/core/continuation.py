@@ -71,6 +71,7 @@ class Settings:
     observable: str | None = None   # the observable bounded per step and stopped on
     observable_step: float = 0.2    # its largest change in one step, relative above magnitude 1
     observable_max: float = math.inf  # stop when the observable reaches this
+    observable_max_label: str = ""  # what set that stop, as the stop's message names it ("": the caller's default)
     p_max: float = math.inf         # stop when the parameter reaches this
     p_min: float = -math.inf        # or falls to this
     max_steps: int = 5000           # the truncated model at mu = 10 takes about 3950 (edge_grids.MU_TRUNCATED)

@@ -180,7 +180,10 @@ def stop_reason(stop, settings) -> str:
         where = "a turning point (natural continuation cannot pass it)" \
             if settings.corrector == "natural" else "a point it cannot pass"
         return f"step below -cont_ds_min at lambda = {value:.6g}: {where}"
-    return {"observable_max": f"load F = {value:.4g} >= -cont_F_max {settings.observable_max:g}",
+    # the load that stopped the curve named as the user gave it: -cont_F_max, or an instrument's trigger
+    label = settings.observable_max_label
+    at = f"{label} (F = {settings.observable_max:.4g})" if label else f"-cont_F_max {settings.observable_max:g}"
+    return {"observable_max": f"load F = {value:.4g} >= {at}",
             "p_max": f"approach lambda = {value:.4g} >= -cont_lambda_max {settings.p_max:g}",
             "p_min": f"approach lambda = {value:.4g} <= {settings.p_min:g}",
             "max_steps": f"-cont_max_steps {value} reached",
