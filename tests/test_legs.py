@@ -236,6 +236,7 @@ def test_a_trigger_in_newtons(tmp_path):
     assert proc.returncode == 0, proc.stderr
     stopped = json.loads((tmp_path / "n.json").read_text())
     assert "-phys_trigger 5e-9" in stopped["stop_reason"] and "-cont_F_max" not in stopped["stop_reason"], stopped
+    assert stopped["physical"]["spring"]["trigger_nN"] == pytest.approx(5.0, rel=1e-12)    # as given, in nN
 
 
 def test_a_piece_between_two_turning_points_has_them_at_its_ends_from_arrays_or_a_branch():

@@ -309,6 +309,8 @@ def summary_of(curve: Curve) -> dict:
                                                                      **phys["spring"]["jumps"][v["index"]]}
                                          for k, v in s["spring"]["primary"].items()}
             phys["spring"]["jump_groups"] = _physical_groups(s["spring"]["jump_groups"], "Z", units)
+            if "trigger" in s["spring"]:         # the load the approach was to end at, as the instrument sets it
+                phys["spring"]["trigger_nN"] = s["spring"]["trigger"] * units["force_nN"]
     if spread is not None:               # after physical: in_units reads the events, not the spread
         s["model_spread"] = spread_record(spread)
     if curve.model.topography:
