@@ -366,6 +366,11 @@ class Continuation:
         self.monitor(start)
         return self.resume(on_step, until, pause)
 
+    def name_stop(self, reason: str, value: float) -> None:
+        """Name the stop an ``until`` of the caller ended the run with (its own reason and value: the end of a
+        model's domain, say), for the stop's message and the files."""
+        self.stop = (reason, value)
+
     def resume(self, on_step=None, until=None, pause=None) -> list[Point]:
         """Go on from the last point with the step ``ds``: after :meth:`run`'s start, or from a state
         restored as :meth:`run`'s ``pause`` saw it."""

@@ -28,11 +28,12 @@ def known() -> dict:
     # here, not at the top: the readers of result files (io.summary, plot) need not load PETSc, which
     # tracing.critical and tracing.error_bars do
     from ..model import parameters, physical, topography
-    from ..tracing import case, critical, curve, error_bars, legs, measured, model_spread
+    from ..tracing import case, critical, curve, error_bars, legs, measured, model_spread, tracer
 
     classes = [parameters.Model, physical.Bodies, measured.Measured, measured.Missing, critical.Critical,
                error_bars.Estimate, error_bars.LandingEstimate, model_spread.Rule, model_spread.Quantity,
-               model_spread.ModelSpread, case.CaseResult]
+               model_spread.ModelSpread, case.CaseResult,
+               tracer.Point]   # the points an estimate located (core's Point, as tracing's tracer holds it)
     # a curve's parts, the legs behind its spring, the topography its model was read from: every value class
     # their modules export
     for module in (curve, legs, topography):

@@ -280,7 +280,7 @@ class Tracer:
             else:
                 seg.cont.run(start, on_step=seg.finder, until=until, pause=hook)
             if ended[0]:
-                seg.cont.stop = ("domain_end", seg.cont.points[-1].p)
+                seg.cont.name_stop("domain_end", seg.cont.points[-1].p)
                 return self.segments
             if regrid is None or regrid.next is None:
                 return self.segments

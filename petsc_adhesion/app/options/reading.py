@@ -567,8 +567,7 @@ def read_settings(opts: AppOptions, model: Model | None = None):
     if trigger is not None:
         assert model is not None, "a trigger is read with its model"
         stop, dF = trigger, min(dF, figure_step(trigger, rigid_pull_off(model)))
-        label = next((f"the trigger -{n} {opts.string(n)}" for n in ("phys_trigger", "afm_trigger") if opts.db.hasName(n)),
-                     "the default trigger, 3 times the rigid sphere's pull-off")
+        label = next((f"the trigger -{n} {opts.string(n)}" for n in ("phys_trigger", "afm_trigger") if opts.db.hasName(n)), "the default trigger, 3 times the rigid sphere's pull-off")
     return curve_settings(1.0 if model is None else step_scale(model), corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                           ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
                           max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
