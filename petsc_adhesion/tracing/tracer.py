@@ -130,10 +130,12 @@ class _Regrid:
             a = seg.problem.radius(b.x)
             ratio = a / seg.grid.edge
             return None if 1 / GROW <= ratio <= GROW else ("scaled", a, not 1 / GROW**2 <= ratio <= GROW**2, edge)
-        # a contact, and the peak attraction off the centre (a rough centre may still attract most)
-        a = contact_radius(seg.problem, b.x)
-        if tr.sharp and min(edge, a) >= a_switch(seg.problem.model):
-            return "scaled", a, False, edge
+        # a contact, and the peak attraction off the centre (a rough centre may still attract most); the
+        # contact radius only where the scaled frame can take over (it is a cubic root search at every step)
+        if tr.sharp:
+            a = contact_radius(seg.problem, b.x)
+            if min(edge, a) >= a_switch(seg.problem.model):
+                return "scaled", a, False, edge
         moved = abs(edge - seg.grid.edge)
         return None if moved <= self.travel else ("edge", edge, moved > self.forced, edge)
 
