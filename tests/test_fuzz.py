@@ -1138,7 +1138,7 @@ def _run_sub(case: Case, folder: str, np_: int) -> tuple[dict, bytes, bytes]:
         mpiexec = shutil.which("mpiexec")
         if mpiexec is None:
             pytest.skip("mpiexec not found")
-        cmd = [mpiexec, "-n", str(np_), *cmd]
+        cmd = [*conftest.mpiexec(np_), *cmd]
     env = dict(conftest._env(), **case["env"])
     if np_ > 1:                 # two ranks on two shared cores: spin less while waiting
         env["OMPI_MCA_mpi_yield_when_idle"] = "1"
