@@ -3,6 +3,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 
 import petsc4py
 import pytest
@@ -39,17 +40,72 @@ def _env():
     # a waiting rank yields its core: the suite's workers (pytest-xdist) share the cores with the ranks a test
     # starts, and Open MPI's busy wait on a machine it does not know is full slows a two-rank run many times
     env.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
+    # Hundreds of tests start the program: without compiled modules (PYTHONDONTWRITEBYTECODE, as some shells
+    # and CI images set it) each start compiles the package again, 0.15-0.2 s of its 0.65-0.85 s of CPU
+    # (a fixed solve on 41 nodes, measured); they are kept outside the checkout, as the variable wants it
+    if env.get("PYTHONDONTWRITEBYTECODE") and not env.get("PYTHONPYCACHEPREFIX"):
+        del env["PYTHONDONTWRITEBYTECODE"]
+        env["PYTHONPYCACHEPREFIX"] = PYCACHE
     return env
+
+
+#: Where the programs the tests start keep their compiled modules when the environment says not to write
+#: them beside the sources (see _env)
+PYCACHE = os.path.join(tempfile.gettempdir(), f"petsc-adhesion-tests-pycache-{os.getuid()}")
+
+
+def _ranks_core():
+    """The one core all the ranks of this worker's mpiexec runs share, or None when the cores are enough for
+    every worker's two ranks.
+
+    A waiting rank of Open MPI (or MPICH) spins: with yield_when_idle it calls sched_yield in a loop, which
+    costs a core while the other rank works.  Two ranks on a core of their own therefore cost two cores; with
+    two pytest-xdist workers on two cores they compete with the other worker and with each other, and every
+    collective waits for a rank the kernel has set aside.  Measured (mpiexec -n 2, -study_compute critical
+    -study_sigma 0 -study_ranks 2, under a load of 15): 180 s wall and 48 s of CPU (26 s system) on two cores;
+    70 s and 17 s on one core, where a waiting rank's yield hands the core to the one it waits for.  The
+    ranks' numbers are the same either way (their placement is no input of the run)."""
+    cpus = sorted(os.sched_getaffinity(0))
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    if len(cpus) >= 2 * workers or shutil.which("taskset") is None:
+        return None
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    return cpus[int(worker[2:]) % len(cpus) if worker[2:].isdigit() else 0]
+
+
+def _open_mpi(mpiexec: str) -> bool:
+    """Whether ``mpiexec`` is Open MPI's (it binds two ranks to two cores of its own choice by default)."""
+    if mpiexec not in _OPEN_MPI:
+        try:
+            v = subprocess.run([mpiexec, "--version"], capture_output=True, text=True, timeout=60).stdout
+        except (OSError, subprocess.SubprocessError):
+            v = ""
+        _OPEN_MPI[mpiexec] = "Open MPI" in v or "OpenRTE" in v
+    return _OPEN_MPI[mpiexec]
+
+
+_OPEN_MPI: dict = {}
+
+
+def mpiexec(n: int) -> list:
+    """The command that starts ``n`` ranks, before the program's: ``mpiexec -n n``, and on a machine whose
+    cores are fewer than the workers' ranks, all of them on one core (:func:`_ranks_core`: ``taskset``, and
+    Open MPI's own binding off, which would move them back to a core each).  Skips the test without mpiexec."""
+    path = shutil.which("mpiexec")
+    if path is None:
+        pytest.skip("mpiexec not found")
+    core = _ranks_core()
+    if core is None:
+        return [path, "-n", str(n)]
+    return [shutil.which("taskset"), "-c", str(core), path, *(["--bind-to", "none"] if _open_mpi(path) else []),
+            "-n", str(n)]
 
 
 def run_cli(*args, np=1, cwd=None, timeout=600):
     """Run petsc-adhesion (on ``np`` ranks through mpiexec) and return the CompletedProcess."""
     cmd = [sys.executable, "-m", "petsc_adhesion", *map(str, args)]
     if np > 1:
-        mpiexec = shutil.which("mpiexec")
-        if mpiexec is None:
-            pytest.skip("mpiexec not found")
-        cmd = [mpiexec, "-n", str(np), *cmd]
+        cmd = [*mpiexec(np), *cmd]
     return subprocess.run(cmd, cwd=cwd or ROOT, env=_env(), capture_output=True, text=True, timeout=timeout)
 
 
@@ -89,3 +145,19 @@ def make_problem(mu=1.0, sigma=0.0, r=None, pmat="dense", **model):
     r = grid.uniform(201, 10.0) if r is None else r
     pb = Problem(Model(mu=mu, sigma=sigma, **model), r, create_influence(r), preconditioning.create(pmat))
     return pb, Newton(pb)
+
+
+#: The files whose tests take longest (a 2-worker run's --durations, 20.8 min: two-rank runs, the fuzz, killed
+#: runs, refinements), longest first.  pytest-xdist's --dist loadfile hands a worker a whole file at a time,
+#: in the order of collection: alphabetically, the long test_sweep.py, test_spring.py and test_soft.py came
+#: near the end, where one of them could run on one worker with the other idle.  Handed out first, the short
+#: files fill the gaps at the end (the longest-first rule of scheduling on two machines).
+LONGEST_FIRST = ("test_extremes.py", "test_sweep.py", "test_critical.py", "test_checkpoint.py", "test_fuzz.py",
+                 "test_fitting.py", "test_hostile.py", "test_soft.py", "test_error_estimate.py", "test_spring.py",
+                 "test_kill.py", "test_continuation.py", "test_fit_instrument.py")
+
+
+def pytest_collection_modifyitems(items):
+    """The files of LONGEST_FIRST before the rest, each file's tests in their order (a stable sort)."""
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))

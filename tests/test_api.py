@@ -258,7 +258,7 @@ def test_every_rank_gets_the_result(tmp_path):
     mpiexec = shutil.which("mpiexec")
     if mpiexec is None:
         pytest.skip("mpiexec not found")
-    run = subprocess.run([mpiexec, "-n", "2", sys.executable, "-c", code], env=conftest._env(), cwd=tmp_path,
+    run = subprocess.run([*conftest.mpiexec(2), sys.executable, "-c", code], env=conftest._env(), cwd=tmp_path,
                          capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     # a file a rank: mpiexec interleaves the ranks' stdout in 2048-byte pieces

@@ -52,7 +52,7 @@ def _env(np_: int) -> dict:
 
 def _command(np_: int, *args) -> list[str]:
     cmd = [sys.executable, "-m", "petsc_adhesion", *map(str, args)]
-    return [shutil.which("mpiexec"), "-n", str(np_), *cmd] if np_ > 1 else cmd
+    return [*conftest.mpiexec(np_), *cmd] if np_ > 1 else cmd
 
 
 def _start(np_: int, folder, *args) -> subprocess.Popen:

@@ -1,7 +1,8 @@
 """Fuzz: random option sets, deterministic by seed, each ending in one line and a non-zero exit or in a valid,
 complete result set.
 
-About 1000 option sets are drawn from the real option table (petsc_adhesion.app.options.TABLE) and PETSc's solver
+About 1000 option sets (in the suite about 420 of them, every class of input of the 1000 kept: suite_draws) are
+drawn from the real option table (petsc_adhesion.app.options.TABLE) and PETSc's solver
 options under the three prefixes, with valid, out-of-range, mistyped, empty, non-finite, huge and list values,
 misspelt and unknown names, words without a dash, duplicates, and files: outputs at a missing directory, a
 directory, /dev/null, a FIFO, a symbolic link, an input of the run, another output; options files and guesses
@@ -53,6 +54,10 @@ ROOT = os.path.dirname(HERE)
 PREFIX = "petsc-adhesion: error: "
 SEED = int(os.environ.get("FUZZ_SEED", "20261122"))
 N_IN_PROCESS = 1000
+#: The suite runs the first N_SUITE of the N_IN_PROCESS draws and, from the rest, each draw that brings a class
+#: the first lack (:func:`suite_draws`): 422 of the 1000 at the default seed, every class drawn kept (``FUZZ_ALL=1``
+#: runs all 1000).
+N_SUITE = 400
 N_SUBPROCESS = 30          # the last N_MPI of them under mpiexec -n 2
 N_MPI = 10
 HANG = 10.0                # seconds: a case slower than this is a hang (reduced grids take < 1 s)
@@ -1068,10 +1073,30 @@ def assets(tmp_path_factory):
             "csv": str(d / "e.csv"), "csv_events": str(d / "ee.csv")}
 
 
+def classes(case: Case) -> set:
+    """The classes of input a draw belongs to: its category with its special kind (a kind of file, of
+    environment, of output path: None for the categories without), and each application option it names."""
+    return {("category", case["cat"], case["special"])} | \
+        {("option", a[1:]) for a in case["args"] if a.startswith("-") and a[1:] in TABLE}
+
+
+def suite_draws(cases: list, first: int = N_SUITE) -> list:
+    """The first ``first`` of ``cases``, then each later one that brings a class (:func:`classes`) none before it
+    has: every class of the whole draw, fewer draws of each (at the default seed 422 of 1000, with all of its
+    63 categories and special kinds and 94 application options; measured by test_fuzz_suite_keeps_every_class)."""
+    out, seen = list(cases[:first]), set().union(set(), *(classes(c) for c in cases[:first]))
+    for c in cases[first:]:
+        new = classes(c) - seen
+        if new:
+            out.append(c)
+            seen |= new
+    return out
+
+
 def _selected(cases: list) -> list:
     only = os.environ.get("FUZZ_CASES")
     if not only:
-        return cases
+        return cases if os.environ.get("FUZZ_ALL") else suite_draws(cases)
     ids = {int(x) for x in only.split(",")}
     return [c for c in cases if c["id"] in ids]
 
@@ -1116,7 +1141,8 @@ def _summary(stats: dict) -> str:
 
 
 def test_fuzz_in_process(tmp_path, assets):
-    """N_IN_PROCESS random option sets through cli.main in a worker process, each judged by :func:`judge`."""
+    """N_IN_PROCESS random option sets (in the suite those of :func:`suite_draws`) through cli.main in a worker
+    process, each judged by :func:`judge`."""
     cases = _selected(generate(SEED, N_IN_PROCESS))
     worker = Worker(str(tmp_path))
     t0 = time.perf_counter()
@@ -1131,6 +1157,19 @@ def test_fuzz_in_process(tmp_path, assets):
     assert not failures, report.encode("utf-8", "backslashreplace").decode("utf-8")   # surrogate escapes: see below
 
 
+def test_fuzz_suite_keeps_every_class():
+    """The suite's draws (suite_draws) hold every class of input of all N_IN_PROCESS draws, in fewer than half
+    the cases, and the first N_SUITE draws alone lack some (so that the draws after them are needed)."""
+    full = generate(SEED, N_IN_PROCESS)
+    chosen = suite_draws(full)
+    every = set().union(*(classes(c) for c in full))
+    assert set().union(*(classes(c) for c in chosen)) == every
+    assert len(chosen) < N_IN_PROCESS / 2 and [c["id"] for c in chosen[:N_SUITE]] == list(range(N_SUITE))
+    assert set().union(*(classes(c) for c in full[:N_SUITE])) < every
+    cats = {k[1] for k in every if k[0] == "category"}
+    assert cats == {"valid", "mutated", "petsc", "names", "output_paths", "input_files", "environment"}
+
+
 # -- the command line: real processes, some under mpiexec -n 2 ------------------------------------------
 def _run_sub(case: Case, folder: str, np_: int) -> tuple[dict, bytes, bytes]:
     cmd = [sys.executable, "-m", "petsc_adhesion", *[a.replace("{D}", folder) for a in case["args"]]]
@@ -1138,7 +1177,7 @@ def _run_sub(case: Case, folder: str, np_: int) -> tuple[dict, bytes, bytes]:
         mpiexec = shutil.which("mpiexec")
         if mpiexec is None:
             pytest.skip("mpiexec not found")
-        cmd = [mpiexec, "-n", str(np_), *cmd]
+        cmd = [*conftest.mpiexec(np_), *cmd]
     env = dict(conftest._env(), **case["env"])
     if np_ > 1:                 # two ranks on two shared cores: spin less while waiting
         env["OMPI_MCA_mpi_yield_when_idle"] = "1"

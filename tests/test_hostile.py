@@ -78,7 +78,7 @@ def cli(*args, np=1, cwd, env=None, timeout=HANG) -> subprocess.CompletedProcess
                 full[k] = v
         cmd = [sys.executable, "-m", "petsc_adhesion", *map(str, args)]
         if np > 1:                                  # the environment given to every rank
-            cmd = [shutil.which("mpiexec"), "-n", str(np), *cmd]
+            cmd = [*conftest.mpiexec(np), *cmd]
         return subprocess.run(cmd, cwd=cwd, env=full, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return subprocess.CompletedProcess(args, None, "", f"HANG: no answer within {timeout} s")

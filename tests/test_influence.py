@@ -196,7 +196,7 @@ def test_two_ranks_match_one(PETSc, tmp_path):
 
     env = conftest._env()       # without the variables of this process's own MPI start
     script = textwrap.dedent(MPI_SCRIPT).format(repo=str(REPO), out=str(out))
-    proc = subprocess.run(["mpiexec", "-n", "2", sys.executable, "-c", script],
+    proc = subprocess.run([*conftest.mpiexec(2), sys.executable, "-c", script],
                           env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     r = grid.paper(3.0)

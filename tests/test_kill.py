@@ -66,7 +66,7 @@ def _outputs(folder) -> list[str]:
 def _start(np_: int, args, folder) -> subprocess.Popen:
     cmd = [sys.executable, "-m", "petsc_adhesion", *args, *_outputs(folder)]
     if np_ > 1:
-        cmd = [shutil.which("mpiexec"), "-n", str(np_), *cmd]
+        cmd = [*conftest.mpiexec(np_), *cmd]
     return subprocess.Popen(cmd, cwd=folder, env=_env(np_), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, start_new_session=True)
 
