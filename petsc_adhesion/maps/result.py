@@ -41,6 +41,8 @@ __all__ = ["STATUSES", "Pixel", "MapResult", "fitted_pixel", "flagged_pixel", "m
 STATUSES = ("ok", "warned", "refused", "outside", "unreadable", "failed")
 #: The quantities of a pixel, each a Measured or Missing (``rms`` also None: not fitted).
 QUANTITIES = ("gamma", "E_star", "rms", "pull_off", "jump_in", "energy")
+#: The quantities of the fit (drawn only where it holds); the others are what the curve shows by itself.
+FITTED = ("gamma", "E_star", "rms", "reduced_chi2")
 
 Quantity = Measured | Missing
 
@@ -103,13 +105,15 @@ class MapResult:
         """Whether every pixel's fit holds (exit status 0, else 3)."""
         return all(p.status == "ok" for p in self.pixels)
 
-    def image(self, quantity: str, trusted: bool = True) -> np.ndarray:
+    def image(self, quantity: str) -> np.ndarray:
         """The values of ``quantity`` (a name of QUANTITIES, ``reduced_chi2``) on the grid, shape (ny, nx): NaN
-        where no curve lies, where it is Missing, and (``trusted``) where the pixel's fit does not hold."""
+        where no curve lies, where it is Missing, and for a fitted quantity (w, E*, rms, reduced chi^2) where
+        the pixel's fit does not hold (what the curve shows by itself, its pull-off, jump-in and energy, is
+        drawn wherever the curve was read)."""
         nx, ny = self.grid.shape
         out = np.full((ny, nx), np.nan)
         for p in self.pixels:
-            if trusted and p.status != "ok":
+            if quantity in FITTED and p.status != "ok":
                 continue
             v = getattr(p, quantity)
             v = v.value if isinstance(v, Measured) else v if isinstance(v, float) else None

@@ -1,0 +1,27 @@
+"""Synthetic force maps made by the forward solver with noise: the truth a map's fit is checked and timed on.
+
+Pixel (ix, iy) of a grid of ``shape`` is the curve :func:`~petsc_adhesion.fitting.synthetic.synthetic_curve`
+makes for the bodies ``truth(ix, iy)`` behind ``spring``, sampled as ``sampling`` says with the noise's stream
+seeded by the pixel (``sampling.seed`` + its number): each pixel's noise its own, the map the same each time.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+from ..fitting.results import Spring
+from ..fitting.synthetic import Sampling, synthetic_curve
+from ..model.physical import Bodies
+from .source import MapSource, curves_map
+
+__all__ = ["synthetic_map"]
+
+
+def synthetic_map(shape: tuple, truth: Callable[[int, int], Bodies], spring: Spring,
+                  sampling: Sampling = Sampling(), settings=None) -> MapSource:
+    """A map of ``shape`` (nx, ny) whose pixel (ix, iy) is a curve of the bodies ``truth(ix, iy)`` (see the
+    module), filled row by row (x fastest)."""
+    nx, ny = shape
+    curves = [synthetic_curve(truth(i % nx, i // nx), spring, replace(sampling, seed=sampling.seed + i),
+                              settings=settings) for i in range(nx * ny)]
+    return curves_map(curves, (nx, ny), "synthetic")
