@@ -3,7 +3,7 @@ the ranks it runs on.
 
     python -m petsc_adhesion.benchmarks.maps 4                     # a 4x4 map on one rank
     mpiexec -n 2 python -m petsc_adhesion.benchmarks.maps 4        # on two
-    mpiexec -n 2 python -m petsc_adhesion.benchmarks.maps 64       # the 64x64 map of issue 34 (4,096 curves)
+    mpiexec -n 2 python -m petsc_adhesion.benchmarks.maps 64       # a 64x64 map (4,096 curves)
 
 The map: a 20 nm tip on four materials in quadrants (w 0.04 and 0.06 J/m^2, mu 0.1 and 0.15 by eq. 9: where
 one fit is fastest), 1% noise of 2 pi R w, 100 points a leg, each pixel's noise its own; every curve fitted
