@@ -249,6 +249,8 @@ def test_refusals_write_nothing_and_keep_an_earlier_result(folder, tmp_path):
     _refused(run_cli("-fit_map", QI, "-phys_radius", R, "-phys_epsilon", EPS, "-out", out, "-fit_map_shape",
                      "2,2"), "fit_map")                                               # a map file has its grid
     _refused(run_cli("-fit_map", os.path.join(DATA, "NOTICE"), *TIP, "-out", out), "fit_map")     # no map
+    os.mkfifo(tmp_path / "fifo")
+    assert "is a FIFO" in _refused(run_cli("-fit_map", tmp_path / "fifo", *TIP, "-out", out), "fit_map")
     assert out.read_bytes() == b"an earlier result"
     assert not os.path.exists(str(out) + ".journal")
 

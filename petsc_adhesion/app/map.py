@@ -28,6 +28,7 @@ from petsc4py import PETSc
 from ..errors import InputError, collective, printable
 from ..fitting.data import CurveFileError, NeedsInstrument
 from ..fitting.results import FitChoice, Spring
+from ..io.inputs import check_input
 from ..io.map import Journal, JournalError, map_tree, pixel_fields, report_map, write_map_csv, write_map_h5
 from ..io.resultset import PLOT_FORMATS, check_targets, plot_format, written
 from ..io.summary import program_record
@@ -47,6 +48,8 @@ from .progress import Progress
 
 __all__ = ["MapRequest", "read", "execute", "main", "journal_path"]
 
+#: The largest map file read (afmformats reads a map's curves from it as they are asked for, not whole).
+MAP_BYTES = 1 << 40
 #: The outputs a map writes.
 _OUTPUTS = ("out", "csv", "plot")
 #: Options a map does not take, each with why.
@@ -137,8 +140,8 @@ def read(opts: AppOptions, comm, argv: list[str]) -> MapRequest:
     rough = model.roughness != "none" and (model.sigma > 0 or fit_rough)
     spread = read_model_spread(opts, replace(model, sigma=model.sigma or (0.3 if rough else 0.0)))
     path = opts.string("fit_map")
-    if not (os.path.isdir(path) or os.path.isfile(path)):
-        raise InputError(f"-fit_map: no file or folder '{printable(path)}'")
+    if not os.path.isdir(path):
+        check_input("fit_map", path, MAP_BYTES)     # a FIFO, a device, a link to nothing: named, never opened
     try:
         source = open_map(path, _shape(opts))
     except MapSourceError as e:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 from dataclasses import dataclass, field
 
 from ..fitting.data import AFM_EXTENSIONS, CurveFileError, MeasuredCurve, afm_curve, load_afm, read_curve
@@ -100,7 +101,14 @@ class MapSource:
                 raise CurveFileError(f"'{os.path.basename(self.path)}' curve {entry.index}: cannot be read "
                                      f"({type(e).__name__}: {str(e).splitlines()[0][:100] if str(e) else ''})") \
                     from None
-        return read_curve(self._files[entry.index], 0, spring=spring, invols=invols)
+        path = self._files[entry.index]
+        try:
+            regular = stat.S_ISREG(os.stat(path).st_mode)
+        except OSError as e:
+            raise CurveFileError(f"'{os.path.basename(path)}': cannot be read ({e.strerror})") from None
+        if not regular:             # a FIFO or a device listed would block or never end: never opened
+            raise CurveFileError(f"'{os.path.basename(path)}': not a regular file")
+        return read_curve(path, 0, spring=spring, invols=invols)
 
 
 def curves_map(curves, shape: tuple | None = None, name: str = "curves") -> MapSource:
