@@ -193,9 +193,9 @@ def test_one_and_two_ranks_give_the_same_map(folder, whole, tmp_path):
 
 
 def test_a_killed_map_resumes_to_the_same_files(folder, whole, tmp_path):
-    """A map killed (SIGKILL) once its journal holds a pixel: no output written, the journal kept; run again,
-    it takes that up and fits the rest, and its table and HDF5 pixels are those of the map never interrupted;
-    the journal is gone after."""
+    """A map killed (SIGKILL) once its journal holds a pixel: no output written, the journal kept; run again
+    (with progress lines: the rate, the time left), it takes that up and fits the rest, and its table and HDF5
+    pixels are those of the map never interrupted; the journal is gone after."""
     out = tmp_path / "cut.h5"
     journal = str(out) + ".journal"
     cmd = [sys.executable, "-m", "petsc_adhesion", "-fit_map", str(folder), *map(str, TIP), *map(str, FAST),
@@ -215,9 +215,10 @@ def test_a_killed_map_resumes_to_the_same_files(folder, whole, tmp_path):
     assert not out.exists() and os.path.exists(journal)
     kept = open(journal).read().count("\n") - 1
     assert 1 <= kept < 4
-    p = _map(folder, out)
+    p = _map(folder, out, "-progress", "true", "-progress_interval", 1e-6)   # progress lines: the same map
     assert p.returncode == 3, p.stderr
     assert f"{kept} of 4 curves taken up from the journal" in p.stdout
+    assert f"map: 4 of 4 curves ({kept} from the journal), " in p.stderr and " curves/s, " in p.stderr
     assert open(str(out) + ".csv").read() == open(str(whole) + ".csv").read()
     _same(_pixels(out), _pixels(whole))
     with h5py.File(out) as f:
