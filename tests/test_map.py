@@ -293,3 +293,30 @@ def test_a_list_with_a_missing_file_and_a_curve_without_retract_flags_them(folde
                                                                 ("0", "1", "unreadable")]
     assert "nonesuch.csv" in rows[1]["reasons"]
     assert "retract" in rows[2]["reasons"] or "turn" in rows[2]["reasons"], rows[2]["reasons"]
+
+
+def test_a_pixel_through_the_journal_is_the_same_value(tmp_path):
+    """A pixel of each kind (a fit's Measured with and without a bar, Missing, no rms; a flagged one) written
+    to a journal, a torn line after it (a kill mid-write), read back: equal to the pixels written, the torn
+    line dropped; a journal of another fingerprint refused."""
+    from petsc_adhesion.io.map import Journal, JournalError, pixel_fields
+    from petsc_adhesion.maps.result import Pixel
+    from petsc_adhesion.maps.source import MapEntry
+    from petsc_adhesion.tracing.measured import Measured, Missing
+
+    a = Pixel(MapEntry(0, 1, 2, 1.5e-6, None, "a.csv"), "warned", ("a misfit",), Measured(0.05, 1e-3),
+              Measured(3e10, None, note="held at 3e+10 Pa"), None, Measured(6.2e-9, 1e-11, note="n"),
+              Missing("no jump"), Measured(1.0e-16, 2e-18), 1.7, 1e-9, 12)
+    b = Pixel(MapEntry(1, 0, 0), "refused", ("no adhesion",), Missing("no adhesion"), Missing("no adhesion"),
+              Missing("no adhesion"), Missing("x"), Missing("y"), Missing("z"))
+    j = Journal(str(tmp_path / "m.journal"), "print")
+    j.start()
+    j.append([a, b])
+    with open(j.path, "a") as f:
+        f.write('{"index": 2, "ix"')                    # torn by a kill
+    back = [Pixel(MapEntry(**e), **f) for e, f in map(pixel_fields, j.read())]
+    assert back == [a, b]
+    j.start()                                           # the torn line cut off, the rest kept
+    assert open(j.path).read().count("\n") == 3 and len(j.read()) == 2
+    with pytest.raises(JournalError):
+        Journal(j.path, "another").read()
