@@ -238,7 +238,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
             if "plot" in files.targets:
                 from ..io.plot.map import map_figure
 
-                map_figure(tree, files.temp("plot"), plot_format(files.targets["plot"]))
+                map_figure(tree, files.temp("plot"), plot_format(files.targets["plot"]) or "png")
             files.commit()
         journal.remove()
         if report:

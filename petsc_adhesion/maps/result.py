@@ -165,6 +165,8 @@ def measured_quantities(data: MeasuredCurve) -> dict:
         return {"pull_off": Missing(why), "jump_in": Missing(why), "energy": Missing(why)}
     noise = feat.noise_N
     note = "the noise of one sample" + (f"; {feat.noise_note}" if feat.noise_note else "")
+    pull: Quantity
+    jump: Quantity
     if feat.pull_off_N > 0:
         pull = Measured(feat.pull_off_N, noise, note=note)
     else:
