@@ -238,7 +238,9 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
             if "plot" in files.targets:
                 from ..io.plot.map import map_figure
 
-                map_figure(tree, files.temp("plot"), plot_format(files.targets["plot"]) or "png")
+                fmt = plot_format(files.targets["plot"])
+                assert fmt is not None, "read refuses a -plot that ends in no figure format"
+                map_figure(tree, files.temp("plot"), fmt)
             files.commit()
         journal.remove()
         if report:
