@@ -113,11 +113,11 @@ def test_the_energy_of_a_rectangular_cycle_is_its_area():
     z = np.r_[np.linspace(0, L, n), np.linspace(L, 0, n)]
     F = np.r_[np.zeros(n), np.full(n, -P)]
     q = measured_quantities(MeasuredCurve(z=z, F=F, turn=n, direction=1))
-    assert q["energy"].value == pytest.approx(P * L, rel=1e-12) and q["energy"].covers(P * L)
-    assert q["pull_off"].value == pytest.approx(P, rel=1e-12)
+    assert q.energy.value == pytest.approx(P * L, rel=1e-12) and q.energy.covers(P * L)
+    assert q.pull_off.value == pytest.approx(P, rel=1e-12)
     # the same cycle measured with z falling towards the surface: the same energy
     q = measured_quantities(MeasuredCurve(z=-z, F=F, turn=n, direction=-1))
-    assert q["energy"].value == pytest.approx(P * L, rel=1e-12)
+    assert q.energy.value == pytest.approx(P * L, rel=1e-12)
 
 
 # -- a synthetic map --------------------------------------------------------------------------------------------

@@ -34,7 +34,7 @@ from ..model.physical import Bodies
 from ..tracing.measured import Measured, Missing
 from .source import Grid, MapEntry
 
-__all__ = ["STATUSES", "Pixel", "MapResult", "fitted_pixel", "flagged_pixel", "measured_quantities",
+__all__ = ["STATUSES", "Pixel", "MapResult", "Shown", "fitted_pixel", "flagged_pixel", "measured_quantities",
            "QUANTITIES"]
 
 #: What a pixel's fit can end as (see the module).
@@ -122,30 +122,35 @@ class MapResult:
         return out
 
 
-def _missing_all(reason: str) -> dict:
-    return {q: Missing(reason) for q in QUANTITIES if q != "rms"}
+@dataclass(frozen=True)
+class Shown:
+    """What a curve shows by itself (see the module): its ``pull_off``, ``jump_in`` and ``energy``."""
+
+    pull_off: Quantity
+    jump_in: Quantity
+    energy: Quantity
 
 
 def flagged_pixel(entry: MapEntry, status: str, reason: str, data: MeasuredCurve | None = None,
                   rms_fitted: bool = False) -> Pixel:
     """The pixel of a curve that was not fitted: every fitted quantity Missing with ``reason``; what the
     curve shows by itself measured where it was read (``data``)."""
-    q = _missing_all(reason)
-    if data is not None:
-        q |= measured_quantities(data)
-    return Pixel(entry, status, (reason,), rms=Missing(reason) if rms_fitted else None, **q)
+    shown = measured_quantities(data) if data is not None else Shown(Missing(reason), Missing(reason),
+                                                                     Missing(reason))
+    return Pixel(entry, status, (reason,), Missing(reason), Missing(reason), Missing(reason) if rms_fitted else None,
+                 shown.pull_off, shown.jump_in, shown.energy)
 
 
 def fitted_pixel(entry: MapEntry, fit: CurveFit) -> Pixel:
     """The pixel of a fitted curve: the fit's quantities, the curve's own measured on its data."""
     data = fit.data
     assert isinstance(data, MeasuredCurve), "a curve fit holds the measured curve"
-    q = measured_quantities(data)
+    shown = measured_quantities(data)
     status = "ok" if fit.trustworthy else "warned"
     reasons = tuple(fit.warnings) or (() if fit.complete else ("a quantity fitted is undetermined",))
     chi2 = fit.reduced_chi2
-    return Pixel(entry, status, reasons, fit.gamma, fit.E_star, fit.rms, q["pull_off"], q["jump_in"],
-                 q["energy"], chi2 if math.isfinite(chi2) else None,
+    return Pixel(entry, status, reasons, fit.gamma, fit.E_star, fit.rms, shown.pull_off, shown.jump_in,
+                 shown.energy, chi2 if math.isfinite(chi2) else None,
                  fit.p_value if math.isfinite(fit.p_value) else None, fit.traces)
 
 
@@ -153,16 +158,16 @@ def fitted_pixel(entry: MapEntry, fit: CurveFit) -> Pixel:
 JUMP_NOISES = 10.0
 
 
-def measured_quantities(data: MeasuredCurve) -> dict:
+def measured_quantities(data: MeasuredCurve) -> Shown:
     """What ``data`` shows by itself, with bars (see the module): pull_off, jump_in, energy (Measured or
-    Missing), by name."""
+    Missing)."""
     from ..fitting.domain import features
 
     try:
         feat = features(data)
     except (ValueError, ArithmeticError, IndexError) as e:
         why = f"the curve's features cannot be read ({type(e).__name__})"
-        return {"pull_off": Missing(why), "jump_in": Missing(why), "energy": Missing(why)}
+        return Shown(Missing(why), Missing(why), Missing(why))
     noise = feat.noise_N
     note = "the noise of one sample" + (f"; {feat.noise_note}" if feat.noise_note else "")
     pull: Quantity
@@ -175,7 +180,7 @@ def measured_quantities(data: MeasuredCurve) -> dict:
         jump = Measured(feat.jump_in_drop_N, math.sqrt(2) * noise, note="a difference of two samples' noise")
     else:
         jump = Missing(f"the approach does not jump by more than {JUMP_NOISES:g} noise")
-    return {"pull_off": pull, "jump_in": jump, "energy": _energy(data, feat.F0_N, noise)}
+    return Shown(pull, jump, _energy(data, feat.F0_N, noise))
 
 
 def _energy(data: MeasuredCurve, F0: float, noise: float) -> Quantity:
