@@ -19,6 +19,8 @@ package                what
 ``model``              parameters and units, pressure laws and roughness, closed forms
 ``discretization``     grids, the influence operator, the problem in each frame
 ``tracing``            the curve over grids that follow the edge, error bars, results
+``fitting``            measurements to the material: a pull-off's w, a force curve's w and E*
+``maps``               force maps: every curve of a map fitted over MPI ranks (:func:`fit_map`)
 ``io``                 result files, their layout, the report, figures
 ``app``                options, one run, studies over MPI, checkpoints, command line, API
 ``benchmarks``         measurements and the docs' figures (the library never imports it)
@@ -34,12 +36,17 @@ from .tracing.curve import Curve, Event, Solution  # noqa: E402
 from .version import __version__  # noqa: E402
 
 __all__ = ["__version__", "curve", "solve", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
-           "SolverChoice", "PetscSettings", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError"]
+           "SolverChoice", "PetscSettings", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError",
+           "fit_curve", "CurveFit", "Spring", "FitChoice", "read_curve", "MeasuredCurve", "fit_map", "open_map", "MapResult",
+           "Pixel"]
 
 #: Names loaded on first use (their modules import petsc4py.PETSc, which starts PETSc).
 _LAZY = {"trace_curve": "tracing.trace", "solve_at": "tracing.trace", "GridChoice": "tracing.trace",
          "SolverChoice": "tracing.trace", "PetscSettings": "core.newton", "CurveRequest": "tracing.trace", "curve_settings": "tracing.trace",
-         "Settings": "core.continuation", "Model": "model.parameters", "Bodies": "model.physical"}
+         "Settings": "core.continuation", "Model": "model.parameters", "Bodies": "model.physical",
+         "fit_curve": "fitting.curve_fit", "CurveFit": "fitting.results", "Spring": "fitting.results",
+         "FitChoice": "fitting.results", "read_curve": "fitting.data", "MeasuredCurve": "fitting.data",
+         "fit_map": "maps.fit", "open_map": "maps.source", "MapResult": "maps.result", "Pixel": "maps.result"}
 
 
 def __getattr__(name: str):

@@ -150,6 +150,9 @@ def _program(argv: list[str]) -> int:
         print_help()
     # a fit and a study load their modules only when asked for: the fitting code and its scipy parts are
     # a part of a curve's start-up it does not use (docs/performance.md)
+    if opts.db.hasName("fit_map"):          # the same on every rank: the options are every rank's
+        from . import map as fitmap
+        return fitmap.main(opts, argv, helping)
     if collective(PETSc.COMM_WORLD, run.is_fit, opts):
         from . import fit
         return fit.main(opts, argv, helping)

@@ -146,6 +146,8 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
     for name, needs in (("fit_pull_off_err", "pull_off"), *((n, "curve") for n in CURVE_ONLY)):
         if _given(opts, name) and kind != needs:
             raise InputError(f"-{name}: only with -fit_{needs}")
+    if _given(opts, "fit_map_shape"):
+        raise InputError("-fit_map_shape: only with -fit_map")
     if comm.getSize() > 1:
         raise InputError(f"{what}: a fit runs on one rank (its curves are small); run it without mpiexec")
     _refuse_others(opts, what)

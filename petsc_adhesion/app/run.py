@@ -81,7 +81,8 @@ def refuse_fit_options(opts: AppOptions) -> None:
     """An InputError for a -fit_ option given without -fit_pull_off or -fit_curve."""
     stray = [n for n in TABLE if n.startswith("fit_") and opts.db.hasName(n)]
     if stray:
-        needs = "-fit_pull_off" if stray[0] == "fit_pull_off_err" else "-fit_curve"
+        needs = "-fit_pull_off" if stray[0] == "fit_pull_off_err" else \
+            "-fit_map" if stray[0].startswith("fit_map") else "-fit_curve"
         raise InputError(f"-{stray[0]}: only with {needs}; remove it")
 
 

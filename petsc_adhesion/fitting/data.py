@@ -47,7 +47,8 @@ import numpy as np
 
 from ..errors import printable as _printable
 
-__all__ = ["CurveFileError", "NeedsInstrument", "MeasuredCurve", "VOLT_UNITS", "read_curve", "AFM_EXTENSIONS",
+__all__ = ["CurveFileError", "NeedsInstrument", "MeasuredCurve", "VOLT_UNITS", "read_curve", "load_afm", "afm_curve",
+           "AFM_EXTENSIONS",
            "LENGTH_UNITS", "FORCE_UNITS",
            "MIN_POINTS", "MAX_TEXT_BYTES"]
 
@@ -321,6 +322,17 @@ def _read_text(path: str, spring: float | None = None, invols: float | None = No
 # -- afmformats ------------------------------------------------------------------
 def _read_afm(path: str, index: int, spring_given: float | None = None,
               invols: float | None = None) -> MeasuredCurve:
+    curves = load_afm(path)
+    if not 0 <= index < len(curves):
+        raise CurveFileError(f"{_name(path)}: holds {len(curves)} curve{'s' * (len(curves) != 1)}; index {index} "
+                             f"asked for")
+    return afm_curve(curves[index], path, index, len(curves), spring_given, invols)
+
+
+def load_afm(path: str) -> list:
+    """The force-distance curves afmformats reads in ``path`` (its data objects, in the file's order; a force
+    map's curves each once: a map is opened once, not once per curve); CurveFileError (one line) for a file it
+    cannot read or one without a curve."""
     try:
         import afmformats
     except ImportError:
@@ -348,10 +360,13 @@ def _read_afm(path: str, index: int, spring_given: float | None = None,
         logging.disable(disabled)
     if not curves:
         raise CurveFileError(f"{_name(path)}: afmformats finds no force-distance curve in it")
-    if not 0 <= index < len(curves):
-        raise CurveFileError(f"{_name(path)}: holds {len(curves)} curve{'s' * (len(curves) != 1)}; index {index} "
-                             f"asked for")
-    d = curves[index]
+    return list(curves)
+
+
+def afm_curve(d, path: str, index: int, count: int, spring_given: float | None = None,
+              invols: float | None = None) -> MeasuredCurve:
+    """The measured curve of afmformats' data object ``d``, curve ``index`` of the ``count`` of ``path``
+    (:func:`load_afm`); ``spring_given`` and ``invols`` as :func:`read_curve`'s."""
     columns = list(d.columns)
     zcol = next((c for c in ("height (piezo)", "height (measured)") if c in columns), None)
     deflected = "force" not in columns and "deflection" in columns and spring_given is not None
@@ -379,7 +394,7 @@ def _read_afm(path: str, index: int, spring_given: float | None = None,
                                   f"deflection is already in metres", "fit_invols")
         F, sens = F * (invols / sens), invols       # the deflection is the voltage times the sensitivity
     return _curve(np.asarray(d[zcol], dtype=float), F, path, source, spring, sens,
-                  {**meta, "z_column": zcol, "curves_in_file": len(curves), "index": index})
+                  {**meta, "z_column": zcol, "curves_in_file": count, "index": index})
 
 
 # -- the curve -------------------------------------------------------------------

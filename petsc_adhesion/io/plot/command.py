@@ -14,7 +14,7 @@ USAGE = "usage: petsc-adhesion plot RESULT.h5 [-o OUT.png|OUT.pdf|OUT.svg]   (de
 
 
 #: The kinds of result file the program writes, each drawn here.
-KINDS = ("curve", "solve", "study", "critical", "fit")
+KINDS = ("curve", "solve", "study", "critical", "fit", "map")
 #: What begins an HDF5 file (at byte 0, or 512, 1024, ... after a user block).
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 #: What h5py raises on a file damaged inside (a bad symbol table, a heap or an attribute message that
@@ -78,6 +78,10 @@ def _draw(kind: str, path: str, out: str, fmt: str) -> None:
 
     if kind == "fit":
         fit_figure(path, out, fmt)
+    elif kind == "map":
+        from ..plot.map import map_figure
+
+        map_figure(path, out, fmt)
     elif kind == "curve":
         curve_figure(path, out, fmt)
     elif kind == "solve":

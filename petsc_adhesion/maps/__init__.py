@@ -1,0 +1,1 @@
+"""Force maps: many curves of one sample fitted alike, a pixel each (docs/maps.md)."""

@@ -1,0 +1,322 @@
+"""Force maps (-fit_map, petsc_adhesion.fit_map; docs/maps.md): a JPK map read with its grid and each pixel
+flagged with its true reason; a synthetic 3x3 map whose pixels were made with known w and E* recovered within
+their bars; the same table on 1 and 2 ranks; a map killed mid-way and resumed gives the files of one never
+interrupted; bad input refused in one line with nothing written, or flagged per curve."""
+import csv
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import ROOT, _env, run_cli
+
+DATA = os.path.join(ROOT, "tests", "data")
+QI = os.path.join(DATA, "fmt-jpk-fd_2020.02.07-16.29.05.036.jpk-qi-data")
+R, EPS, K_SPRING = 20e-9, 0.3e-9, 1.0
+TIP = ("-phys_radius", R, "-phys_epsilon", EPS, "-phys_spring", K_SPRING)
+
+
+def _bodies(w, mu):
+    """The bodies of a synthetic curve: work of adhesion ``w``, E* from eq. (9) at ``mu`` (on a rigid flat)."""
+    from petsc_adhesion.model.physical import Bodies
+
+    return Bodies(radius=R, young1=w * math.sqrt(R / (mu**3 * EPS**3)), poisson1=0.0, epsilon=EPS, gamma=w)
+
+
+def _write(path, z, F):
+    with open(path, "w") as f:
+        f.write("z (m), F (N)\n")
+        f.writelines(f"{a!r}, {b!r}\n" for a, b in zip(z, F))
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    """A folder of four curve files: two made by the solver with noise (w 0.04 and 0.06 J/m^2, mu 0.1 and
+    0.15), one without adhesion (the first's approach without its attraction, its retract the approach run
+    back), one that is no curve."""
+    from petsc_adhesion.fitting.results import Spring
+    from petsc_adhesion.fitting.synthetic import Sampling, synthetic_curve
+
+    d = tmp_path_factory.mktemp("map")
+    for i, (w, mu) in enumerate([(0.04, 0.1), (0.06, 0.15)]):
+        c = synthetic_curve(_bodies(w, mu), Spring(K_SPRING),
+                            Sampling(noise=0.01 * 2 * math.pi * R * 0.05, points=60, z0=5e-9, seed=20 + i))
+        _write(d / f"c{i}.csv", c.z, c.F)
+        if i == 0:
+            a = np.maximum(c.F[: c.turn], 0.0)         # no attraction, the same force both ways: no pull-off
+            _write(d / "c2.csv", c.z, np.r_[a, a[::-1]])
+    (d / "c3.csv").write_text("z (m), F (N)\nnot, numbers\n")
+    return d
+
+
+def _rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+# -- the JPK map ------------------------------------------------------------------------------------------------
+def test_a_jpk_map_gives_its_grid_and_positions():
+    """The QI file's four curves on its 128 x 128 grid of 10 um: the pixel each states, and the position of
+    each pixel's centre made from the grid (its origin plus the index times the pixel size) equal to the
+    position the file states for the curve (to 1e-12 m)."""
+    from petsc_adhesion.maps.source import open_map
+
+    m = open_map(QI)
+    assert m.kind == "afm" and m.grid.shape == (128, 128) and len(m) == 4
+    assert m.grid.size == pytest.approx((10e-6, 10e-6), rel=1e-12)
+    assert [(e.ix, e.iy) for e in m.entries] == [(0, 0), (1, 0), (2, 0), (3, 0)]
+    px, py = m.grid.pixel
+    for e in m.entries:
+        assert abs(m.grid.origin[0] + e.ix * px - e.x) < 1e-12 and abs(m.grid.origin[1] + e.iy * py - e.y) < 1e-12
+
+
+def test_a_jpk_map_fitted_flags_each_pixel_with_its_reason(tmp_path):
+    """The QI map's curves (a compliant sample, a 20 nm tip assumed): each indents the tip by more than R/4 and
+    holds on far behind the contact (tethers): every pixel 'outside' the model's domain, with those reasons,
+    no w or E* a number; the pull-off and the energy of a cycle, what a curve shows by itself, with bars; the
+    exit status 3; the map's figure drawn by the plot command."""
+    out, table = tmp_path / "qi.h5", tmp_path / "qi.csv"
+    p = run_cli("-fit_map", QI, "-phys_radius", R, "-phys_epsilon", EPS, "-out", out, "-csv", table)
+    assert p.returncode == 3, p.stderr
+    rows = _rows(table)
+    assert [r["status"] for r in rows] == ["outside"] * 4
+    for r in rows:
+        assert "indentation reaches" in r["reasons"] and "tether" in r["reasons"]
+        assert r["gamma_J_m2"] == r["E_star_Pa"] == ""
+        assert 1e-11 < float(r["pull_off_N"]) < 1e-8 and 0 < float(r["pull_off_err"]) < float(r["pull_off_N"])
+        assert float(r["energy_J"]) > 10 * float(r["energy_err"]) > 0
+    with h5py.File(out) as f:
+        assert f.attrs["kind"] == "map" and f.attrs["n_outside"] == 4
+        assert f["images/gamma"].shape == (128, 128) and np.isnan(f["images/gamma"][()]).all()
+        assert np.isfinite(f["images/pull_off"][()]).sum() == 4
+    fig = tmp_path / "qi.png"
+    p = subprocess.run([sys.executable, "-m", "petsc_adhesion", "plot", str(out), "-o", str(fig)], env=_env(),
+                       capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert fig.stat().st_size > 10_000
+
+
+# -- what a curve shows by itself -----------------------------------------------------------------------------
+def test_the_energy_of_a_rectangular_cycle_is_its_area():
+    """A cycle whose approach carries no force and whose retract holds -P over the whole travel L dissipates
+    P L (the trapezoidal rule is exact on it: its bar covers it), and its pull-off is P."""
+    from petsc_adhesion.fitting.data import MeasuredCurve
+    from petsc_adhesion.maps.result import measured_quantities
+
+    L, P, n = 50e-9, 2e-9, 200
+    z = np.r_[np.linspace(0, L, n), np.linspace(L, 0, n)]
+    F = np.r_[np.zeros(n), np.full(n, -P)]
+    q = measured_quantities(MeasuredCurve(z=z, F=F, turn=n, direction=1))
+    assert q.energy.value == pytest.approx(P * L, rel=1e-12) and q.energy.covers(P * L)
+    assert q.pull_off.value == pytest.approx(P, rel=1e-12)
+    # the same cycle measured with z falling towards the surface: the same energy
+    q = measured_quantities(MeasuredCurve(z=-z, F=F, turn=n, direction=-1))
+    assert q.energy.value == pytest.approx(P * L, rel=1e-12)
+
+
+# -- a synthetic map --------------------------------------------------------------------------------------------
+def test_a_synthetic_3x3_map_recovers_each_pixels_w_and_E():
+    """Nine curves made by the solver with 1% noise, w 0.04, 0.05, 0.06 J/m^2 across and mu 0.1, 0.15, 0.2
+    down (E* from eq. 9), fitted from one start (E* 30 GPa) through the Python API: every pixel's fit holds,
+    and its w and E* cover their truth within 1.96 bars."""
+    import petsc_adhesion as pa
+    from petsc_adhesion.fitting.synthetic import Sampling
+    from petsc_adhesion.maps.synthetic import synthetic_map
+
+    W, MU = (0.04, 0.05, 0.06), (0.1, 0.15, 0.2)
+    m = synthetic_map((3, 3), lambda ix, iy: _bodies(W[ix], MU[iy]), pa.Spring(K_SPRING),
+                      Sampling(noise=0.01 * 2 * math.pi * R * 0.05, points=100, z0=5e-9))
+    r = pa.fit_map(m, pa.Bodies(radius=R, young1=30e9, poisson1=0.0, epsilon=EPS), pa.Spring(K_SPRING))
+    assert isinstance(r, pa.MapResult) and r.grid.shape == (3, 3) and r.trustworthy
+    for p in r.pixels:
+        truth = _bodies(W[p.entry.ix], MU[p.entry.iy])
+        assert p.gamma.covers(truth.gamma, 1.96) and p.E_star.covers(truth.E, 1.96), (p.entry, p.gamma, p.E_star)
+        assert p.gamma.relative < 0.05 and p.E_star.relative < 0.3     # the bars say something
+    img = r.image("gamma")
+    assert img.shape == (3, 3) and np.all(np.abs(img / np.array(W)[None, :] - 1) < 0.1)
+
+
+# -- ranks, the journal ----------------------------------------------------------------------------------------
+#: Two evaluations of each fit from a start of 30 GPa: the cap reached (warned), cheap, and the same each time.
+FAST = ("-fit_max_evals", 2, "-fit_map_shape", "2,2", "-phys_young1", 30e9, "-phys_poisson1", 0.0)
+
+
+def _map(folder, out, *extra, np=1):
+    return run_cli("-fit_map", folder, *TIP, *FAST, "-out", out, "-csv", str(out) + ".csv", *extra, np=np)
+
+
+@pytest.fixture(scope="module")
+def whole(folder, tmp_path_factory):
+    """The folder's map on one rank, never interrupted: its HDF5 file."""
+    out = tmp_path_factory.mktemp("whole") / "one.h5"
+    p = _map(folder, out)
+    assert p.returncode == 3, p.stderr
+    return out
+
+
+def _pixels(path):
+    with h5py.File(path) as f:
+        return {k: v[()] for k, v in f["pixels"].items()}, {k: v[()] for k, v in f["images"].items()}
+
+
+def _same(a, b):
+    for (x, y) in zip(a, b):
+        assert x.keys() == y.keys()
+        for k in x:
+            assert np.array_equal(x[k], y[k], equal_nan=x[k].dtype.kind == "f"), k
+
+
+def test_one_and_two_ranks_give_the_same_map(folder, whole, tmp_path):
+    """The four curves on one rank and dealt to two: the same table, the same HDF5 pixels and images, to the
+    last bit; each curve flagged as it should be (the one without adhesion refused, the one that is no curve
+    unreadable, the two made by the solver stopped at the cap of two evaluations: warned, their numbers
+    kept)."""
+    two = tmp_path / "two.h5"
+    p2 = _map(folder, two, np=2)
+    assert p2.returncode == 3, p2.stderr
+    assert open(str(whole) + ".csv").read() == open(str(two) + ".csv").read()
+    _same(_pixels(whole), _pixels(two))
+    rows = _rows(str(whole) + ".csv")
+    assert [r["status"] for r in rows] == ["warned", "warned", "refused", "unreadable"]
+    assert "cap of 2 evaluations" in rows[0]["reasons"]
+    assert "no adhesion" in rows[2]["reasons"] and "c3.csv" in rows[3]["reasons"]
+    assert all(r["gamma_J_m2"] != "" for r in rows[:2]) and rows[2]["gamma_J_m2"] == rows[3]["gamma_J_m2"] == ""
+    with h5py.File(two) as f:
+        assert f.attrs["ranks"] == 2 and f.attrs["n_warned"] == 2
+    assert not os.path.exists(str(whole) + ".journal")
+
+
+def test_a_killed_map_resumes_to_the_same_files(folder, whole, tmp_path):
+    """A map killed (SIGKILL) once its journal holds a pixel: no output written, the journal kept; run again
+    (with progress lines: the rate, the time left), it takes that up and fits the rest, and its table and HDF5
+    pixels are those of the map never interrupted; the journal is gone after."""
+    out = tmp_path / "cut.h5"
+    journal = str(out) + ".journal"
+    cmd = [sys.executable, "-m", "petsc_adhesion", "-fit_map", str(folder), *map(str, TIP), *map(str, FAST),
+           "-out", str(out), "-csv", str(out) + ".csv"]
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        t0 = time.time()
+        while time.time() - t0 < 300:
+            if os.path.exists(journal) and open(journal).read().count("\n") >= 2:     # its header and a pixel
+                break
+            if proc.poll() is not None:
+                pytest.fail("the map ended before it was killed")
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGKILL)
+    finally:
+        proc.wait()
+    assert not out.exists() and os.path.exists(journal)
+    kept = open(journal).read().count("\n") - 1
+    assert 1 <= kept < 4
+    p = _map(folder, out, "-progress", "true", "-progress_interval", 1e-6)   # progress lines: the same map
+    assert p.returncode == 3, p.stderr
+    assert f"{kept} of 4 curves taken up from the journal" in p.stdout
+    assert f"map: 4 of 4 curves ({kept} from the journal), " in p.stderr and " curves/s, " in p.stderr
+    assert open(str(out) + ".csv").read() == open(str(whole) + ".csv").read()
+    _same(_pixels(out), _pixels(whole))
+    with h5py.File(out) as f:
+        assert f.attrs["resumed"] == kept
+    assert not os.path.exists(journal)
+
+
+# -- bad input ---------------------------------------------------------------------------------------------------
+def _refused(p, option):
+    assert p.returncode == 2, (p.returncode, p.stderr)
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"-{option}" in lines[0], p.stderr
+    return lines[0]
+
+
+def test_refusals_write_nothing_and_keep_an_earlier_result(folder, tmp_path):
+    """Each refusal one line naming the option, exit 2; the earlier -out untouched, no journal made."""
+    out = tmp_path / "m.h5"
+    out.write_bytes(b"an earlier result")
+    base = ("-fit_map", folder, *TIP, "-out", out)
+    _refused(run_cli("-fit_map", folder, *TIP), "out")                                 # nowhere to write
+    _refused(run_cli("-fit_map", tmp_path / "nonesuch", *TIP, "-out", out), "fit_map")
+    _refused(run_cli(*base, "-fit_map_shape", "1,1"), "fit_map")                       # 4 curves, 1 pixel
+    _refused(run_cli(*base, "-fit_map_shape", "2.5,3"), "fit_map_shape")
+    _refused(run_cli(*base, "-fit_curve", folder / "c0.csv"), "fit_curve")
+    _refused(run_cli(*base, "-summary", tmp_path / "s.json"), "summary")
+    _refused(run_cli(*base, "-fit_curve_index", 2), "fit_curve_index")
+    _refused(run_cli("-fit_curve", folder / "c0.csv", *TIP, "-fit_map_shape", "2,3"), "fit_map_shape")
+    _refused(run_cli("-fit_map", QI, "-phys_radius", R, "-phys_epsilon", EPS, "-out", out, "-fit_map_shape",
+                     "2,2"), "fit_map")                                               # a map file has its grid
+    _refused(run_cli("-fit_map", os.path.join(DATA, "NOTICE"), *TIP, "-out", out), "fit_map")     # no map
+    os.mkfifo(tmp_path / "fifo")
+    assert "is a FIFO" in _refused(run_cli("-fit_map", tmp_path / "fifo", *TIP, "-out", out), "fit_map")
+    assert out.read_bytes() == b"an earlier result"
+    assert not os.path.exists(str(out) + ".journal")
+
+
+def test_volts_without_a_sensitivity_and_a_journal_of_another_map(folder, tmp_path):
+    """A folder of curves in volts without -fit_invols: one line naming -fit_invols.  A journal left by a map
+    of other options: one line, the earlier result and the journal untouched."""
+    volts = tmp_path / "volts"
+    volts.mkdir()
+    z = np.r_[np.linspace(0, 1e-7, 30), np.linspace(1e-7, 0, 30)]
+    with open(volts / "v.csv", "w") as f:
+        f.write("z (m), deflection (V)\n")
+        f.writelines(f"{a!r}, {0.01 * i!r}\n" for i, a in enumerate(z))
+    out = tmp_path / "v.h5"
+    _refused(run_cli("-fit_map", volts, *TIP, "-out", out), "fit_invols")
+    assert not out.exists()
+    out.write_bytes(b"earlier")
+    journal = str(out) + ".journal"
+    with open(journal, "w") as f:
+        f.write('{"journal": "petsc-adhesion map journal", "format": 1, "fingerprint": "another"}\n')
+    before = open(journal).read()
+    line = _refused(run_cli("-fit_map", folder, *TIP, "-out", out), "fit_map")
+    assert "journal of another map" in line
+    assert out.read_bytes() == b"earlier" and open(journal).read() == before
+
+
+def test_a_list_with_a_missing_file_and_a_curve_without_retract_flags_them(folder, tmp_path):
+    """A list file placing its curves on the grid: a path that does not exist and a curve whose displacement
+    never turns back (no retract) are pixels flagged unreadable with their reasons; the map goes on."""
+    z = np.linspace(0, 1e-7, 40)
+    _write(tmp_path / "oneway.csv", z, np.linspace(0, 1e-9, 40))
+    lst = tmp_path / "m.list"
+    lst.write_text(f"# path ix iy\n{folder / 'c2.csv'} 0 0\nnonesuch.csv 1 0\noneway.csv 0 1\n")
+    out = tmp_path / "l.csv"
+    p = run_cli("-fit_map", lst, *TIP, "-csv", out)
+    assert p.returncode == 3, p.stderr
+    rows = _rows(out)
+    assert [(r["ix"], r["iy"], r["status"]) for r in rows] == [("0", "0", "refused"), ("1", "0", "unreadable"),
+                                                                ("0", "1", "unreadable")]
+    assert "nonesuch.csv" in rows[1]["reasons"]
+    assert "retract" in rows[2]["reasons"] or "turn" in rows[2]["reasons"], rows[2]["reasons"]
+
+
+def test_a_pixel_through_the_journal_is_the_same_value(tmp_path):
+    """A pixel of each kind (a fit's Measured with and without a bar, Missing, no rms; a flagged one) written
+    to a journal, a torn line after it (a kill mid-write), read back: equal to the pixels written, the torn
+    line dropped; a journal of another fingerprint refused."""
+    from petsc_adhesion.io.map import Journal, JournalError, pixel_fields
+    from petsc_adhesion.maps.result import Pixel
+    from petsc_adhesion.maps.source import MapEntry
+    from petsc_adhesion.tracing.measured import Measured, Missing
+
+    a = Pixel(MapEntry(0, 1, 2, 1.5e-6, None, "a.csv"), "warned", ("a misfit",), Measured(0.05, 1e-3),
+              Measured(3e10, None, note="held at 3e+10 Pa"), None, Measured(6.2e-9, 1e-11, note="n"),
+              Missing("no jump"), Measured(1.0e-16, 2e-18), 1.7, 1e-9, 12)
+    b = Pixel(MapEntry(1, 0, 0), "refused", ("no adhesion",), Missing("no adhesion"), Missing("no adhesion"),
+              Missing("no adhesion"), Missing("x"), Missing("y"), Missing("z"))
+    j = Journal(str(tmp_path / "m.journal"), "print")
+    j.start()
+    j.append([a, b])
+    with open(j.path, "a") as f:
+        f.write('{"index": 2, "ix"')                    # torn by a kill
+    back = [Pixel(MapEntry(**e), **f) for e, f in map(pixel_fields, j.read())]
+    assert back == [a, b]
+    j.start()                                           # the torn line cut off, the rest kept
+    assert open(j.path).read().count("\n") == 3 and len(j.read()) == 2
+    with pytest.raises(JournalError):
+        Journal(j.path, "another").read()
