@@ -20,6 +20,7 @@ package                what
 ``discretization``     grids, the influence operator, the problem in each frame
 ``tracing``            the curve over grids that follow the edge, error bars, results
 ``io``                 result files, their layout, the report, figures
+``population``         a particle population on a measured topography: its pull-off distribution
 ``app``                options, one run, studies over MPI, checkpoints, command line, API
 ``benchmarks``         measurements and the docs' figures (the library never imports it)
 =====================  ==============================================================
@@ -33,7 +34,7 @@ from .errors import InputError  # noqa: E402
 from .tracing.curve import Curve, Event, Solution  # noqa: E402
 from .version import __version__  # noqa: E402
 
-__all__ = ["__version__", "curve", "solve", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
+__all__ = ["__version__", "curve", "solve", "population", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
            "SolverChoice", "PetscSettings", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError"]
 
 #: Names loaded on first use (their modules import petsc4py.PETSc, which starts PETSc).
@@ -43,6 +44,10 @@ _LAZY = {"trace_curve": "tracing.trace", "solve_at": "tracing.trace", "GridChoic
 
 
 def __getattr__(name: str):
+    if name == "population":          # a package, callable as the population of particles (population/__init__.py)
+        import importlib
+
+        return importlib.import_module(".population", __name__)
     if name not in _LAZY:
         raise AttributeError(f"module 'petsc_adhesion' has no attribute '{name}'")
     import importlib

@@ -96,6 +96,9 @@ def population(topography, bodies, law: RadiusLaw, count: int | None = None, see
 
     Raises ValueError for inputs it cannot take (one line).
     """
+    from ..core.start import start_petsc
+
+    start_petsc()                      # a library call from a process that has not started PETSc
     from petsc4py import PETSc
 
     count = len(law.radii) if count is None and law.listed else count
