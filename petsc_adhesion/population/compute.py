@@ -26,7 +26,7 @@ import numpy as np
 
 from ..tracing.measured import Measured, Missing
 from .evaluate import EVALUATORS, GaussianRule, PullOffModel, SolverEvaluator, TableEvaluator, Trace
-from .footprint import ZONE_SHARE, Footprint
+from .footprint import MIN_PIXELS, ZONE_SHARE, Footprint
 from .results import BOOTSTRAP, Particle, PopulationResult, SpreadSample, lognormal_fit, radius_bins
 from .sample import RadiusLaw, draw
 
@@ -54,13 +54,13 @@ def _check(topography, bodies, law, count: int, evaluator: str) -> None:
         raise ValueError("bodies: the moduli are needed for mu (eq. 9)")
 
 
-def _particle(d, site, mu: float, unit: float, fp: Footprint | None, F, passes: int, note: str,
+def _particle(d, mu: float, unit: float, fp: Footprint | None, F, passes: int, note: str,
               epsilon: float) -> Particle:
     if fp is None:
-        return Particle(d.index, d.radius, site, mu, None, 0, 0.0, None, None, None, F, unit, passes, note)
+        return Particle(d.index, d.radius, None, mu, None, 0, 0.0, None, None, None, F, unit, passes, note)
     rms = fp.rms if fp.pixels else None
     note = note or (fp.note if isinstance(F, Measured) else "")
-    return Particle(d.index, d.radius, site, mu, fp.radius, fp.pixels, fp.independent, rms, fp.skewness,
+    return Particle(d.index, d.radius, fp.center, mu, fp.radius, fp.pixels, fp.independent, rms, fp.skewness,
                     None if rms is None else rms / epsilon, F, unit, passes, note)
 
 
@@ -118,38 +118,25 @@ def population(topography, bodies, law: RadiusLaw, count: int | None = None, see
     tab = TableEvaluator(table) if table is not None else None
     draws = [draw(i, seed, law) for i in _mine(count, rank, size)]
     mus = [replace(bodies, radius=d.radius, rms=None).mu for d in draws]
-    # the site: uniform over those whose footprint, sized by the smooth sphere's contact at pull-off, fits
-    sites, footprints = [], []
-    from .footprint import footprint_radius, md_contact_radius
-    for d, mu in zip(draws, mus):
-        sites.append(d.site(footprint_radius(md_contact_radius(mu), d.radius, eps), topography.size))
     mine = []
     if evaluator == "solver":
-        for d, mu, site in zip(draws, mus, sites):
-            unit = 2 * np.pi * d.radius * w
-            if site is None:
-                mine.append(_particle(d, None, mu, unit, None, Missing("the footprint is larger than the scan"),
-                                      0, "", eps))
-                continue
-            ev = solver.evaluate(topography, site, mu, d.radius, eps)
-            mine.append(_particle(d, site, mu, unit, ev.footprint, ev.pull_off, ev.passes, ev.note, eps))
+        for d, mu in zip(draws, mus):
+            ev = solver.evaluate(topography, d, mu, eps)
+            mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, ev.footprint, ev.pull_off, ev.passes, ev.note,
+                                  eps))
     else:
         assert tab is not None
-        for d, mu, site in zip(draws, mus, sites):
-            footprints.append(None if site is None else tab.footprint(topography, site, mu, d.radius, eps))
+        footprints = [tab.footprint(topography, d, mu, eps) for d, mu in zip(draws, mus)]
         ok = [k for k, fp in enumerate(footprints) if isinstance(fp, Footprint) and fp.usable]
         values = tab.evaluate_many(np.array([mus[k] for k in ok]),
                                    np.array([footprints[k].rms / eps for k in ok]))
         got = dict(zip(ok, values))
-        for k, (d, mu, site, fp) in enumerate(zip(draws, mus, sites, footprints)):
-            unit = 2 * np.pi * d.radius * w
-            if site is None:
-                F, fp = Missing("the footprint is larger than the scan"), None
-            elif isinstance(fp, Missing):
+        for k, (d, mu, fp) in enumerate(zip(draws, mus, footprints)):
+            if isinstance(fp, Missing):
                 F, fp = fp, None
             else:
                 F = got.get(k, Missing(fp.note))
-            mine.append(_particle(d, site, mu, unit, fp, F, 0, "", eps))
+            mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, fp, F, 0, "", eps))
     particles = tuple(sorted((p for part in mpi.allgather(mine) for p in part), key=lambda p: p.index))
     spread = _spread(particles, topography, eps, spread_count, evaluator, solver, tab, trace, mpi)
     forces = np.array([p.force.value for p in particles if isinstance(p.pull_off, Measured)])
@@ -166,8 +153,7 @@ def _spread(particles, topography, eps, spread_count, evaluator, solver, tab, tr
 
     if spread_count == 0:
         return Missing("no model spread asked for (spread_count 0)")
-    chosen = [p for p in particles if p.footprint_radius is not None and p.pixels and
-              not (isinstance(p.pull_off, Missing) and "pixels" in p.pull_off.reason)][:spread_count]
+    chosen = [p for p in particles if p.footprint_radius is not None and p.pixels >= MIN_PIXELS][:spread_count]
     if not chosen:
         return Missing("no particle with a footprint")
     rank, size = mpi.Get_rank(), mpi.Get_size()

@@ -129,33 +129,36 @@ class SolverEvaluator:
         """The pull-off and its contact radius of a particle of ``mu`` on ``heights`` (units of epsilon)."""
         return _pull_off(measured_model(mu, heights, self.trace.farfield), self.trace, self.comm)
 
-    def evaluate(self, topography, site: tuple, mu: float, R: float, epsilon: float) -> Evaluation:
-        """The particle of Tabor parameter ``mu`` and radius ``R`` (m) at ``site`` (m)."""
-        a = md_contact_radius(mu)
-        passes = 0
-        try:
-            fp = footprint(topography, site, footprint_radius(a, R, epsilon), epsilon)
-        except ValueError:
-            return Evaluation(None, Missing("the footprint leaves the scan"), 0)
+    def evaluate(self, topography, draw, mu: float, epsilon: float) -> Evaluation:
+        """The particle ``draw`` (:class:`~petsc_adhesion.population.sample.Draw`: its radius and site deviates)
+        of Tabor parameter ``mu``: its site uniform over those where its footprint (of each pass) fits."""
+        R = draw.radius
+
+        def at(a):
+            radius = footprint_radius(a, R, epsilon)
+            site = draw.site(radius, topography.size, topography.pixel_size)
+            return None if site is None else footprint(topography, site, radius, epsilon)
+
+        passes, a = 0, md_contact_radius(mu)
+        fp = at(a)
         while True:
+            if fp is None:
+                return Evaluation(None, Missing(f"the footprint (contact radius {a:.3g} sqrt(R epsilon) at "
+                                                f"pull-off) is larger than the scan"), passes)
             if not fp.usable:
                 return Evaluation(fp, Missing(fp.note), passes)
             F, a_new = self.measured(mu, fp.heights)
             passes += 1
             if not isinstance(F, Measured) or a_new is None:
                 return Evaluation(fp, F, passes)
-            try:
-                nxt = footprint(topography, site, footprint_radius(a_new, R, epsilon), epsilon)
-            except ValueError:
-                return Evaluation(fp, Missing(f"the footprint (contact radius {a_new:.3g} sqrt(R epsilon) at "
-                                              f"pull-off) leaves the scan"), passes)
+            nxt = at(a_new)
             # settled: the next footprint holds the same pixels to SETTLED (its heights, its pull-off the same)
-            if abs(nxt.pixels - fp.pixels) <= SETTLED * fp.pixels:
+            if nxt is not None and abs(nxt.pixels - fp.pixels) <= SETTLED * fp.pixels:
                 return Evaluation(fp, F, passes)
             if passes == PASSES:
                 return Evaluation(fp, F, passes, f"the footprint had not settled after {PASSES} solves "
-                                                 f"({fp.pixels} then {nxt.pixels} pixels)")
-            fp = nxt
+                                                 f"({fp.pixels} then {nxt.pixels if nxt else 'no'} pixels)")
+            fp, a = nxt, a_new
 
 
 class TableEvaluator:
@@ -166,12 +169,14 @@ class TableEvaluator:
     def __init__(self, model: PullOffModel):
         self.model = model
 
-    def footprint(self, topography, site: tuple, mu: float, R: float, epsilon: float) -> Footprint | Missing:
-        """The footprint sized by the smooth sphere's contact radius at pull-off."""
-        try:
-            return footprint(topography, site, footprint_radius(md_contact_radius(mu), R, epsilon), epsilon)
-        except ValueError:
-            return Missing("the footprint leaves the scan")
+    def footprint(self, topography, draw, mu: float, epsilon: float) -> Footprint | Missing:
+        """The footprint of ``draw`` sized by the smooth sphere's contact radius at pull-off, its site uniform
+        over those where it fits."""
+        radius = footprint_radius(md_contact_radius(mu), draw.radius, epsilon)
+        site = draw.site(radius, topography.size, topography.pixel_size)
+        if site is None:
+            return Missing("the footprint is larger than the scan")
+        return footprint(topography, site, radius, epsilon)
 
     def evaluate_many(self, mu: np.ndarray, sigma: np.ndarray) -> list[Measured | Missing]:
         """The rule's pull-off at each (mu, sigma), Missing outside the table."""

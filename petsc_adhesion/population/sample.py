@@ -61,12 +61,13 @@ class Draw:
     radius: float
     u: tuple
 
-    def site(self, margin: float, size: tuple) -> tuple | None:
-        """The site (m from the first pixel, each axis) of a footprint of radius ``margin`` (m) on a scan of
-        ``size`` (m): uniform over the sites whose footprint lies inside; None where none does."""
+    def site(self, margin: float, size: tuple, pixel: tuple) -> tuple | None:
+        """The site (m from the first pixel's centre, each axis) of a footprint of radius ``margin`` (m) on a
+        scan of ``size`` (m) and ``pixel`` (m), which covers half a pixel either side of the pixels' centres:
+        uniform over the sites whose footprint lies inside; None where none does."""
         if any(2 * margin > L for L in size):
             return None
-        return tuple(margin + u * (L - 2 * margin) for u, L in zip(self.u, size))
+        return tuple(margin - p / 2 + u * (L - 2 * margin) for u, L, p in zip(self.u, size, pixel))
 
 
 def draw(index: int, seed: int, law: RadiusLaw) -> Draw:
