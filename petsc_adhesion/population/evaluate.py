@@ -131,34 +131,29 @@ class SolverEvaluator:
 
     def evaluate(self, topography, draw, mu: float, epsilon: float) -> Evaluation:
         """The particle ``draw`` (:class:`~petsc_adhesion.population.sample.Draw`: its radius and site deviates)
-        of Tabor parameter ``mu``: its site uniform over those where its footprint (of each pass) fits."""
-        R = draw.radius
-
-        def at(a):
-            radius = footprint_radius(a, R, epsilon)
-            site = draw.site(radius, topography.size, topography.pixel_size)
-            return None if site is None else footprint(topography, site, radius, epsilon)
-
-        passes, a = 0, md_contact_radius(mu)
-        fp = at(a)
+        of Tabor parameter ``mu``: its site uniform over those where the first footprint (sized by the smooth
+        sphere's contact radius at pull-off, as the table's) fits; the later passes' footprints about the same
+        site (a larger one clipped at the scan's edge, noted)."""
+        R, passes, a = draw.radius, 0, md_contact_radius(mu)
+        site = draw.site(footprint_radius(a, R, epsilon), topography.size, topography.pixel_size)
+        if site is None:
+            return Evaluation(None, Missing("the footprint is larger than the scan"), 0)
+        fp = footprint(topography, site, footprint_radius(a, R, epsilon), epsilon)
         while True:
-            if fp is None:
-                return Evaluation(None, Missing(f"the footprint (contact radius {a:.3g} sqrt(R epsilon) at "
-                                                f"pull-off) is larger than the scan"), passes)
             if not fp.usable:
                 return Evaluation(fp, Missing(fp.note), passes)
             F, a_new = self.measured(mu, fp.heights)
             passes += 1
             if not isinstance(F, Measured) or a_new is None:
                 return Evaluation(fp, F, passes)
-            nxt = at(a_new)
+            nxt = footprint(topography, site, footprint_radius(a_new, R, epsilon), epsilon, clip=True)
             # settled: the next footprint holds the same pixels to SETTLED (its heights, its pull-off the same)
-            if nxt is not None and abs(nxt.pixels - fp.pixels) <= SETTLED * fp.pixels:
+            if abs(nxt.pixels - fp.pixels) <= SETTLED * fp.pixels:
                 return Evaluation(fp, F, passes)
             if passes == PASSES:
                 return Evaluation(fp, F, passes, f"the footprint had not settled after {PASSES} solves "
-                                                 f"({fp.pixels} then {nxt.pixels if nxt else 'no'} pixels)")
-            fp, a = nxt, a_new
+                                                 f"({fp.pixels} then {nxt.pixels} pixels)")
+            fp = nxt
 
 
 class TableEvaluator:

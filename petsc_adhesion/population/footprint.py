@@ -100,15 +100,19 @@ class Footprint:
         return self.pixels >= MIN_PIXELS
 
 
-def footprint(topography, center: tuple, radius: float, epsilon: float) -> Footprint:
+def footprint(topography, center: tuple, radius: float, epsilon: float, clip: bool = False) -> Footprint:
     """The heights of ``topography`` (a :class:`~petsc_adhesion.model.topography.Topography` map with its
     pixel size) within ``radius`` (m) of ``center`` (m), from their least-squares plane, in units of
-    ``epsilon`` (m).  ValueError where the disk leaves the scan."""
+    ``epsilon`` (m).  ValueError where the disk leaves the scan, unless ``clip``: then the pixels of the disk
+    inside the scan, and a note."""
     z, p = topography.heights, topography.pixel_size
     lo, hi = [], []
+    clipped = False
     for c, n, d in zip(center, z.shape, p):
         if c - radius < -d / 2 or c + radius > (n - 1) * d + d / 2:
-            raise ValueError(f"the footprint of radius {radius:g} m at {center} leaves the scan")
+            if not clip:
+                raise ValueError(f"the footprint of radius {radius:g} m at {center} leaves the scan")
+            clipped = True
         lo.append(max(0, int(math.floor((c - radius) / d))))
         hi.append(min(n, int(math.ceil((c + radius) / d)) + 1))
     # the bounding box of the disk, then the pixels whose centres lie within it
@@ -121,6 +125,8 @@ def footprint(topography, center: tuple, radius: float, epsilon: float) -> Footp
     share = topography.stats.independent[0] / z.size       # the map's independent samples per pixel
     independent = min(float(n), n * share)
     note = ""
+    if clipped:
+        note = "the footprint reaches past the scan's edge: the pixels inside it"
     if n < MIN_PIXELS:
         note = f"{n} pixels under the footprint, fewer than {MIN_PIXELS}: no height distribution"
     elif independent < MIN_INDEPENDENT:
