@@ -25,8 +25,9 @@ ALLOWED = {
     "family": {"core", "model", "discretization", "tracing"},
     "io": {"model", "tracing"},
     "fitting": {"core", "model", "discretization", "tracing", "family"},
-    "app": {"core", "model", "discretization", "tracing", "io", "fitting", "family"},
-    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app", "fitting", "family"},
+    "population": {"core", "model", "discretization", "tracing", "family"},
+    "app": {"core", "model", "discretization", "tracing", "io", "fitting", "family", "population"},
+    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app", "fitting", "family", "population"},
 }
 
 

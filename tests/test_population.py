@@ -324,3 +324,18 @@ def test_the_required_options_are_named(tmp_path):
         from petsc_adhesion.family import pull_off  # noqa: F401
     except ImportError:
         assert proc.returncode == 2 and "-pop_evaluator: table:" in proc.stderr, proc.stderr
+
+
+def test_a_footprint_of_few_independent_samples_keeps_its_value_with_a_note():
+    """The AFM image's correlation length (about 55 nm) is that of a 1 um particle's footprint: a couple of
+    independent samples under it, the pull-off computed (the model's answer for those heights) and noted."""
+    from petsc_adhesion.model.topography import read_topography
+
+    import petsc_adhesion as pa
+
+    topo = read_topography(AFM)
+    r = pa.population(topo, BODIES, RadiusLaw(median=1e-6), count=2, seed=1, spread_count=0)
+    for p in r.particles:
+        assert p.pull_off.value < 0 and p.independent < 5
+        assert "independent samples" in p.note
+    assert len(r.flagged) == 2
