@@ -127,16 +127,16 @@ def population(topography, bodies, law: RadiusLaw, count: int | None = None, see
     else:
         assert tab is not None
         footprints = [tab.footprint(topography, d, mu, eps) for d, mu in zip(draws, mus)]
-        ok = [k for k, fp in enumerate(footprints) if isinstance(fp, Footprint) and fp.usable]
-        values = tab.evaluate_many(np.array([mus[k] for k in ok]),
-                                   np.array([footprints[k].rms / eps for k in ok]))
-        got = dict(zip(ok, values))
-        for k, (d, mu, fp) in enumerate(zip(draws, mus, footprints)):
-            if isinstance(fp, Missing):
-                F, fp = fp, None
+        usable = {k: fp for k, fp in enumerate(footprints) if isinstance(fp, Footprint) and fp.usable}
+        values = tab.evaluate_many(np.array([mus[k] for k in usable]),
+                                   np.array([fp.rms / eps for fp in usable.values()]))
+        got = dict(zip(usable, values))
+        for k, (d, mu, found) in enumerate(zip(draws, mus, footprints)):
+            if isinstance(found, Footprint):
+                mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, found, got.get(k, Missing(found.note)), 0,
+                                      "", eps))
             else:
-                F = got.get(k, Missing(fp.note))
-            mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, fp, F, 0, "", eps))
+                mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, None, found, 0, "", eps))
     particles = tuple(sorted((p for part in mpi.allgather(mine) for p in part), key=lambda p: p.index))
     spread = _spread(particles, topography, eps, spread_count, evaluator, solver, tab, trace, mpi)
     forces = np.array([p.force.value for p in particles if isinstance(p.pull_off, Measured)])

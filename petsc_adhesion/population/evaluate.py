@@ -63,8 +63,10 @@ class TableMissing(RuntimeError):
 def load_table() -> PullOffModel:
     """The Gaussian rule's pull-off table of ``petsc_adhesion.family.pull_off`` (``PullOffTable.default()``);
     :class:`TableMissing` where it is not installed."""
-    try:
-        from ..family import pull_off          # the table of another part: present once it is built
+    import importlib
+
+    try:       # the table of family/, by name: present once it is built (an installation without it refuses)
+        pull_off = importlib.import_module("..family.pull_off", __package__)
     except ImportError:
         raise TableMissing("the pull-off table (petsc_adhesion.family.pull_off) is not in this installation; "
                            "use the solver") from None
