@@ -339,3 +339,14 @@ def test_a_footprint_of_few_independent_samples_keeps_its_value_with_a_note():
         assert p.pull_off.value < 0 and p.independent < 5
         assert "independent samples" in p.note
     assert len(r.flagged) == 2
+
+
+def test_a_footprint_past_the_edge_is_refused_or_clipped_with_a_note():
+    """A later pass's wider footprint about the first's site may reach past the scan: its pixels inside, noted
+    (the disk's area inside the scan, to a pixel's rim); asked without clip, a ValueError."""
+    topo = gaussian_surface(n=128)
+    with pytest.raises(ValueError):
+        footprint(topo, (10e-9, 100e-9), 20e-9, EPS)
+    fp = footprint(topo, (-1e-9, 100e-9), 20e-9, EPS, clip=True)      # the centre on the scan's edge
+    assert "past the scan's edge" in fp.note
+    assert fp.pixels == pytest.approx(math.pi * 10 ** 2 / 2, rel=0.1)

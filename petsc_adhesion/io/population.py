@@ -54,6 +54,19 @@ def _finite(a) -> list:
     return [None if not math.isfinite(float(x)) else float(x) for x in a]
 
 
+#: The most distinct reasons of missing pull-offs the report and the summary name (the CSV has every one).
+REASONS = 5
+
+
+def _reasons(result) -> tuple[list, int]:
+    """The commonest reasons of the missing pull-offs with their counts (at most REASONS), and how many
+    other reasons there are."""
+    from collections import Counter
+
+    counts = Counter(p.pull_off.reason for p in result.missing).most_common()
+    return counts[:REASONS], max(0, len(counts) - REASONS)
+
+
 def population_summary(head: dict, given: dict, result) -> dict:
     """The JSON summary: the inputs, the counts, the lognormal fit, the bins, the model spread."""
     topo = result.topography
@@ -66,7 +79,8 @@ def population_summary(head: dict, given: dict, result) -> dict:
                        "independent": topo.stats.independent[0]},
         "bodies": result.bodies.describe()["inputs"] | {"gamma_J_m2": result.bodies.work_of_adhesion},
         "pull_offs": int(result.forces.size), "missing": len(result.missing), "flagged": len(result.flagged),
-        "missing_reasons": sorted({p.pull_off.reason for p in result.missing}),
+        "missing_reasons": [{"reason": r, "count": n} for r, n in _reasons(result)[0]],
+        "missing_other_reasons": _reasons(result)[1],
         "ranks": result.ranks, "wall_time_s": result.wall_time, "cpu_time_s": result.cpu_time}}
     pop = out["population"]
     if hasattr(fit, "median"):
@@ -209,9 +223,11 @@ def report_population(result, out=None) -> None:
              f"evaluator {result.evaluator}: {result.forces.size} pull-offs, {len(result.missing)} missing, "
              f"{len(result.flagged)} flagged; {result.ranks} rank(s), {result.wall_time:.3g} s "
              f"({result.cpu_time:.3g} s CPU)"]
-    for reason in sorted({p.pull_off.reason for p in result.missing}):
-        n = sum(1 for p in result.missing if p.pull_off.reason == reason)
+    reasons, others = _reasons(result)
+    for reason, n in reasons:
         lines.append(f"  missing ({n}): {reason}")
+    if others:
+        lines.append(f"  missing: {others} other reasons (the CSV's column missing)")
     fit = result.fit
     if hasattr(fit, "median"):
         lines.append(f"  lognormal of |F|: median {fit.median.value * 1e9:.5g} +- {fit.median.err * 1e9:.2g} nN, "

@@ -163,7 +163,7 @@ def _spread(particles, topography, eps, spread_count, evaluator, solver, tab, tr
     mine = []
     for k in range(rank, len(chosen), size):
         p = chosen[k]
-        fp = footprint(topography, p.site, p.footprint_radius, eps)
+        fp = footprint(topography, p.site, p.footprint_radius, eps, clip=True)
         measured = p.pull_off if evaluator == "solver" else solver.measured(p.mu, fp.heights)[0]
         if evaluator == "table":
             ruled = p.pull_off
