@@ -133,29 +133,36 @@ class SolverEvaluator:
 
     def evaluate(self, topography, draw, mu: float, epsilon: float) -> Evaluation:
         """The particle ``draw`` (:class:`~petsc_adhesion.population.sample.Draw`: its radius and site deviates)
-        of Tabor parameter ``mu``: its site uniform over those where the first footprint (sized by the smooth
-        sphere's contact radius at pull-off, as the table's) fits; the later passes' footprints about the same
-        site (a larger one clipped at the scan's edge, noted)."""
+        of Tabor parameter ``mu``.  Each pass's site is the draw's uniform deviates mapped onto the sites where
+        that pass's footprint fits (:meth:`~petsc_adhesion.population.sample.Draw.site`): the settled footprint
+        lies inside the scan, its site uniform over those where it does (a pass moves it by at most the
+        change of the footprint's radius)."""
         R, passes, a = draw.radius, 0, md_contact_radius(mu)
-        site = draw.site(footprint_radius(a, R, epsilon), topography.size, topography.pixel_size)
-        if site is None:
-            return Evaluation(None, Missing("the footprint is larger than the scan"), 0)
-        fp = footprint(topography, site, footprint_radius(a, R, epsilon), epsilon)
+
+        def at(a: float) -> Footprint | None:
+            radius = footprint_radius(a, R, epsilon)
+            site = draw.site(radius, topography.size, topography.pixel_size)
+            return None if site is None else footprint(topography, site, radius, epsilon)
+
+        fp = at(a)
         while True:
+            if fp is None:
+                return Evaluation(None, Missing(f"the footprint (contact radius {a:.3g} sqrt(R epsilon) at "
+                                                f"pull-off) is larger than the scan"), passes)
             if not fp.usable:
                 return Evaluation(fp, Missing(fp.note), passes)
             F, a_new = self.measured(mu, fp.heights)
             passes += 1
             if not isinstance(F, Measured) or a_new is None:
                 return Evaluation(fp, F, passes)
-            nxt = footprint(topography, site, footprint_radius(a_new, R, epsilon), epsilon, clip=True)
+            nxt = at(a_new)
             # settled: the next footprint holds the same pixels to SETTLED (its heights, its pull-off the same)
-            if abs(nxt.pixels - fp.pixels) <= SETTLED * fp.pixels:
+            if nxt is not None and abs(nxt.pixels - fp.pixels) <= SETTLED * fp.pixels:
                 return Evaluation(fp, F, passes)
             if passes == PASSES:
                 return Evaluation(fp, F, passes, f"the footprint had not settled after {PASSES} solves "
-                                                 f"({fp.pixels} then {nxt.pixels} pixels)")
-            fp = nxt
+                                                 f"({fp.pixels} then {nxt.pixels if nxt else 'no'} pixels)")
+            fp, a = nxt, a_new
 
 
 class TableEvaluator:

@@ -19,6 +19,11 @@ for the table the smooth sphere's Maugis-Dugdale contact radius at pull-off
 (:func:`md_contact_radius`; roughness lowers it, so the footprint is if anything too
 large by a little).
 
+**Its site.**  Uniform over the sites where the footprint lies inside the scan: each
+pass of the solver's iteration maps the particle's uniform deviates onto the sites of
+its own footprint's radius (sample.py), so the settled footprint lies inside.  ``clip``
+takes the pixels of a disk inside the scan where one reaches past it (noted).
+
 **Its heights.**  The pixels whose centres lie within r_f of the site, their heights
 measured from the least-squares plane through them (the particle rests on its own
 patch: a slope or a step the whole map's plane leaves in the patch is not roughness the
