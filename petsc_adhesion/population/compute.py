@@ -157,7 +157,7 @@ def _spread(particles, topography, eps, spread_count, evaluator, solver, tab, tr
     if not chosen:
         return Missing("no particle with a footprint")
     rank, size = mpi.Get_rank(), mpi.Get_size()
-    rule = tab if tab is not None else None
+    rule = tab
     source = "table" if rule is not None else "the solver's Gaussian rule (16-point Hermite)"
     exact = GaussianRule(trace, solver.comm)
     mine = []
