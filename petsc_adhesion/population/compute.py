@@ -25,7 +25,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..tracing.measured import Measured, Missing
-from .evaluate import EVALUATORS, GaussianRule, PullOffModel, SolverEvaluator, TableEvaluator, Trace
+from .evaluate import EVALUATORS, Evaluator, GaussianRule, PullOffModel, SolverEvaluator, TableEvaluator, Trace
 from .footprint import MIN_PIXELS, ZONE_SHARE, Footprint
 from .results import BOOTSTRAP, Particle, PopulationResult, SpreadSample, lognormal_fit, radius_bins
 from .sample import RadiusLaw, draw
@@ -118,25 +118,12 @@ def population(topography, bodies, law: RadiusLaw, count: int | None = None, see
     tab = TableEvaluator(table) if table is not None else None
     draws = [draw(i, seed, law) for i in _mine(count, rank, size)]
     mus = [replace(bodies, radius=d.radius, rms=None).mu for d in draws]
-    mine = []
-    if evaluator == "solver":
-        for d, mu in zip(draws, mus):
-            ev = solver.evaluate(topography, d, mu, eps)
-            mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, ev.footprint, ev.pull_off, ev.passes, ev.note,
-                                  eps))
-    else:
-        assert tab is not None
-        footprints = [tab.footprint(topography, d, mu, eps) for d, mu in zip(draws, mus)]
-        usable = {k: fp for k, fp in enumerate(footprints) if isinstance(fp, Footprint) and fp.usable}
-        values = tab.evaluate_many(np.array([mus[k] for k in usable]),
-                                   np.array([fp.rms / eps for fp in usable.values()]))
-        got = dict(zip(usable, values))
-        for k, (d, mu, found) in enumerate(zip(draws, mus, footprints)):
-            if isinstance(found, Footprint):
-                mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, found, got.get(k, Missing(found.note)), 0,
-                                      "", eps))
-            else:
-                mine.append(_particle(d, mu, 2 * np.pi * d.radius * w, None, found, 0, "", eps))
+    chosen: Evaluator = solver
+    if evaluator == "table":
+        assert tab is not None, "a table evaluator without its table: refused above"
+        chosen = tab
+    mine = [_particle(d, mu, 2 * np.pi * d.radius * w, ev.footprint, ev.pull_off, ev.passes, ev.note, eps)
+            for d, mu, ev in zip(draws, mus, chosen.evaluate_all(topography, draws, mus, eps))]
     particles = tuple(sorted((p for part in mpi.allgather(mine) for p in part), key=lambda p: p.index))
     spread = _spread(particles, topography, eps, spread_count, evaluator, solver, tab, trace, mpi)
     forces = np.array([p.force.value for p in particles if isinstance(p.pull_off, Measured)])

@@ -1,4 +1,5 @@
-"""A particle's pull-off from its footprint's heights: two evaluators behind one protocol.
+"""A particle's pull-off from its footprint's heights: two evaluators behind one protocol (:class:`Evaluator`:
+``name`` and ``evaluate_all``, an :class:`Evaluation` of each particle).
 
 **solver** (:class:`SolverEvaluator`): the curve traced by the solver under the
 particle's own measured law (the footprint's heights, eq. 7 averaged over their
@@ -33,7 +34,7 @@ from ..tracing.measured import Measured, Missing
 from ..tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, step_scale, trace_curve
 from .footprint import Footprint, footprint, footprint_radius, md_contact_radius
 
-__all__ = ["PullOffModel", "TableMissing", "load_table", "SolverEvaluator", "TableEvaluator", "GaussianRule",
+__all__ = ["Evaluator", "PullOffModel", "TableMissing", "load_table", "SolverEvaluator", "TableEvaluator", "GaussianRule",
            "Evaluation", "PASSES", "SETTLED", "EVALUATORS"]
 
 #: The most solves of the solver's footprint iteration.
@@ -54,6 +55,17 @@ class PullOffModel(Protocol):
 
     def covers(self, mu: np.ndarray, sigma: np.ndarray) -> np.ndarray:
         """Whether each (mu, sigma) lies in the model's range."""
+
+
+class Evaluator(Protocol):
+    """What the population asks of an evaluator: its ``name`` (the run says which it used) and
+    ``evaluate_all(topography, draws, mus, epsilon)``, an :class:`Evaluation` of each particle (its draw and
+    Tabor parameter), in their order."""
+
+    name: str
+
+    def evaluate_all(self, topography, draws: list, mus: list, epsilon: float) -> list:
+        """Each particle's footprint and pull-off."""
 
 
 class TableMissing(RuntimeError):
@@ -165,6 +177,11 @@ class SolverEvaluator:
             fp, a = nxt, a_new
 
 
+    def evaluate_all(self, topography, draws: list, mus: list, epsilon: float) -> list:
+        """Each particle by :meth:`evaluate`, one after the other."""
+        return [self.evaluate(topography, d, mu, epsilon) for d, mu in zip(draws, mus)]
+
+
 class TableEvaluator:
     """The Gaussian rule at the footprint's rms, from a :class:`PullOffModel` (``model``)."""
 
@@ -181,6 +198,15 @@ class TableEvaluator:
         if site is None:
             return Missing("the footprint is larger than the scan")
         return footprint(topography, site, radius, epsilon)
+
+    def evaluate_all(self, topography, draws: list, mus: list, epsilon: float) -> list:
+        """Each particle's footprint, then the rule at their rms in one call of the table."""
+        found = [self.footprint(topography, d, mu, epsilon) for d, mu in zip(draws, mus)]
+        usable = {k: fp for k, fp in enumerate(found) if isinstance(fp, Footprint) and fp.usable}
+        values = dict(zip(usable, self.evaluate_many(np.array([mus[k] for k in usable]),
+                                                     np.array([fp.rms / epsilon for fp in usable.values()]))))
+        return [Evaluation(fp, values.get(k, Missing(fp.note))) if isinstance(fp, Footprint) else
+                Evaluation(None, fp) for k, fp in enumerate(found)]
 
     def evaluate_many(self, mu: np.ndarray, sigma: np.ndarray) -> list[Measured | Missing]:
         """The rule's pull-off at each (mu, sigma), Missing outside the table."""
