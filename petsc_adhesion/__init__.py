@@ -22,6 +22,7 @@ package                what
 ``fitting``            measurements to the material: a pull-off's w, a force curve's w and E*
 ``maps``               force maps: every curve of a map fitted over MPI ranks (:func:`fit_map`)
 ``io``                 result files, their layout, the report, figures
+``population``         a particle population on a measured topography: its pull-off distribution
 ``app``                options, one run, studies over MPI, checkpoints, command line, API
 ``benchmarks``         measurements and the docs' figures (the library never imports it)
 =====================  ==============================================================
@@ -35,7 +36,7 @@ from .errors import InputError  # noqa: E402
 from .tracing.curve import Curve, Event, Solution  # noqa: E402
 from .version import __version__  # noqa: E402
 
-__all__ = ["__version__", "curve", "solve", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
+__all__ = ["__version__", "curve", "solve", "population", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
            "SolverChoice", "PetscSettings", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError",
            "fit_curve", "CurveFit", "Spring", "FitChoice", "read_curve", "MeasuredCurve", "fit_map", "open_map", "MapResult",
            "Pixel"]
@@ -50,6 +51,10 @@ _LAZY = {"trace_curve": "tracing.trace", "solve_at": "tracing.trace", "GridChoic
 
 
 def __getattr__(name: str):
+    if name == "population":          # a package, callable as the population of particles (population/__init__.py)
+        import importlib
+
+        return importlib.import_module(".population", __name__)
     if name not in _LAZY:
         raise AttributeError(f"module 'petsc_adhesion' has no attribute '{name}'")
     import importlib

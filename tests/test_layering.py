@@ -26,8 +26,9 @@ ALLOWED = {
     "io": {"model", "tracing"},
     "fitting": {"core", "model", "discretization", "tracing", "family"},
     "maps": {"core", "model", "discretization", "tracing", "fitting", "family"},
-    "app": {"core", "model", "discretization", "tracing", "io", "fitting", "family", "maps"},
-    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app", "fitting", "family", "maps"},
+    "population": {"core", "model", "discretization", "tracing", "family"},
+    "app": {"core", "model", "discretization", "tracing", "io", "fitting", "family", "maps", "population"},
+    "benchmarks": {"core", "model", "discretization", "tracing", "io", "app", "fitting", "family", "maps", "population"},
 }
 
 

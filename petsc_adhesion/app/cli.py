@@ -157,6 +157,10 @@ def _program(argv: list[str]) -> int:
         from . import fit
         return fit.main(opts, argv, helping)
     run.refuse_fit_options(opts)
+    from .population import is_population
+    if collective(PETSc.COMM_WORLD, is_population, opts):
+        from . import population
+        return population.main(opts, argv, helping)
     if collective(PETSc.COMM_WORLD, run.is_study, opts):
         from . import study
         return study.main(opts, argv, helping)

@@ -10,7 +10,8 @@ __all__ = ["HELP_GROUPS", "help_groups", "shown_default", "print_help", "help_te
 #: The groups of -help and docs/usage.md: (title, the name prefixes of its options); the last takes the rest.
 HELP_GROUPS = (("model (eq. 9-14) and its solver", ("adh_",)), ("physical units", ("phys_",)), ("grid", ("grid_",)),
                ("continuation, events and error bars", ("cont_", "target_")), ("studies of many cases", ("study_",)),
-               ("fitting a measurement", ("fit_",)), ("output and progress", ()))
+               ("fitting a measurement", ("fit_",)), ("a particle population", ("pop_",)),
+               ("output and progress", ()))
 
 
 def help_groups() -> list[tuple[str, list[Option]]]:

@@ -277,6 +277,24 @@ TABLE = {o.name: o for o in [
            "the journal beside it resumes a killed map (docs/maps.md)"),
     Option("fit_map_shape", "reals", (), "fit: the grid nx,ny a -fit_map folder or list fills row by row (x "
            "fastest; default a row)", 1.0, 1e6),
+    # a particle population on a topography (petsc_adhesion.population; docs/population.md)
+    Option("pop_count", "int", None, "population: the number of particles, each landing on a random site of "
+           "-adh_topography (default: as many as -pop_radius_file lists)", 1, 10**6),
+    Option("pop_radius_median", "real", None, "population: the median radius of the particles (m); their radii "
+           "lognormal with -pop_radius_spread", 0.0, 1e-2, lo_open=True),
+    Option("pop_radius_spread", "real", 1.0, "population: the geometric standard deviation of the radii (1: every "
+           "particle of -pop_radius_median)", 1.0, 100.0),
+    Option("pop_radius_file", "string", None, "population: a text file of the particles' radii (m), one a line "
+           "('#' comments), instead of -pop_radius_median"),
+    Option("pop_seed", "int", 0, "population: the seed of every particle's radius and site (drawn by its index: "
+           "the same particles on any number of ranks)", 0, 2**31 - 1),
+    Option("pop_evaluator", "choice", "solver", "population: each pull-off by the solver under the footprint's "
+           "measured heights (exact for the model), or by the table of the Gaussian rule at the footprint's rms "
+           "(fast)", choices=("solver", "table")),
+    Option("pop_spread_count", "int", 50, "population: particles evaluated under both the measured law and the "
+           "Gaussian rule on the same footprints, the model spread (0: none)", 0, 10**6),
+    Option("pop_bins", "int", 8, "population: bins of the pull-off against radius (log-spaced)", 1, 1000),
+    Option("pop_bootstrap", "int", 200, "population: bootstrap resamples of the lognormal fit's bars", 10, 10**5),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
