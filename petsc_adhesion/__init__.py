@@ -36,7 +36,7 @@ from .errors import InputError  # noqa: E402
 from .tracing.curve import Curve, Event, Solution  # noqa: E402
 from .version import __version__  # noqa: E402
 
-__all__ = ["__version__", "curve", "solve", "population", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
+__all__ = ["__version__", "curve", "solve", "particle_population", "trace_curve", "solve_at", "Model", "Bodies", "GridChoice",
            "SolverChoice", "PetscSettings", "CurveRequest", "Settings", "curve_settings", "Curve", "Event", "Solution", "InputError",
            "fit_curve", "CurveFit", "Spring", "FitChoice", "read_curve", "MeasuredCurve", "fit_map", "open_map", "MapResult",
            "Pixel"]
@@ -51,10 +51,10 @@ _LAZY = {"trace_curve": "tracing.trace", "solve_at": "tracing.trace", "GridChoic
 
 
 def __getattr__(name: str):
-    if name == "population":          # a package, callable as the population of particles (population/__init__.py)
+    if name == "particle_population":  # the package population/ keeps its own name; its call is this one
         import importlib
 
-        return importlib.import_module(".population", __name__)
+        return importlib.import_module(".population.compute", __name__).population
     if name not in _LAZY:
         raise AttributeError(f"module 'petsc_adhesion' has no attribute '{name}'")
     import importlib

@@ -334,7 +334,7 @@ def test_a_footprint_of_few_independent_samples_keeps_its_value_with_a_note():
     import petsc_adhesion as pa
 
     topo = read_topography(AFM)
-    r = pa.population(topo, BODIES, RadiusLaw(median=1e-6), count=2, seed=1, spread_count=0)
+    r = pa.particle_population(topo, BODIES, RadiusLaw(median=1e-6), count=2, seed=1, spread_count=0)
     for p in r.particles:
         assert p.pull_off.value < 0 and p.independent < 5
         assert "independent samples" in p.note

@@ -5,7 +5,7 @@
     from petsc_adhesion.population.sample import RadiusLaw
     topo = read_topography("tests/data/wsxm-afm-topography.top")
     bodies = pa.Bodies(radius=10e-6, young1=7e10, poisson1=0.17, gamma=0.05, epsilon=4e-10)
-    result = pa.population(topo, bodies, RadiusLaw(median=10e-6, spread=1.3), count=200, seed=1)
+    result = pa.particle_population(topo, bodies, RadiusLaw(median=10e-6, spread=1.3), count=200, seed=1)
     print(result.fit.median.value, "+-", result.fit.median.err, "N")
 
 Particle i (its radius and site drawn from the seed by its index, sample.py) is
