@@ -20,8 +20,10 @@ against the roughness, with the seed-to-seed spread of the explicit runs as thei
     nice -n 10 python -m petsc_adhesion.benchmarks.peer_rough --data docs/data/peer_rough.json
 
 (``.venv-peer`` is the user's to make, not part of the repository.)  The first command runs this file as a
-script under the peer's interpreter: at module level it imports nothing but the standard library and numpy, and the peer's packages and ours are imported inside the
-functions of each side.  ``muFFT`` 0.95 (the last on the registry) is left out: installed beside muGrid 1.6
+script under the peer's interpreter: at module level it imports nothing but the standard library and numpy,
+and the peer's packages and ours are imported inside the functions of each side.  The peer's cases can be
+split over processes (``peer --cases 64:0.3:1,... --out part.json``, ``--retract``) and their files joined
+(``peer_rough.py merge --out docs/data/peer_rough.json part1.json part2.json ...``), as the stored file was.  ``muFFT`` 0.95 (the last on the registry) is left out: installed beside muGrid 1.6
 it replaces muGrid's ``__init__`` with one that lacks ``FFTEngine``, and ContactMechanics 1.8.3 then fails to
 import (``ImportError: cannot import name 'FFTEngine' from 'muGrid'``); ContactMechanics needs muGrid only.
 
@@ -65,8 +67,9 @@ N_MAIN, N_FINE = 64, 128
 #: rms heights (epsilon) and seeds of the explicit surfaces.
 SIGMAS = (0.1, 0.3, 1.0, 2.0)
 SEEDS = (1, 2, 3)
-#: The refined case (sigma, seed) and the smooth sphere (sigma 0) at both grids.
-REFINED = ((0.0, 0), (0.3, 1))
+#: The refinement: the smooth sphere and one rough surface (sigma, seed), their retraction alone from lam_hi
+#: down to lam_lo (about the pull-off) on both grids.
+REFINED = ((0.0, 0, 0.5, -1.4), (0.3, 2, 0.5, -1.6))
 #: Displacement-control lattice step, the pull-off's refinement step, the approach's stop (the load at
 #: equilibrium, past the pull-off), the start before the highest asperity under the sphere.
 DLAM, DLAM_FINE, F_STOP, START_GAP = 0.05, 0.01, 0.0, 2.6
@@ -233,6 +236,32 @@ def peer_curve(n: int, sigma: float, seed: int, log=print) -> dict:
     return out
 
 
+def peer_retract(n: int, sigma: float, seed: int, lam_hi: float, lam_lo: float, log=print) -> dict:
+    """The grid's refinement at a fifth of a curve's cost: the retraction alone, from a state in contact at
+    lam_hi (a cold start, where the contact branch is the only state) down the lattice to lam_lo, the
+    pull-off refined as :func:`peer_curve` does.  Run on both grids, its pull-off on the coarse one is the
+    full curve's (the same branch), and the two grids' difference is the pixel's error."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    system = PeerSystem(n, sigma, seed)
+    lams = DLAM * np.arange(int(round(lam_hi / DLAM)), int(round(lam_lo / DLAM)) - 1, -1)
+    retract, disps = march(system, None, lams)
+    i = int(np.argmin([s["F"] for s in retract]))
+    fine = []
+    if 0 < i < len(retract) - 1:
+        fine, _ = march(system, disps[i - 1],
+                        retract[i - 1]["lam"] - DLAM_FINE * np.arange(1, int(round(2 * DLAM / DLAM_FINE))))
+    best = min(retract + fine, key=lambda s: s["F"])
+    out = dict(n=n, sigma=sigma, seed=seed, digest=digest(system.z), pixel=system.h, lam_hi=lam_hi, lam_lo=lam_lo,
+               retract={k: [s[k] for s in retract] for k in retract[0]},
+               pull_off=dict(F=best["F"], lam=best["lam"], F_lattice=retract[i]["F"], lam_lattice=retract[i]["lam"],
+                             at_end=i in (0, len(retract) - 1)),
+               solves=system.solves, iterations=system.iterations,
+               wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0)
+    log(f"n {n} sigma {sigma} seed {seed} retract from {lam_hi}: pull-off F {best['F']:.5f} at lambda "
+        f"{best['lam']:.3f}; {system.solves} solves, {out['cpu_time_s']:.1f} s CPU")
+    return out
+
+
 def hysteresis(approach, retract) -> float:
     """The energy of the displacement-controlled cycle, the integral of F_approach - F_retract over lambda
     on the shared lattice (trapezoid; units 2 pi R gamma epsilon)."""
@@ -275,13 +304,30 @@ def peer_main(argv) -> int:
     p = argparse.ArgumentParser(prog="peer_rough.py peer")
     p.add_argument("--out", required=True)
     p.add_argument("--cases", default=None,
-                   help="n:sigma:seed,... (default: the smooth sphere and every sigma and seed at N_MAIN, then REFINED at N_FINE)")
+                   help="n:sigma:seed,...: these curves (with neither option: every curve at N_MAIN, "
+                        "then the refinement)")
+    p.add_argument("--retract", default=None,
+                   help="n:sigma:seed:lam_hi:lam_lo,...: the retraction alone (the grid's refinement)")
     a = p.parse_args(argv)
-    if a.cases:
-        cases = [(int(n), float(s), int(k)) for n, s, k in (c.split(":") for c in a.cases.split(","))]
-    else:
-        cases = [(N_MAIN, 0.0, 0)] + [(N_MAIN, s, k) for s in SIGMAS for k in SEEDS]
-        cases += [(N_FINE, s, k) for s, k in REFINED]
+    if a.retract is None and a.cases is None:     # the whole benchmark: the curves, then the refinement
+        peer_main(["--out", a.out, "--cases", ",".join(f"{N_MAIN}:{s}:{k}" for s in (0.0,) + SIGMAS
+                                                       for k in ((0,) if s == 0.0 else SEEDS))])
+        a.retract = ",".join(f"{n}:{s}:{k}:{hi}:{lo}" for s, k, hi, lo in REFINED for n in (N_MAIN, N_FINE))
+    if a.retract:
+        data = {"retract_runs": []}
+        if os.path.exists(a.out):
+            with open(a.out) as f:
+                data = json.load(f)
+        for c in a.retract.split(","):
+            n, s, k, hi, lo = c.split(":")
+            run = peer_retract(int(n), float(s), int(k), float(hi), float(lo))
+            run.update(versions=_versions(), date=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg=os.getloadavg())
+            data["retract_runs"] = [r for r in data.get("retract_runs", [])
+                                    if (r["n"], r["sigma"], r["seed"]) != (run["n"], run["sigma"], run["seed"])]
+            data["retract_runs"].append(run)
+            write_atomic(a.out, data)
+        return 0
+    cases = [(int(n), float(s), int(k)) for n, s, k in (c.split(":") for c in a.cases.split(","))]
     data = {"runs": []}
     if os.path.exists(a.out):
         with open(a.out) as f:
@@ -381,6 +427,10 @@ def ours_main(argv) -> int:
                 key = f"{run['n']}:{run['sigma']}:{run['seed']}"
                 ours["runs"][key] = ours_for(run, tmp)
                 print(key, {k: round(v["pull_off"]["F"], 5) for k, v in ours["runs"][key].items()}, flush=True)
+            ours["retract"] = {}
+            for run in peer.get("retract_runs", []):
+                key = f"{run['n']}:{run['sigma']}:{run['seed']}"
+                ours["retract"][key] = ours_for(run, tmp)
             for sigma in sorted({r["sigma"] for r in peer["runs"] if r["sigma"] > 0 and r["n"] == N_MAIN}):
                 tops = [r["top"] for r in peer["runs"] if r["sigma"] == sigma and r["n"] == N_MAIN]
                 ours["gaussian"][str(sigma)] = gaussian_laws(sigma, tops)
@@ -450,27 +500,39 @@ def tables(peer: dict, ours: dict) -> str:
                      + ", ".join(f"{(r['snap_on'] or {}).get('count', 0)}/{(r['snap_off'] or {}).get('count', 0)}"
                                  for r in rs) + " |")
     lines += ["", "The grid: the same continuous surfaces on 64 and 128 pixels a side (pixel 0.156 and "
-              "0.078 sqrt(R epsilon)), the explicit pull-off and the mean field of each grid's pixel heights.", "",
-              "| surface | pixels | explicit pull-off F | its lambda | mean field (the square's heights) | "
-              "CPU (s) |", "|---|---|---|---|---|---|"]
-    for sigma, seed in REFINED:
-        for r in sorted((r for r in peer["runs"] if (r["sigma"], r["seed"]) == (sigma, seed)), key=lambda r: r["n"]):
-            o = ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"]
+              "0.078 sqrt(R epsilon)), the explicit retraction alone about the pull-off (from a state in contact), "
+              "the full curve's pull-off on the same grid, and the mean field of each grid's pixel heights.", "",
+              "| surface | pixels | explicit pull-off F (retraction) | its lambda | the full curve's | "
+              "mean field (the square's heights) | CPU (s) |", "|---|---|---|---|---|---|---|"]
+    for sigma, seed, _, _ in REFINED:
+        full = {r["n"]: r for r in peer["runs"] if (r["sigma"], r["seed"]) == (sigma, seed)}
+        for r in sorted((r for r in peer.get("retract_runs", []) if (r["sigma"], r["seed"]) == (sigma, seed)),
+                        key=lambda r: r["n"]):
+            o = ours["retract"][f"{r['n']}:{r['sigma']}:{r['seed']}"]
             mf = o["smooth" if sigma == 0.0 else "measured"]["pull_off"]
             name = "smooth" if sigma == 0.0 else f"sigma {sigma:g}, seed {seed}"
-            lines.append(f"| {name} | {r['n']} | {r['pull_off']['F']:.5f} | {r['pull_off']['lam']:.3f} | "
-                         f"{mf['F']:.5f} +- {mf['err']:.0e} | {r['cpu_time_s']:.0f} |")
-    cpu = sum(r["cpu_time_s"] for r in peer["runs"])
-    ocpu = sum(v["cpu_time_s"] for o in ours["runs"].values() for v in o.values()) + \
-        sum(v["cpu_time_s"] for g in ours["gaussian"].values() for v in g.values())
+            f = full.get(r["n"])
+            lines.append(f"| {name} | {r['n']} | {r['pull_off']['F']:.5f}"
+                         + (" (at the range's end)" if r["pull_off"]["at_end"] else "")
+                         + f" | {r['pull_off']['lam']:.3f} | " + (f"{f['pull_off']['F']:.5f}" if f else "-")
+                         + f" | {mf['F']:.5f} +- {mf['err']:.0e} | {r['cpu_time_s']:.0f} |")
+    cpu = sum(r["cpu_time_s"] for r in peer["runs"] + peer.get("retract_runs", []))
+    mine = list(ours["runs"].values()) + list(ours.get("retract", {}).values()) + list(ours["gaussian"].values())
+    ocpu = sum(v["cpu_time_s"] for o in mine for v in o.values())
     ver = peer["runs"][0]["versions"]
-    lines += ["", f"CPU time: the explicit runs {cpu / 60:.1f} min ({len(peer['runs'])} curves, "
-              f"{sum(r['solves'] for r in peer['runs'])} minimisations), ours {ocpu:.0f} s "
-              f"({sum(len(o) for o in ours['runs'].values()) + sum(len(g) for g in ours['gaussian'].values())} "
-              f"curves); ContactMechanics {ver['ContactMechanics']}, Adhesion {ver['Adhesion']}, "
-              f"muGrid {ver['muGrid']}, one core each, the machine shared (load average "
-              f"{peer['runs'][0]['loadavg'][0]:.0f} to {max(r['loadavg'][0] for r in peer['runs']):.0f})."]
+    every = peer["runs"] + peer.get("retract_runs", [])
+    lines += ["", f"CPU time: the explicit runs {cpu / 60:.1f} min ({len(peer['runs'])} curves and "
+              f"{len(every) - len(peer['runs'])} retractions, {sum(r['solves'] for r in every)} minimisations), "
+              f"ours {ocpu:.0f} s ({sum(len(o) for o in mine)} curves); ContactMechanics "
+              f"{ver['ContactMechanics']}, Adhesion {ver['Adhesion']}, muGrid {ver['muGrid']}, one core each, "
+              f"the machine shared (load average "
+              f"{min(r['loadavg'][0] for r in every):.0f} to {max(r['loadavg'][0] for r in every):.0f})."]
     return "\n".join(lines)
+
+
+def _ours_of(ours: dict, runs, sigma: float, law: str) -> list:
+    """Our curves under ``law`` for the peer runs at ``sigma``."""
+    return [ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"][law] for r in runs if r["sigma"] == sigma]
 
 
 def figure(peer: dict, ours: dict, path: str) -> None:
@@ -508,8 +570,8 @@ def figure(peer: dict, ours: dict, path: str) -> None:
     ax.errorbar(rough, [-e[0] for e in ex], yerr=[e[1] for e in ex], fmt="o", color="C3", capsize=3,
                 label="explicit (mean +- seed spread)")
     for label, get, fmt in (
-            ("mean field, the square's heights", lambda s: [ours["runs"][f"{N_MAIN}:{s}:{k}"]["measured"] for k in SEEDS], "k-"),
-            ("mean field, the footprint's heights", lambda s: [ours["runs"][f"{N_MAIN}:{s}:{k}"]["footprint"] for k in SEEDS], "k--"),
+            ("mean field, the square's heights", lambda s: _ours_of(ours, main, s, "measured"), "k-"),
+            ("mean field, the footprint's heights", lambda s: _ours_of(ours, main, s, "footprint"), "k--"),
             ("Gaussian rule, 16 points", lambda s: [ours["gaussian"][str(s)]["hermite"]], "C2-"),
             ("Gaussian cut at the own top", lambda s: [v for k, v in ours["gaussian"][str(s)].items()
                                                        if k.startswith("truncated")], "C1-")):
@@ -530,10 +592,34 @@ def figure(peer: dict, ours: dict, path: str) -> None:
     plt.close(fig)
 
 
+def merge_main(argv) -> int:
+    """``merge --out FILE A.json B.json ...``: the runs of several peer processes (each ran a part of the
+    cases, ``--cases``) in one file; a later file's run replaces an earlier one's of the same case."""
+    p = argparse.ArgumentParser(prog="peer_rough.py merge")
+    p.add_argument("--out", required=True)
+    p.add_argument("parts", nargs="+")
+    a = p.parse_args(argv)
+    data: dict = {}
+    runs: dict = {}
+    retracts: dict = {}
+    for part in a.parts:
+        with open(part) as f:
+            d = json.load(f)
+        runs.update({(r["n"], r["sigma"], r["seed"]): r for r in d.pop("runs", [])})
+        retracts.update({(r["n"], r["sigma"], r["seed"]): r for r in d.pop("retract_runs", [])})
+        data.update(d)
+    data["runs"] = sorted(runs.values(), key=lambda r: (r["sigma"], r["seed"], r["n"]))
+    data["retract_runs"] = sorted(retracts.values(), key=lambda r: (r["sigma"], r["seed"], r["n"]))
+    write_atomic(a.out, data)
+    return 0
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["peer"]:
         return peer_main(argv[1:])
+    if argv[:1] == ["merge"]:
+        return merge_main(argv[1:])
     return ours_main(argv)
 
 
