@@ -23,9 +23,11 @@ against the roughness, with the seed-to-seed spread of the explicit runs as thei
 script under the peer's interpreter: at module level it imports nothing but the standard library and numpy,
 and the peer's packages and ours are imported inside the functions of each side.  The peer's cases can be
 split over processes (``peer --cases 64:0.3:1,... --out part.json``, ``--retract``) and their files joined
-(``peer_rough.py merge --out docs/data/peer_rough.json part1.json part2.json ...``), as the stored file was.  ``muFFT`` 0.95 (the last on the registry) is left out: installed beside muGrid 1.6
-it replaces muGrid's ``__init__`` with one that lacks ``FFTEngine``, and ContactMechanics 1.8.3 then fails to
-import (``ImportError: cannot import name 'FFTEngine' from 'muGrid'``); ContactMechanics needs muGrid only.
+(``peer_rough.py merge --out docs/data/peer_rough.json part1.json part2.json ...``), as the stored file was.
+
+``muFFT`` 0.95 (the last on the registry) is left out: installed beside muGrid 1.6 it replaces muGrid's
+``__init__`` with one that lacks ``FFTEngine``, and ContactMechanics 1.8.3 then fails to import
+(``ImportError: cannot import name 'FFTEngine' from 'muGrid'``); ContactMechanics needs muGrid only.
 
 Units (as :mod:`.peers`, exact): R = epsilon = gamma = 1, lengths in the plane in sqrt(R epsilon), gaps in
 epsilon, the contact modulus E* = mu^(-3/2), ``Lj82(w=1, z0=1)`` whose traction is (8/3)(g^-9 - g^-3), the
