@@ -13,9 +13,9 @@ against the roughness, with the seed-to-seed spread of the explicit runs as thei
     python3 -m venv .venv-peer
     .venv-peer/bin/pip install ContactMechanics Adhesion NuMPI SurfaceTopography   # not muFFT: below
     export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
-    # their side, in their environment (about 25 CPU minutes; merged into the JSON after every curve):
+    # their side, in their environment (about 15 CPU minutes; merged into the JSON after every curve):
     nice -n 10 .venv-peer/bin/python petsc_adhesion/benchmarks/peer_rough.py peer --out docs/data/peer_rough.json
-    # ours, in ours (a minute): docs/data/mean_field.json, the table docs/figures/mean_field.md, the figure
+    # ours, in ours (35 CPU seconds): docs/data/mean_field.json, the table docs/figures/mean_field.md, the figure
     # docs/figures/mean_field.png
     nice -n 10 python -m petsc_adhesion.benchmarks.peer_rough --data docs/data/peer_rough.json
 
@@ -483,7 +483,8 @@ def tables(peer: dict, ours: dict) -> str:
     lines = ["Pull-off F (load / (2 pi R gamma)) at mu = 1: the explicit runs' mean +- their seed-to-seed "
              "standard deviation (over the seeds of the second column), the mean field of each surface's own "
              "pixel heights (mean +- spread over the seeds): all of the square's and the footprint's "
-             "(r < 2.5), the paper's Gaussian rule (16 points) at the same rms, the Gaussian cut at each surface's own top.", "",
+             "(r < 2.5), the paper's Gaussian rule (16 points) at the same rms, the Gaussian cut at each "
+             "surface's own top.", "",
              "| sigma (rms / epsilon) | seeds | explicit (ContactMechanics) | mean field, the square's heights | "
              "mean field, the footprint's heights | Gaussian rule, 16 points | Gaussian cut at the own top | "
              "highest height / rms |", "|---|---|---|---|---|---|---|---|"]
