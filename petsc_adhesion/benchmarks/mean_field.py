@@ -95,6 +95,11 @@ def ours_main(argv) -> int:
     p.add_argument("--table", default=os.path.join("docs", "figures", "mean_field.md"))
     p.add_argument("--reuse", action="store_true", help="the table and figure from --ours as it is")
     a = p.parse_args(argv)
+    for path in [a.data] + ([a.ours] if a.reuse else []):
+        if not os.path.exists(path):
+            print(f"mean_field: {path} does not exist (--data: the peer's file of peer_rough.py peer; --reuse "
+                  "needs --ours)", file=sys.stderr)
+            return 2
     with open(a.data) as f:
         peer = json.load(f)
     if a.reuse:

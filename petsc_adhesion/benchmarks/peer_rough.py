@@ -69,9 +69,9 @@ N_MAIN, N_FINE = 64, 128
 #: rms heights (epsilon) and seeds of the explicit surfaces.
 SIGMAS = (0.1, 0.3, 1.0, 2.0)
 SEEDS = (1, 2, 3)
-#: The refinement: the smooth sphere and one rough surface (sigma, seed), their retraction alone from lam_hi
+#: The refinement: the smooth sphere and two rough surfaces (sigma, seed), their retraction alone from lam_hi
 #: down to lam_lo (about the pull-off) on both grids.
-REFINED = ((0.0, 0, 0.5, -1.4), (0.3, 2, 0.5, -1.6))
+REFINED = ((0.0, 0, 0.5, -1.4), (0.3, 2, 0.5, -1.6), (1.0, 1, 0.5, -2.3))
 #: Displacement-control lattice step, the pull-off's refinement step, the approach's stop (the load at
 #: equilibrium, past the pull-off), the start before the highest asperity under the sphere.
 DLAM, DLAM_FINE, F_STOP, START_GAP = 0.05, 0.01, 0.0, 2.6
