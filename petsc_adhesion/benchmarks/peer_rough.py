@@ -13,7 +13,7 @@ against the roughness, with the seed-to-seed spread of the explicit runs as thei
     python3 -m venv .venv-peer
     .venv-peer/bin/pip install ContactMechanics Adhesion NuMPI SurfaceTopography   # not muFFT: below
     export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
-    # their side, in their environment (about 15 CPU minutes; merged into the JSON after every curve):
+    # their side, in their environment (about 18 CPU minutes; merged into the JSON after every curve):
     nice -n 10 .venv-peer/bin/python petsc_adhesion/benchmarks/peer_rough.py peer --out docs/data/peer_rough.json
     # ours, in ours (35 CPU seconds): docs/data/mean_field.json, the table docs/figures/mean_field.md, the
     # figure docs/figures/mean_field.png
