@@ -1,0 +1,302 @@
+"""docs/mean_field.md's table and figure: our side of :mod:`.peer_rough` (the project's environment).
+
+For each explicit rough sphere of the peer's data file (``docs/data/peer_rough.json``) the mean field of the
+same surface: its pixel heights as the measured law (all of the square's, and the footprint's under the
+sphere), the paper's Gaussian rule at its rms and the Gaussian cut at its own highest height; kept in
+``docs/data/mean_field.json``; then the table ``docs/figures/mean_field.md`` and the figure
+``docs/figures/mean_field.png``::
+
+    OPENBLAS_NUM_THREADS=1 nice -n 10 python -m petsc_adhesion.benchmarks.mean_field
+    OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.benchmarks.mean_field --reuse               # table, figure
+
+Each surface is drawn again from its seed (:func:`.peer_rough.surface`) and must be the peer's (its digest).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from .peer_rough import DLAM, L, MU, N_MAIN, REFINED, digest, surface, write_atomic
+
+__all__ = ["FOOTPRINT", "OUR_F_MAX", "BISTABLE", "our_curve", "ours_for", "gaussian_laws", "bistable", "tables",
+           "figure", "main"]
+
+#: The footprint whose pixel heights make the local law: the sphere's contact up to F = 0 lies inside it.
+FOOTPRINT = 2.5
+#: Our curves stop past the equilibrium, where the peer's approach does (F_STOP).
+OUR_F_MAX = 0.05
+
+
+def _event(c, kind):
+    ev = c.events_of(kind)
+    return None if not ev else float(ev[0].lam.value)
+
+
+def our_curve(mu: float = MU, sigma: float | None = None, **options) -> dict:
+    """Our curve (no model spread: the laws are compared here one by one): the pull-off, the folds in
+    lambda, the cycle's energy, the branch; and its CPU time."""
+    from petsc_adhesion import curve
+    from petsc_adhesion.tracing.measured import Measured
+    c0 = time.process_time()
+    c = curve(mu, sigma, cont_F_max=OUR_F_MAX, adh_model_spread=False, **options)
+    energy = c.rigid.energy
+    return dict(sigma=float(c.model.sigma), pull_off=dict(F=float(c.pull_off.F.value), err=float(c.pull_off.F.err),
+                                                         lam=float(c.pull_off.lam.value)),
+                snap_on=_event(c, "snap_on"), snap_off=_event(c, "snap_off"),
+                hysteresis=float(energy.value) if isinstance(energy, Measured) else None,
+                branch=dict(lam=c.lam.tolist(), F=c.F.tolist(), stable=c.branch.stable.tolist()),
+                complete=bool(c.complete), warnings=list(c.warnings), cpu_time_s=time.process_time() - c0)
+
+
+def ours_for(run: dict, tmp: str) -> dict:
+    """The mean field of one peer surface: its pixel heights as the measured law (all of the square's, and
+    the footprint's), the paper's Gaussian rule at its rms, the truncated Gaussian cut at its own top.  The
+    surface is drawn again from its seed and must be the peer's (their digests)."""
+    n, sigma, seed = run["n"], run["sigma"], run["seed"]
+    z = surface(n, sigma, seed)
+    if digest(z) != run["digest"]:
+        raise RuntimeError(f"the surface n {n} sigma {sigma} seed {seed} is not the peer's (digest)")
+    if sigma == 0.0:
+        return dict(smooth=our_curve(sigma=0.0))
+    x = -L + (np.arange(n) + 0.5) * (2.0 * L / n)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    out = {}
+    for name, heights in (("measured", z.ravel()), ("footprint", z[np.hypot(X, Y) < FOOTPRINT])):
+        path = os.path.join(tmp, f"{name}.npy")
+        np.save(path, heights)            # 1-D: read as they are (a 2-D map would be levelled by its plane)
+        out[name] = our_curve(adh_roughness="measured", adh_roughness_file=path)
+        out[name]["top"] = float(heights.max())
+    return out
+
+
+def gaussian_laws(sigma: float, tops) -> dict:
+    """The paper's Gaussian rule (16-point Hermite) at rms sigma, and the truncated Gaussian cut at each
+    surface's own highest height (K = top / sigma, two decimals; sigma that of the uncut Gaussian)."""
+    out = {"hermite": our_curve(sigma=sigma)}
+    for top in tops:
+        K = round(top / sigma, 2)
+        out[f"truncated:{K}"] = our_curve(sigma=sigma, adh_roughness="truncated_gaussian", adh_roughness_cutoff=K)
+    return out
+
+
+def ours_main(argv) -> int:
+    """Our side of every peer run in the data file, written beside it (``mean_field.json``), then the table
+    and the figure."""
+    p = argparse.ArgumentParser(prog="python -m petsc_adhesion.benchmarks.mean_field")
+    p.add_argument("--data", default=os.path.join("docs", "data", "peer_rough.json"))
+    p.add_argument("--ours", default=os.path.join("docs", "data", "mean_field.json"))
+    p.add_argument("--figure", default=os.path.join("docs", "figures", "mean_field.png"))
+    p.add_argument("--table", default=os.path.join("docs", "figures", "mean_field.md"))
+    p.add_argument("--reuse", action="store_true", help="the table and figure from --ours as it is")
+    a = p.parse_args(argv)
+    for path in [a.data] + ([a.ours] if a.reuse else []):
+        if not os.path.exists(path):
+            print(f"mean_field: {path} does not exist (--data: the peer's file of peer_rough.py peer; --reuse "
+                  "needs --ours)", file=sys.stderr)
+            return 2
+    with open(a.data) as f:
+        peer = json.load(f)
+    if a.reuse:
+        with open(a.ours) as f:
+            ours = json.load(f)
+    else:
+        ours = {"runs": {}, "gaussian": {}}
+        with tempfile.TemporaryDirectory() as tmp:
+            for run in peer["runs"]:
+                key = f"{run['n']}:{run['sigma']}:{run['seed']}"
+                ours["runs"][key] = ours_for(run, tmp)
+                print(key, {k: round(v["pull_off"]["F"], 5) for k, v in ours["runs"][key].items()}, flush=True)
+            ours["retract"] = {}
+            for run in peer.get("retract_runs", []):
+                key = f"{run['n']}:{run['sigma']}:{run['seed']}"
+                ours["retract"][key] = ours_for(run, tmp)
+            for sigma in sorted({r["sigma"] for r in peer["runs"] if r["sigma"] > 0 and r["n"] == N_MAIN}):
+                tops = [r["top"] for r in peer["runs"] if r["sigma"] == sigma and r["n"] == N_MAIN]
+                ours["gaussian"][str(sigma)] = gaussian_laws(sigma, tops)
+        write_atomic(a.ours, ours)
+    table = tables(peer, ours)
+    d = os.path.dirname(os.path.abspath(a.table))
+    fd, tmp = tempfile.mkstemp(dir=d, suffix=".md")
+    with os.fdopen(fd, "w") as f:
+        f.write(f"<!-- made by: python -m petsc_adhesion.benchmarks.mean_field (docs/mean_field.md) -->\n{table}\n")
+    os.chmod(tmp, 0o644)
+    os.replace(tmp, a.table)
+    figure(peer, ours, a.figure)
+    print(table)
+    return 0
+
+
+def _stats(values):
+    v = np.array([x for x in values if x is not None], float)
+    if v.size == 0:
+        return None
+    return float(v.mean()), (float(v.std(ddof=1)) if v.size > 1 else None), float(v.min()), float(v.max())
+
+
+def _ms(st, digits=4):
+    if st is None:
+        return "-"
+    mean, sd, lo, hi = st
+    return f"{mean:.{digits}f}" + ("" if sd is None else f" +- {sd:.{digits}f}")
+
+
+#: Approach and retraction at one lambda on different branches: their loads differ by more than this (on one
+#: branch, by the minimiser's tolerance, 2e-4 at most in these runs).
+BISTABLE = 1e-3
+
+
+def bistable(run: dict):
+    """The explicit curve's bistable range on the lattice, (lowest, highest lambda), or None: the states
+    where the approach and the retraction differ in load by more than BISTABLE."""
+    a = {round(lam, 6): F for lam, F in zip(run["approach"]["lam"], run["approach"]["F"])}
+    lams = [lam for lam, F in zip(run["retract"]["lam"], run["retract"]["F"])
+            if round(lam, 6) in a and abs(a[round(lam, 6)] - F) > BISTABLE]
+    return (min(lams), max(lams)) if lams else None
+
+
+def tables(peer: dict, ours: dict) -> str:
+    """The comparison, one row per rms: the explicit runs' mean and seed-to-seed spread, each mean field."""
+    main = [r for r in peer["runs"] if r["n"] == N_MAIN and r["sigma"] > 0]
+    lines = ["Pull-off F (load / (2 pi R gamma)) at mu = 1: the explicit runs' mean +- their seed-to-seed "
+             "standard deviation (over the seeds of the second column), the mean field of each surface's own "
+             "pixel heights (mean +- spread over the seeds): all of the square's and the footprint's "
+             "(r < 2.5), the paper's Gaussian rule (16 points) at the same rms, the Gaussian cut at each "
+             "surface's own top.", "",
+             "| sigma (rms / epsilon) | seeds | explicit (ContactMechanics) | mean field, the square's heights | "
+             "mean field, the footprint's heights | Gaussian rule, 16 points | Gaussian cut at the own top | "
+             "highest height / rms |", "|---|---|---|---|---|---|---|---|"]
+    for sigma in sorted({r["sigma"] for r in main}):
+        rs = [r for r in main if r["sigma"] == sigma]
+        keys = [f"{r['n']}:{r['sigma']}:{r['seed']}" for r in rs]
+        g = ours["gaussian"][str(sigma)]
+        trunc = [v["pull_off"]["F"] for k, v in g.items() if k.startswith("truncated")]
+        lines.append(f"| {sigma:g} | {', '.join(str(r['seed']) for r in rs)} | "
+                     f"{_ms(_stats([r['pull_off']['F'] for r in rs]))} | "
+                     f"{_ms(_stats([ours['runs'][k]['measured']['pull_off']['F'] for k in keys]))} | "
+                     f"{_ms(_stats([ours['runs'][k]['footprint']['pull_off']['F'] for k in keys]))} | "
+                     f"{g['hermite']['pull_off']['F']:.4f} | {_ms(_stats(trunc))} | "
+                     f"{_ms(_stats([r['top'] / sigma for r in rs]), 2)} |")
+    lines += ["", "Snap-on and snap-off (lambda, approach / epsilon) and the hysteresis (the energy of the "
+              "displacement-controlled cycle, 2 pi R gamma epsilon), surface by surface.  The explicit ones: the "
+              f"lattice's bistable range (where approach and retraction differ by more than {BISTABLE:g} in load; "
+              "on one branch they agree to 2e-4): the snap-on lies within DLAM = 0.05 above it, the snap-off "
+              "within 0.05 below; 'none': no bistable state, the curve reversible.  The mean field's: its folds "
+              "in lambda (of the square's heights).", "",
+              "| sigma | seed | snap-on, explicit | snap-on, mean field | snap-off, explicit | snap-off, mean field | "
+              "hysteresis, explicit | hysteresis, mean field |", "|---|---|---|---|---|---|---|---|"]
+    for r in sorted(main, key=lambda r: (r["sigma"], r["seed"])):
+        m = ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"]["measured"]
+        b = bistable(r)
+        on = "none" if b is None else f"{b[1]:.2f} to {b[1] + DLAM:.2f}"
+        off = "none" if b is None else f"{b[0] - DLAM:.2f} to {b[0]:.2f}"
+
+        def fold(x):
+            return "none" if x is None else f"{x:.4f}"
+        lines.append(f"| {r['sigma']:g} | {r['seed']} | {on} | {fold(m['snap_on'])} | {off} | {fold(m['snap_off'])} | "
+                     f"{r['hysteresis']:.4f} | {m['hysteresis']:.4f} |")
+    lines += ["", "The grid: the same continuous surfaces on 64 and 128 pixels a side (pixel 0.156 and "
+              "0.078 sqrt(R epsilon)), the explicit retraction alone about the pull-off (from a state in contact), "
+              "the full curve's pull-off on the same grid, and the mean field of each grid's pixel heights.", "",
+              "| surface | pixels | explicit pull-off F (retraction) | its lambda | the full curve's | "
+              "mean field (the square's heights) | CPU (s) |", "|---|---|---|---|---|---|---|"]
+    for sigma, seed, _, _ in REFINED:
+        full = {r["n"]: r for r in peer["runs"] if (r["sigma"], r["seed"]) == (sigma, seed)}
+        for r in sorted((r for r in peer.get("retract_runs", []) if (r["sigma"], r["seed"]) == (sigma, seed)),
+                        key=lambda r: r["n"]):
+            o = ours["retract"][f"{r['n']}:{r['sigma']}:{r['seed']}"]
+            mf = o["smooth" if sigma == 0.0 else "measured"]["pull_off"]
+            name = "smooth" if sigma == 0.0 else f"sigma {sigma:g}, seed {seed}"
+            f = full.get(r["n"])
+            lines.append(f"| {name} | {r['n']} | {r['pull_off']['F']:.5f}"
+                         + (" (at the range's end)" if r["pull_off"]["at_end"] else "")
+                         + f" | {r['pull_off']['lam']:.3f} | " + (f"{f['pull_off']['F']:.5f}" if f else "-")
+                         + f" | {mf['F']:.5f} +- {mf['err']:.0e} | {r['cpu_time_s']:.0f} |")
+    cpu = sum(r["cpu_time_s"] for r in peer["runs"] + peer.get("retract_runs", []))
+    mine = list(ours["runs"].values()) + list(ours.get("retract", {}).values()) + list(ours["gaussian"].values())
+    ocpu = sum(v["cpu_time_s"] for o in mine for v in o.values())
+    ver = peer["runs"][0]["versions"]
+    every = peer["runs"] + peer.get("retract_runs", [])
+    lines += ["", f"CPU time: the explicit runs {cpu / 60:.1f} min ({len(peer['runs'])} curves and "
+              f"{len(every) - len(peer['runs'])} retractions, {sum(r['solves'] for r in every)} minimisations), "
+              f"ours {ocpu:.0f} s ({sum(len(o) for o in mine)} curves); ContactMechanics "
+              f"{ver['ContactMechanics']}, Adhesion {ver['Adhesion']}, muGrid {ver['muGrid']}, one core each, "
+              f"the machine shared (load average "
+              f"{min(r['loadavg'][0] for r in every):.0f} to {max(r['loadavg'][0] for r in every):.0f})."]
+    return "\n".join(lines)
+
+
+def _ours_of(ours: dict, runs, sigma: float, law: str) -> list:
+    """Our curves under ``law`` for the peer runs at ``sigma``."""
+    return [ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"][law] for r in runs if r["sigma"] == sigma]
+
+
+def figure(peer: dict, ours: dict, path: str) -> None:
+    """F(lambda) of the first seed at each rms: the explicit approach and retract against the mean field's
+    branch (stable solid, unstable dotted) and the Gaussian rule's; and the pull-off against sigma."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    main = [r for r in peer["runs"] if r["n"] == N_MAIN]
+    sigmas = sorted({r["sigma"] for r in main})
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5))
+    for ax, sigma in zip(axes.flat, sigmas):
+        r = min((r for r in main if r["sigma"] == sigma), key=lambda r: r["seed"])
+        o = ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"]
+        ax.plot(r["approach"]["lam"], r["approach"]["F"], "o", ms=2.5, color="C0", label="explicit, approach")
+        ax.plot(r["retract"]["lam"], r["retract"]["F"], "s", ms=2.5, mfc="none", color="C3",
+                label="explicit, retract")
+        curves = [("mean field (own heights)", o["smooth" if sigma == 0 else "measured"]["branch"], "k")]
+        if sigma > 0:
+            curves.append(("Gaussian rule, 16 points", ours["gaussian"][str(sigma)]["hermite"]["branch"], "C2"))
+        for label, b, col in curves:
+            lam, F, st = (np.array(b[k]) for k in ("lam", "F", "stable"))
+            ax.plot(lam, np.where(st, F, np.nan), "-", color=col, lw=1.2, label=label)
+            ax.plot(lam, np.where(st, np.nan, F), ":", color=col, lw=1.0)
+        lo = min(r["approach"]["lam"])
+        ax.set_xlim(lo, max(r["approach"]["lam"]) + 0.1)
+        ax.set_ylim(min(min(r["retract"]["F"]), o[next(iter(o))]["pull_off"]["F"]) * 1.15 - 0.02, 0.05)
+        ax.set_title(("smooth" if sigma == 0 else f"sigma = {sigma:g}, seed {r['seed']}") + ", mu = 1")
+        ax.set_xlabel("lambda (approach / epsilon)")
+        ax.set_ylabel("F / (2 pi R gamma)")
+        ax.legend(fontsize=7, loc="lower left")
+    ax = axes.flat[-1]
+    rough = [s for s in sigmas if s > 0]
+    ex = [_stats([r["pull_off"]["F"] for r in main if r["sigma"] == s]) for s in rough]
+    ax.errorbar(rough, [-e[0] for e in ex], yerr=[np.nan if e[1] is None else e[1] for e in ex], fmt="o",
+                color="C3", capsize=3,
+                label="explicit (mean +- seed spread)")
+    for label, get, fmt in (
+            ("mean field, the square's heights", lambda s: _ours_of(ours, main, s, "measured"), "k-"),
+            ("mean field, the footprint's heights", lambda s: _ours_of(ours, main, s, "footprint"), "k--"),
+            ("Gaussian rule, 16 points", lambda s: [ours["gaussian"][str(s)]["hermite"]], "C2-"),
+            ("Gaussian cut at the own top", lambda s: [v for k, v in ours["gaussian"][str(s)].items()
+                                                       if k.startswith("truncated")], "C1-")):
+        ax.plot(rough, [-np.mean([c["pull_off"]["F"] for c in get(s)]) for s in rough], fmt, marker=".", label=label)
+    sm = [r for r in main if r["sigma"] == 0]
+    if sm:
+        ax.axhline(-sm[0]["pull_off"]["F"], color="0.6", lw=0.8, label="smooth sphere")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xticks(rough, [f"{s:g}" for s in rough])
+    ax.minorticks_off()
+    ax.set_xlabel("sigma (rms / epsilon)")
+    ax.set_ylabel("pull-off -F / (2 pi R gamma)")
+    ax.set_title("pull-off against roughness, mu = 1")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    return ours_main(sys.argv[1:] if argv is None else list(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
