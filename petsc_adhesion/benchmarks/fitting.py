@@ -238,6 +238,13 @@ def _fit_row(data, truth, bodies, spring, table) -> dict:
     return row
 
 
+def _partial(name: str, rows: list) -> None:
+    """The rows so far (a study stopped part way keeps them: ``-table`` redraws from the file)."""
+    with open(_data(name) + ".partial", "w") as f:
+        json.dump({"made": {"load": f"{os.getloadavg()[0]:.1f}", "partial": True, **paths.source()}, "rows": rows},
+                  f, indent=1)
+
+
 def speed_rows(before: bool, cache: str | None) -> list:
     """The CPU of one fit through the table (and with ``before`` on the solver alone) at SPEED_MUS."""
     _init()
@@ -252,6 +259,7 @@ def speed_rows(before: bool, cache: str | None) -> list:
             row = _fit_row(data, truth, bodies, spring, "none" if before else "default")
             row.update(seed=seed, path_kind="solver" if before else "table")
             rows.append(row)
+            _partial("speed_before" if before else "speed", rows)
             print(f"mu {mu:g} seed {seed}: {row.get('cpu_s', math.nan):.3f} s CPU", flush=True)
     return rows
 
@@ -283,13 +291,16 @@ def speed_section(rows: list, made: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def table_coverage_rows(n: int, cache: str | None, make_only: bool = False) -> list:
+def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False) -> list:
     """The first ``n`` cases of :func:`table_cases`, the cheapest (lowest mu) first: each a curve made by the
     solver (finer steps than the fit's), fitted through the default table (``make_only``: made into the cache
-    only, no rows)."""
+    only, no rows; ``made_only``: the cases whose curve is in the cache alone)."""
     _init()
     rows = []
     for case in sorted(table_cases(n), key=lambda c: c["mu"]):
+        name = f"curve_{case['mu']:.6g}_{case['K']:.6g}_{case['noise_share']:g}_{case['seed']}_1.npz"
+        if made_only and not (cache and os.path.exists(os.path.join(cache, name))):
+            continue
         data, truth, bodies, spring = _synthetic(case["mu"], case["K"], case["noise_share"], case["seed"], cache,
                                                  finer=True)
         if make_only:
@@ -298,6 +309,7 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False) -> l
         row = _fit_row(data, truth, bodies, spring, "default")
         row.update(case=case["case"], noise_share=case["noise_share"], seed=case["seed"])
         rows.append(row)
+        _partial("table_coverage", rows)
         print(json.dumps({k: row.get(k) for k in ("case", "mu", "K", "gamma_fit", "gamma_err", "cpu_s")}), flush=True)
     return rows
 
@@ -311,7 +323,9 @@ def table_coverage_section(rows: list, made: dict) -> str:
              f"log-uniform in mu over [1e-3, 1e3] and in K over [1e-4, 0.5], the noise {', '.join(f'{x:.1%}' for x in NOISE_SHARES)} of "
              f"2 pi R w, sigma = 0 (R = {SYNTH['radius'] * 1e9:g} nm, epsilon = {SYNTH['epsilon'] * 1e9:g} nm, "
              f"w = {SYNTH['gamma']:g} J/m^2, {SYNTH['points']} points a leg), each fitted through the package's table "
-             f"with R, epsilon and k given.  {len(ok)} of {len(rows)} cases gave both bars.", ""]
+             f"with R, epsilon and k given.  {len(ok)} of {len(rows)} cases gave both bars"
+             + (f"; the cases fitted span mu {min(r['mu'] for r in rows):.3g} to {max(r['mu'] for r in rows):.3g}"
+                if rows else "") + ".", ""]
     for key, label in (("gamma", "w"), ("E_star", "E*")):
         inside = [abs(r[f"{key}_fit"] - r[key]) <= 1.96 * r[f"{key}_err"] for r in ok]
         ratio = [r[f"{key}_err"] / max(abs(r[f"{key}_fit"] - r[key]), 1e-300) for r in ok]
@@ -416,7 +430,7 @@ def main(argv: list[str]) -> int:
         print(text)
     for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache), speed_section),
                                    ("table_coverage", lambda: table_coverage_rows(int(value.get("-cases", 60)), cache,
-                                                                    "-make_only" in argv),
+                                                                    "-make_only" in argv, "-made_only" in argv),
                                     table_coverage_section)):
         if part not in parts:
             continue
