@@ -64,8 +64,8 @@ class TableStep:
         """One line for the fit's notes: the path, the step, the table's share of each bar (``names``: the
         reported coordinate's label for each of ``coordinates``)."""
         share = ", ".join(f"{names.get(c, c)} {b:.2g} bars" for c, b in zip(self.coordinates, self.bars))
-        return (f"the search ran on the table {self.table} ({self.evaluations} evaluations, {self.seconds:.3g} s of "
-                f"CPU), then the solver traced {self.curves} curve{'s' * (self.curves != 1)} at its optimum: chi^2, "
+        return (f"the search ran on the table {self.table} ({self.evaluations} evaluations), then the solver traced "
+                f"{self.curves} curve{'s' * (self.curves != 1)} at its optimum: chi^2, "
                 f"the residuals and the events are the solver's, the parameters one Gauss-Newton step from its "
                 f"last curve, the step added to each bar ({share})")
 
