@@ -25,11 +25,11 @@ TIP_ARGS = ("-phys_radius", "20e-9", "-phys_epsilon", "0.3e-9")
 GOLDEN_CURVE = os.path.join(ROOT, "tests", "data", "golden", "curve.csv")
 
 
-def _curve(mu: float, noise_share: float = 0.01, seed: int = 1, k: float = 1.0):
+def _curve(mu: float, noise_share: float = 0.01, seed: int = 1, k: float = 1.0, R_tip: float = R):
     """A curve made by the solver at mu (w = 0.05 J/m^2, E* by eq. 9), noise a share of 2 pi R w; its E*."""
-    E = W * math.sqrt(R / (mu**3 * EPS**3))
-    truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=EPS, gamma=W)
-    data = synthetic_curve(truth, Spring(k), Sampling(noise=noise_share * 2 * math.pi * R * W, points=300,
+    E = W * math.sqrt(R_tip / (mu**3 * EPS**3))
+    truth = Bodies(radius=R_tip, young1=E, poisson1=0.0, epsilon=EPS, gamma=W)
+    data = synthetic_curve(truth, Spring(k), Sampling(noise=noise_share * 2 * math.pi * R_tip * W, points=300,
                                                        z0=3e-9, F0=1e-10, seed=seed))
     return data, E
 
@@ -37,10 +37,13 @@ def _curve(mu: float, noise_share: float = 0.01, seed: int = 1, k: float = 1.0):
 @pytest.mark.parametrize("mu", [0.003, 0.4, 60.0])
 def test_a_fit_through_the_table_recovers_w_and_E(mu):
     """Three mu across the range (60 beyond the solver path's old bound of 50), each between the table's nodes:
-    w and E* within their 95% intervals, one solver curve after the search.  At mu = 0.003, the DMT end, the
-    curve hardly depends on E* (a rigid sphere's): the fit says E* is undetermined instead of a number."""
-    data, E = _curve(mu)
-    fit = fit_curve(data, TIP, Spring(1.0))
+    w and E* within their 95% intervals, one to three solver curves after the search.  At mu = 0.003, the DMT
+    end, the curve hardly depends on E* (a rigid sphere's): the fit says E* is undetermined instead of a number.
+    At mu = 60 the tip is 1.2 um (the indentation at the top load, about 5 mu epsilon, within R/4, the model's
+    domain) and the lever 60 N/m (K = 0.048, as 1 N/m on 20 nm)."""
+    scale = max(1.0, mu)
+    data, E = _curve(mu, R_tip=R * scale, k=scale)
+    fit = fit_curve(data, Bodies(radius=R * scale, young1=None, poisson1=None, epsilon=EPS), Spring(scale))
     assert isinstance(fit.path, TableStep) and 1 <= fit.path.curves == fit.traces <= 3, fit.path
     assert abs(fit.gamma.value - W) <= 1.96 * fit.gamma.err
     if mu < 0.01:

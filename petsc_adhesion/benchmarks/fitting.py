@@ -189,13 +189,17 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
     from ..tracing.trace import curve_settings
 
     s = SYNTH
-    R, eps, w = s["radius"], s["epsilon"], s["gamma"]
+    # the tip's radius grows with mu above 1 as the indentation at the top load does (about 5 mu epsilon at
+    # F = 2), so that it stays below a sixth of R, inside the model's domain (R / 4, domain.py)
+    R, eps, w = s["radius"] * max(1.0, mu), s["epsilon"], s["gamma"]
     E = w * math.sqrt(R / (mu**3 * eps**3))                      # eq. (9) solved for E*
     k = K * 2 * math.pi * R * w / eps
     rng = np.random.default_rng(1000 + seed)
     z0, F0 = float(rng.uniform(-20e-9, 20e-9)), float(rng.uniform(-1e-9, 1e-9))
     noise = noise_share * 2 * math.pi * R * w
-    name = None if cache is None else os.path.join(cache, f"curve_{mu:.6g}_{K:.6g}_{noise_share:g}_{seed}_{int(finer)}.npz")
+    tag = "" if R == s["radius"] else f"_R{R:.4g}"
+    name = None if cache is None else \
+        os.path.join(cache, f"curve_{mu:.6g}_{K:.6g}_{noise_share:g}_{seed}_{int(finer)}{tag}.npz")
     made = math.nan
     if name is not None and os.path.exists(name):
         with np.load(name) as z:
@@ -208,7 +212,7 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
         made = time.process_time() - c0
         if name is not None:
             np.savez(name, z=data.z, F=data.F, turn=data.turn)
-    truth = {"mu": mu, "K": K, "gamma": w, "E_star": E, "z0_m": z0, "noise_N": noise, "made_cpu_s": made}
+    truth = {"mu": mu, "K": K, "gamma": w, "E_star": E, "z0_m": z0, "noise_N": noise, "made_cpu_s": made, "R": R}
     return data, truth, Bodies(radius=R, young1=None, poisson1=None, epsilon=eps), Spring(k)
 
 
@@ -268,8 +272,9 @@ def speed_section(rows: list, made: dict) -> str:
     lines = ["## The speed of a curve fit", "",
              "<!-- made by: python -m petsc_adhesion.benchmarks.fitting speed [-before] -cache DIR (data: "
              "docs/data/fitting_speed.json; -table redraws from it) -->", "",
-             f"One fit of a synthetic curve (made by the solver: R = {SYNTH['radius'] * 1e9:g} nm, epsilon = "
-             f"{SYNTH['epsilon'] * 1e9:g} nm, k = {SYNTH['spring']:g} N/m, w = {SYNTH['gamma']:g} J/m^2, noise "
+             f"One fit of a synthetic curve (made by the solver: R = {SYNTH['radius'] * 1e9:g} nm times mu above 1, "
+             f"inside the model's domain at the top load; epsilon = "
+             f"{SYNTH['epsilon'] * 1e9:g} nm, K = 0.048 (k = 1 N/m at R = 20 nm), w = {SYNTH['gamma']:g} J/m^2, noise "
              f"{SYNTH['noise_share']:.0%} of 2 pi R w, {SYNTH['points']} points a leg), its CPU time "
              "(`time.process_time`, one process; the machine's two cores shared with other work, load average "
              f"{made.get('load', '?')}).  Through the table: the search (`TableStep.seconds`) and the rest, "
@@ -298,7 +303,8 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
     _init()
     rows = []
     for case in sorted(table_cases(n), key=lambda c: c["mu"]):
-        name = f"curve_{case['mu']:.6g}_{case['K']:.6g}_{case['noise_share']:g}_{case['seed']}_1.npz"
+        tag = "" if case["mu"] <= 1 else f"_R{SYNTH['radius'] * case['mu']:.4g}"
+        name = f"curve_{case['mu']:.6g}_{case['K']:.6g}_{case['noise_share']:g}_{case['seed']}_1{tag}.npz"
         if made_only and not (cache and os.path.exists(os.path.join(cache, name))):
             continue
         data, truth, bodies, spring = _synthetic(case["mu"], case["K"], case["noise_share"], case["seed"], cache,
@@ -321,7 +327,7 @@ def table_coverage_section(rows: list, made: dict) -> str:
              "docs/data/fitting_table_coverage.json; -table redraws from it) -->", "",
              f"Synthetic curves made by the solver (not by the table; steps half the fit's), the cases drawn "
              f"log-uniform in mu over [1e-3, 1e3] and in K over [1e-4, 0.5], the noise {', '.join(f'{x:.1%}' for x in NOISE_SHARES)} of "
-             f"2 pi R w, sigma = 0 (R = {SYNTH['radius'] * 1e9:g} nm, epsilon = {SYNTH['epsilon'] * 1e9:g} nm, "
+             f"2 pi R w, sigma = 0 (R = {SYNTH['radius'] * 1e9:g} nm times mu above 1, epsilon = {SYNTH['epsilon'] * 1e9:g} nm, "
              f"w = {SYNTH['gamma']:g} J/m^2, {SYNTH['points']} points a leg), each fitted through the package's table "
              f"with R, epsilon and k given.  {len(ok)} of {len(rows)} cases gave both bars"
              + (f"; the cases fitted span mu {min(r['mu'] for r in rows):.3g} to {max(r['mu'] for r in rows):.3g}"
