@@ -291,7 +291,7 @@ def speed_section(rows: list, made: dict) -> str:
             cpu = np.median([r["cpu_s"] for r in sel])
             lines.append(f"| {mu:g} | {kind} | {len(sel)} | {cpu:.3g} | "
                          f"{f'{np.median(search):.3g}' if search else '-'} | "
-                         f"{int(np.median([r.get('curves', 0) for r in sel]))} | "
+                         f"{int(np.median([r.get('curves', 0) for r in sel])) if kind == 'table' else '-'} | "
                          f"{int(np.median([r['traces'] for r in sel]))} |")
     return "\n".join(lines) + "\n"
 
