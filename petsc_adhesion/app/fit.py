@@ -21,6 +21,7 @@ from petsc4py import PETSc
 from ..errors import InputError, collective, printable, say
 from ..fitting.curve_fit import CurveFitError, FitProgress, OutsideDomain, fit_curve, predict_curve
 from ..fitting.data import CurveFileError, MeasuredCurve, NeedsInstrument, read_curve
+from ..fitting.forward import open_table
 from ..fitting.pull_off import PullOffFitError, fit_pull_off
 from ..fitting.results import FitChoice, Spring
 from ..io.fit import fit_summary, fit_tree, report_fit
@@ -52,7 +53,7 @@ FIT_OPTIONS = {"phys_radius", "phys_radius2", "phys_young1", "phys_poisson1", "p
 #: The options of -fit_curve alone: what is fitted and how.
 CURVE_ONLY = ("fit_curve_index", "fit_modulus", "fit_roughness", "fit_invols", "fit_invols_scale",
               "fit_calibrate_invols", "fit_spring_err", "fit_virtual_deflection", "fit_drag", "fit_segment",
-              "fit_z_range", "fit_max_evals", "fit_outside_domain")
+              "fit_z_range", "fit_max_evals", "fit_outside_domain", "fit_table")
 _OUTPUTS = ("out", "summary", "plot", "csv")
 #: Points per leg of the fitted model's curve in the files.
 MODEL_POINTS = 400
@@ -75,6 +76,7 @@ class FitRequest:
     targets: dict
     spread_rules: tuple | None = None   # the laws of gamma's (a curve's: w's and E*'s) model spread (None: none)
     warnings: tuple = ()                # inputs outside what the field measures, one line each (plausible.py)
+    table: str = "none"                 # curve: the table its search runs on (-fit_table, checked), or none
 
 
 def _given(opts: AppOptions, name: str) -> bool:
@@ -190,6 +192,11 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
         if fit_rough and model.roughness == "none":
             raise InputError("-fit_roughness: not with -adh_roughness none (a smooth surface)")
         choice = _curve_choice(opts, fit_modulus, fit_rough)
+        table = opts.string("fit_table")
+        try:
+            open_table(table)           # checked before any work; the fit opens it again (the package's: once)
+        except ValueError as e:
+            raise InputError(f"-fit_table: {printable(str(e))}; expected a table file, default or none") from None
         rough = model.roughness != "none" and (model.sigma > 0 or fit_rough)
         spread = read_model_spread(opts, replace(model, sigma=model.sigma or (0.3 if rough else 0.0)))
         check_input("fit_curve", path)
@@ -219,7 +226,7 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
             data = data.rescaled(k)       # the file's force is its spring constant times the measured deflection
             source = f"-phys_spring (the file's force rescaled from its {data.metadata.get('spring constant')} N/m)"
         req = FitRequest("curve", model, grid, solver, bodies, None, 0.0, data, Spring(k, source), choice, targets,
-                         spread)
+                         spread, table=table)
     if comm.getRank() == 0:
         check_targets(targets, inputs)
     # last: a fit refused says its one line, not warnings beside it
@@ -266,7 +273,8 @@ def _fit(req: FitRequest, comm, progress=None):
                                 comm=comm, spread_rules=req.spread_rules)
         assert req.data is not None and req.spring is not None, "a curve fit's request holds the curve and spring"
         return fit_curve(req.data, req.bodies, req.spring, req.choice, model=req.model, grid=req.grid,
-                         solver=req.solver, comm=comm, progress=progress, spread_rules=req.spread_rules)
+                         solver=req.solver, comm=comm, progress=progress, spread_rules=req.spread_rules,
+                         table=req.table)
     except PullOffFitError as e:
         raise InputError(f"-fit_pull_off: {printable(str(e))}") from None
     except CurveFitError as e:

@@ -3,10 +3,15 @@
     python -m petsc_adhesion.benchmarks.fitting pull_off   # JKR, DMT, Maugis-Dugdale against ours, by mu
     python -m petsc_adhesion.benchmarks.fitting coverage   # do the curve fit's 95% intervals hold? (about 30 min)
     python -m petsc_adhesion.benchmarks.fitting real       # the measured curve of tests/data, fitted, with its figure
+    python -m petsc_adhesion.benchmarks.fitting speed [-before] [-cache DIR]     # the CPU of one fit, by mu
+    python -m petsc_adhesion.benchmarks.fitting table_coverage [-cases N] [-cache DIR]   # mu 1e-3 to 1e3
     python -m petsc_adhesion.benchmarks.fitting -table     # the sections again from docs/data/fitting_*.json
 
 Each part writes its JSON into docs/data/ and its section of docs/fitting.md (in
-place of the one there).  The coverage runs its cases in two processes.
+place of the one there).  The coverage runs its cases in two processes; ``speed`` and
+``table_coverage`` run theirs one after the other in this process (``speed`` times
+each fit's CPU, ``time.process_time``), keeping the synthetic curves they made in
+``-cache DIR`` (made once, by the solver; a later run fits them again).
 """
 from __future__ import annotations
 
@@ -36,6 +41,18 @@ PULL_OFF_MUS = (0.01, 0.03, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 7.
 #: The measured curve of tests/data and what is assumed of it (docs/fitting.md).
 REAL = {"file": "tests/data/fmt-igor-fd_SiN_FD_plot.ibw", "spring": 1.18, "radius": 20e-9, "epsilon": 0.3e-9,
         "young1": 250e9, "poisson1": 0.25}
+
+
+#: The speed of one fit: Tabor parameters, and the seeds at each (one where a curve costs a minute or more).
+SPEED_MUS = (1e-3, 0.1, 1.0, 10.0, 100.0, 1000.0)
+SPEED_SEEDS = {1e-3: (1, 2, 3), 0.1: (1, 2, 3), 1.0: (1, 2, 3), 10.0: (1, 2, 3), 100.0: (1,), 1000.0: (1,)}
+#: The solver path (-fit_table none) timed where it takes minutes at most: today's fits, "before".
+BEFORE_MUS = (1e-3, 0.1, 1.0)
+#: The coverage over the table's range: cases drawn (stream TABLE_COVERAGE_SEED) log-uniform in mu over
+#: [1e-3, 1e3] and in the spring K over [1e-4, 0.5] (units 2 pi R w / eps: a 2 mN/m to 10 N/m lever on a 20 nm
+#: tip at w = 0.05 J/m^2), the noise one of 0.3%, 1%, 3% of 2 pi R w.
+TABLE_COVERAGE_SEED = 34
+NOISE_SHARES = (0.003, 0.01, 0.03)
 
 
 def _data(name: str) -> str:
@@ -70,7 +87,7 @@ def coverage_case(mu: float, seed: int) -> dict:
     data = synthetic_curve(truth, Spring(k), Sampling(noise=noise, points=s["points"], z0=z0, F0=F0, seed=seed),
                            settings=curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1))
     made = time.perf_counter() - t
-    fit = fit_curve(data, Bodies(radius=R, young1=None, poisson1=None, epsilon=eps), Spring(k))
+    fit = fit_curve(data, Bodies(radius=R, young1=None, poisson1=None, epsilon=eps), Spring(k), table="none")
     row = {"mu": mu, "seed": seed, "gamma": w, "E_star": E, "z0_m": z0, "F0_N": F0, "noise_N": noise,
            "K": data.metadata["K"], "synth_s": made}
     f = fit_record(fit)
@@ -106,7 +123,8 @@ def coverage_section(rows: list, made: dict) -> str:
              f"{SYNTH['epsilon'] * 1e9:g} nm, k = {SYNTH['spring']:g} N/m, w = {SYNTH['gamma']:g} J/m^2, E* from "
              f"mu by eq. 9; {SYNTH['points']} points a leg; Gaussian noise of {SYNTH['noise_share']:.0%} of "
              f"2 pi R w; the contact point and baseline drawn at random), traced with steps half the fit's "
-             f"(`ds_max` 0.2, `cont_dF_max` 0.1), fitted by `fit_curve` with nothing but R, epsilon and k given. "
+             f"(`ds_max` 0.2, `cont_dF_max` 0.1), fitted by `fit_curve` with nothing but R, epsilon and k given, on the "
+             f"solver's curves throughout (`-fit_table none`; through the table: \"Coverage over the table's range\"). "
              f"{len(ok)} of {len(rows)} cases fitted; mu = {', '.join(f'{m:g}' for m in COVERAGE_MUS)}, seeds "
              f"{', '.join(str(s) for s in COVERAGE_SEEDS)}.", ""]
     for key, label in (("gamma", "w"), ("E_star", "E*")):
@@ -146,6 +164,199 @@ def coverage_section(rows: list, made: dict) -> str:
                       f"on a machine of {os.cpu_count()} cores shared with other work, load average 5 to 7; the "
                       f"study took {made.get('study_s', 0) / 60:.1f} min).  Alone on a core, one fit takes about "
                       f"10 s at mu = 1, 50 s at mu = 3 and 140 s at mu = 10 (`-bench_only fit` times mu = 1)."]
+    return "\n".join(lines) + "\n"
+
+
+# -- the speed and the coverage over the table's range ------------------------------------
+def table_cases(n: int) -> list[dict]:
+    """The first ``n`` cases of the coverage over the table's range: mu, K, the noise's share, the seed."""
+    rng = np.random.default_rng(TABLE_COVERAGE_SEED)
+    out = []
+    for i in range(n):
+        out.append({"case": i, "mu": float(10 ** rng.uniform(-3, 3)), "K": float(10 ** rng.uniform(-4, math.log10(0.5))),
+                    "noise_share": float(NOISE_SHARES[int(rng.integers(len(NOISE_SHARES)))]), "seed": 100 + i})
+    return out
+
+
+def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | None, finer: bool):
+    """A synthetic curve made by the solver (finer steps than the fit's where ``finer``) at (mu, K) with noise,
+    the contact point and baseline drawn from ``seed``; read from ``cache`` where it was made before. (data,
+    truth dict, the bodies given to the fit, the spring)."""
+    from ..fitting.data import MeasuredCurve
+    from ..fitting.results import Spring
+    from ..fitting.synthetic import Sampling, synthetic_curve
+    from ..model.physical import Bodies
+    from ..tracing.trace import curve_settings
+
+    s = SYNTH
+    # the tip's radius grows with mu above 1 as the indentation at the top load does (about 5 mu epsilon at
+    # F = 2), so that it stays below a sixth of R, inside the model's domain (R / 4, domain.py)
+    R, eps, w = s["radius"] * max(1.0, mu), s["epsilon"], s["gamma"]
+    E = w * math.sqrt(R / (mu**3 * eps**3))                      # eq. (9) solved for E*
+    k = K * 2 * math.pi * R * w / eps
+    rng = np.random.default_rng(1000 + seed)
+    z0, F0 = float(rng.uniform(-20e-9, 20e-9)), float(rng.uniform(-1e-9, 1e-9))
+    noise = noise_share * 2 * math.pi * R * w
+    tag = "" if R == s["radius"] else f"_R{R:.4g}"
+    name = None if cache is None else \
+        os.path.join(cache, f"curve_{mu:.6g}_{K:.6g}_{noise_share:g}_{seed}_{int(finer)}{tag}.npz")
+    made = math.nan
+    if name is not None and os.path.exists(name):
+        with np.load(name) as z:
+            data = MeasuredCurve(z=z["z"], F=z["F"], turn=int(z["turn"]), direction=1, spring=k, source="synthetic")
+    else:
+        c0 = time.process_time()
+        settings = curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1) if finer else None
+        data = synthetic_curve(Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w), Spring(k),
+                               Sampling(noise=noise, points=s["points"], z0=z0, F0=F0, seed=seed), settings=settings)
+        made = time.process_time() - c0
+        if name is not None:
+            np.savez(name, z=data.z, F=data.F, turn=data.turn)
+    truth = {"mu": mu, "K": K, "gamma": w, "E_star": E, "z0_m": z0, "noise_N": noise, "made_cpu_s": made, "R": R}
+    return data, truth, Bodies(radius=R, young1=None, poisson1=None, epsilon=eps), Spring(k)
+
+
+def _fit_row(data, truth, bodies, spring, table) -> dict:
+    """One fit of a synthetic curve, timed (CPU), its numbers against the truth."""
+    from ..fitting.curve_fit import TableStep, fit_curve
+
+    c0, t0 = time.process_time(), time.perf_counter()
+    try:
+        fit = fit_curve(data, bodies, spring, table=table)
+    except ValueError as e:
+        return {**truth, "error": str(e).splitlines()[0]}
+    cpu, wall = time.process_time() - c0, time.perf_counter() - t0
+    row = {**truth, "cpu_s": cpu, "wall_s": wall, "traces": fit.traces, "iterations": fit.iterations,
+           "reduced_chi2": fit.reduced_chi2, "mu_fit": fit.mu, "warnings": list(fit.warnings)}
+    for key in ("gamma", "E_star"):
+        q = getattr(fit, key)
+        row[f"{key}_fit"] = getattr(q, "value", None)
+        row[f"{key}_err"] = getattr(q, "err", None)
+    if isinstance(fit.path, TableStep):
+        row["search_cpu_s"] = fit.path.seconds
+        row["curves"] = fit.path.curves
+        row["step_bars"] = {c: float(b) for c, b in zip(fit.path.coordinates, fit.path.bars)}
+        row["table_share"] = {c: float(v) for c, v in zip(fit.path.coordinates, fit.path.contribution)}
+    else:
+        row["path"] = fit.path
+    return row
+
+
+def _partial(name: str, rows: list) -> None:
+    """The rows so far (a study stopped part way keeps them: ``-table`` redraws from the file)."""
+    with open(_data(name) + ".partial", "w") as f:
+        json.dump({"made": {"load": f"{os.getloadavg()[0]:.1f}", "partial": True, **paths.source()}, "rows": rows},
+                  f, indent=1)
+
+
+def speed_rows(before: bool, cache: str | None) -> list:
+    """The CPU of one fit through the table (and with ``before`` on the solver alone) at SPEED_MUS."""
+    _init()
+    from ..family.table import shipped
+
+    shipped()                                            # read once, outside the timings
+    rows = []
+    K = SYNTH["spring"] * SYNTH["epsilon"] / (2 * math.pi * SYNTH["radius"] * SYNTH["gamma"])
+    for mu in (BEFORE_MUS if before else SPEED_MUS):
+        for seed in (SPEED_SEEDS[mu][:1] if before else SPEED_SEEDS[mu]):
+            data, truth, bodies, spring = _synthetic(mu, K, SYNTH["noise_share"], seed, cache, finer=False)
+            row = _fit_row(data, truth, bodies, spring, "none" if before else "default")
+            row.update(seed=seed, path_kind="solver" if before else "table")
+            rows.append(row)
+            _partial("speed_before" if before else "speed", rows)
+            print(f"mu {mu:g} seed {seed}: {row.get('cpu_s', math.nan):.3f} s CPU", flush=True)
+    return rows
+
+
+def speed_section(rows: list, made: dict) -> str:
+    lines = ["## The speed of a curve fit", "",
+             "<!-- made by: python -m petsc_adhesion.benchmarks.fitting speed [-before] -cache DIR (data: "
+             "docs/data/fitting_speed.json; -table redraws from it) -->", "",
+             f"One fit of a synthetic curve (made by the solver: R = {SYNTH['radius'] * 1e9:g} nm times mu above 1, "
+             f"inside the model's domain at the top load; epsilon = "
+             f"{SYNTH['epsilon'] * 1e9:g} nm, K = 0.048 (k = 1 N/m at R = 20 nm), w = {SYNTH['gamma']:g} J/m^2, noise "
+             f"{SYNTH['noise_share']:.0%} of 2 pi R w, {SYNTH['points']} points a leg), its CPU time "
+             "(`time.process_time`, one process; the machine's two cores shared with other work, load average "
+             f"{made.get('load', '?')}).  Through the table: the search (`TableStep.seconds`) and the rest, "
+             "nearly all the solver's one curve at the optimum.  `-fit_table none`: the solver's curves throughout "
+             "(before).", "",
+             "| mu | path | fits | median CPU (s) | search on the table (s) | solver curves | median traces |",
+             "|---|---|---|---|---|---|---|"]
+    for kind in ("table", "solver"):
+        for mu in SPEED_MUS:
+            sel = [r for r in rows if r.get("path_kind") == kind and r["mu"] == mu and "cpu_s" in r]
+            if not sel:
+                continue
+            search = [r["search_cpu_s"] for r in sel if "search_cpu_s" in r]
+            cpu = np.median([r["cpu_s"] for r in sel])
+            lines.append(f"| {mu:g} | {kind} | {len(sel)} | {cpu:.3g} | "
+                         f"{f'{np.median(search):.3g}' if search else '-'} | "
+                         f"{int(np.median([r.get('curves', 0) for r in sel])) if kind == 'table' else '-'} | "
+                         f"{int(np.median([r['traces'] for r in sel]))} |")
+    return "\n".join(lines) + "\n"
+
+
+def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False) -> list:
+    """The first ``n`` cases of :func:`table_cases`, the cheapest (lowest mu) first: each a curve made by the
+    solver (finer steps than the fit's), fitted through the default table (``make_only``: made into the cache
+    only, no rows; ``made_only``: the cases whose curve is in the cache alone)."""
+    _init()
+    rows = []
+    for case in sorted(table_cases(n), key=lambda c: c["mu"]):
+        tag = "" if case["mu"] <= 1 else f"_R{SYNTH['radius'] * case['mu']:.4g}"
+        name = f"curve_{case['mu']:.6g}_{case['K']:.6g}_{case['noise_share']:g}_{case['seed']}_1{tag}.npz"
+        if made_only and not (cache and os.path.exists(os.path.join(cache, name))):
+            continue
+        data, truth, bodies, spring = _synthetic(case["mu"], case["K"], case["noise_share"], case["seed"], cache,
+                                                 finer=True)
+        if make_only:
+            print(f"case {case['case']} mu {case['mu']:.3g} made", flush=True)
+            continue
+        row = _fit_row(data, truth, bodies, spring, "default")
+        row.update(case=case["case"], noise_share=case["noise_share"], seed=case["seed"])
+        rows.append(row)
+        _partial("table_coverage", rows)
+        print(json.dumps({k: row.get(k) for k in ("case", "mu", "K", "gamma_fit", "gamma_err", "cpu_s")}), flush=True)
+    return rows
+
+
+def table_coverage_section(rows: list, made: dict) -> str:
+    ok = [r for r in rows if r.get("gamma_err") and r.get("E_star_err")]
+    lines = ["## Coverage over the table's range", "",
+             "<!-- made by: python -m petsc_adhesion.benchmarks.fitting table_coverage -cases N -cache DIR (data: "
+             "docs/data/fitting_table_coverage.json; -table redraws from it) -->", "",
+             f"Synthetic curves made by the solver (not by the table; steps half the fit's), the cases drawn "
+             f"log-uniform in mu over [1e-3, 1e3] and in K over [1e-4, 0.5], the noise {', '.join(f'{x:.1%}' for x in NOISE_SHARES)} of "
+             f"2 pi R w, sigma = 0 (R = {SYNTH['radius'] * 1e9:g} nm times mu above 1, epsilon = {SYNTH['epsilon'] * 1e9:g} nm, "
+             f"w = {SYNTH['gamma']:g} J/m^2, {SYNTH['points']} points a leg), each fitted through the package's table "
+             f"with R, epsilon and k given.  {len(ok)} of {len(rows)} cases gave both bars"
+             + (f"; the cases fitted span mu {min(r['mu'] for r in rows):.3g} to {max(r['mu'] for r in rows):.3g}"
+                if rows else "") + ".", ""]
+    for key, label in (("gamma", "w"), ("E_star", "E*")):
+        inside = [abs(r[f"{key}_fit"] - r[key]) <= 1.96 * r[f"{key}_err"] for r in ok]
+        ratio = [r[f"{key}_err"] / max(abs(r[f"{key}_fit"] - r[key]), 1e-300) for r in ok]
+        share = [r["table_share"].get("ln_gamma" if key == "gamma" else "ln_E_star", 0.0) /
+                 (r[f"{key}_err"] / r[f"{key}_fit"]) for r in ok if "table_share" in r]
+        if inside:
+            lines.append(f"- {label}: inside its 95% interval in **{sum(inside)} of {len(inside)}** cases "
+                         f"({sum(inside) / len(inside):.0%}); median bar / error {np.median(ratio):.2g}; the table's "
+                         f"step, a share of the bar: median {np.median(share) if share else math.nan:.2g}, largest "
+                         f"{max(share) if share else math.nan:.2g}.")
+    lines += ["", "| case | mu | K | noise | w fitted (J/m^2) | (w - w_true) / bar | E* fitted (Pa) | "
+              "(E* - E*_true) / bar | reduced chi^2 | step (bars: E*, w) | CPU (s) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        head = f"| {r.get('case', '')} | {r['mu']:.3g} | {r['K']:.2g} | {r.get('noise_share', 0):.1%} |"
+        if r not in ok:
+            why = r.get("error") or "; ".join(r.get("warnings", [])) or "no bar"
+            lines.append(f"{head} {why} | | | | | | |")
+            continue
+        st = r.get("step_bars", {})
+        lines.append(f"{head} {r['gamma_fit']:.5g} +- {r['gamma_err']:.2g} | "
+                     f"{(r['gamma_fit'] - r['gamma']) / r['gamma_err']:+.2f} | {r['E_star_fit']:.4g} +- "
+                     f"{r['E_star_err']:.2g} | {(r['E_star_fit'] - r['E_star']) / r['E_star_err']:+.2f} | "
+                     f"{r['reduced_chi2']:.3f} | {st.get('ln_E_star', math.nan):.2f}, {st.get('ln_gamma', math.nan):.2f} "
+                     f"| {r['cpu_s']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -205,8 +416,12 @@ def main(argv: list[str]) -> int:
     if argv[:1] == ["-case"]:
         print(json.dumps(coverage_case(float(argv[1]), int(argv[2]))))
         return 0
-    parts = [a for a in argv if not a.startswith("-")] or ["pull_off", "real", "coverage"]
+    value = {a: argv[i + 1] for i, a in enumerate(argv[:-1]) if a in ("-cache", "-cases")}
+    parts = [a for a in argv if not a.startswith("-") and a not in value.values()] or ["pull_off", "real", "coverage"]
     redraw = "-table" in argv
+    cache = value.get("-cache")
+    if cache is not None:
+        os.makedirs(cache, exist_ok=True)
     os.makedirs(paths.DATA, exist_ok=True)
     if "pull_off" in parts:
         if not redraw:
@@ -217,6 +432,29 @@ def main(argv: list[str]) -> int:
         with open(_data("pull_off")) as f:
             d = json.load(f)
         text = pull_off_section(d["rows"], d["made"])
+        paths.write_section(DOC, text)
+        print(text)
+    for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache), speed_section),
+                                   ("table_coverage", lambda: table_coverage_rows(int(value.get("-cases", 60)), cache,
+                                                                    "-make_only" in argv, "-made_only" in argv),
+                                    table_coverage_section)):
+        if part not in parts:
+            continue
+        if not redraw:
+            t = time.perf_counter()
+            rows = rows_of()
+            if not rows:                                    # -make_only: the curves are in the cache
+                continue
+            old = []
+            if part == "speed" and os.path.exists(_data(part)):       # -before adds to the table path's rows
+                with open(_data(part)) as f:
+                    old = [r for r in json.load(f)["rows"] if r.get("path_kind") != rows[0].get("path_kind")]
+            with open(_data(part), "w") as f:
+                json.dump({"made": {"seconds": time.perf_counter() - t, "load": f"{os.getloadavg()[0]:.1f}",
+                                    **paths.source()}, "rows": old + rows}, f, indent=1)
+        with open(_data(part)) as f:
+            d = json.load(f)
+        text = section(d["rows"], d["made"])
         paths.write_section(DOC, text)
         print(text)
     if "coverage" in parts:

@@ -22,6 +22,7 @@ was made on and the measured error; written all together or not at all.
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 from dataclasses import dataclass, field, replace
@@ -32,8 +33,8 @@ from ..tracing.measured import Measured, Missing
 from ..version import __version__
 from .legs import APPROACH, RETRACT, Legs, spring_legs
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "OutOfRange", "TableError", "FamilyTable", "FamilyCurve", "SpringCurve",
-           "TableEvent", "lagrange"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "SHIPPED", "shipped_path", "shipped", "OutOfRange", "TableError",
+           "FamilyTable", "FamilyCurve", "SpringCurve", "TableEvent", "lagrange"]
 
 FORMAT = "petsc-adhesion curve family"
 FORMAT_VERSION = 1
@@ -43,6 +44,24 @@ FORMAT_VERSION = 1
 SAFETY = 2.0
 #: The fields of a TableError, as the file's arrays err_<name>.
 ERROR_FIELDS = ("F_at_Z", "jump_Z", "jump_F", "event_lam", "event_F")
+
+
+#: The tables the package ships (petsc_adhesion/family/data/NAME.npz), by name: "smooth", sigma = 0 over mu 1e-3
+#: to 1e3 (docs/family.md says how it was built and its measured error); the first is the fits' default.
+SHIPPED = ("smooth",)
+
+
+def shipped_path(name: str = SHIPPED[0]) -> str:
+    """The file of the shipped table ``name`` (ValueError, one line, for a name the package does not ship)."""
+    if name not in SHIPPED:
+        raise ValueError(f"table '{name}': the package ships {', '.join(SHIPPED)}")
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", f"{name}.npz")
+
+
+@functools.lru_cache(maxsize=4)
+def shipped(name: str = SHIPPED[0]) -> FamilyTable:
+    """The shipped table ``name``, read once per process (a FamilyTable is immutable)."""
+    return FamilyTable.load(shipped_path(name))
 
 
 class OutOfRange(ValueError):
@@ -146,7 +165,8 @@ class FamilyTable:
         near = (em >= lo_m - 1e-12) & (em <= hi_m + 1e-12) & (self.err_sigma >= lo_s - 1e-12) & \
             (self.err_sigma <= hi_s + 1e-12)
         if not near.any():
-            near = np.ones(em.size, bool)
+            return Missing(f"the table's interpolation error was not measured about mu = {mu:.4g}, sigma = "
+                           f"{sigma:.4g} (its build measured the midpoints up to mu = {self.err_mu.max():.4g})")
         return TableError(**{f: SAFETY * float(np.max(self.errors[f][near])) for f in ERROR_FIELDS},
                           points=int(near.sum()))
 
@@ -255,8 +275,10 @@ class FamilyCurve:
         out.append(TableEvent("pull_off", Measured(float(L(r)), el, note=note), Measured(float(G(r)), ef, note=note)))
         return tuple(out)
 
-    def behind(self, K: float) -> SpringCurve:
-        """The curve behind a spring of stiffness ``K`` (units 2 pi R w / epsilon): its approach and retract.
+    def behind(self, K: float, reach: float | None = None) -> SpringCurve:
+        """The curve behind a spring of stiffness ``K`` (units 2 pi R w / epsilon): its approach and retract;
+        ``reach``, a base position the far branch is to be tabulated beyond (a fit's farthest point: there the
+        legs interpolate instead of solving eq. 28 for each Z).
 
         The table's curves start where the library's do, out of reach of the forces; behind a spring softer
         than the forces' gradient there, the approach jumps in before that start, so the far branch is
@@ -266,10 +288,10 @@ class FamilyCurve:
         if isinstance(K, bool) or not isinstance(K, (int, float, np.integer, np.floating)) or \
                 not (math.isfinite(K) and K > 0):
             raise OutOfRange(f"K {K!r}: expected a spring stiffness, a finite real > 0")
-        t, lam, F = self._far(float(K))
+        t, lam, F = self._far(float(K), reach)
         return SpringCurve(self, float(K), spring_legs(t, lam, F, float(K)))
 
-    def _far(self, K: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _far(self, K: float, reach: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(coordinate, lambda, F) of the curve with its far branch continued out to beyond the spring's start:
         points uniform in ln(1 - lambda) at tau < -1, their coordinate matched to the curve's rate at its start
         (so that the splines in it do not ring at the seam)."""
@@ -277,7 +299,7 @@ class FamilyCurve:
         from ..tracing.trace import spring_start
 
         lam0, F0 = float(self.lam[0]), float(self.F[0])
-        far = min(spring_start(K), lam0) - 2.0
+        far = min(spring_start(K), lam0, lam0 if reach is None or not math.isfinite(reach) else reach) - 2.0
         rigid0 = float(rigid_load(lam0))
         factor = F0 / rigid0 if rigid0 < 0 and F0 < 0 else 1.0
         u0, u1 = math.log(1.0 - lam0), math.log(1.0 - far)

@@ -19,7 +19,7 @@ unknowns are w and E* (optionally the rms roughness), with z_0, F_0 and the
 instrument's as nuisance parameters; R, eps and k_s are given.  They are fitted in
 x = (ln mu, ln w, [sigma], z_0 / eps, F_0 / s_F, [ln c], [ln (k / k_s)], [b eps / s_F],
 [d / s_F]) by scipy's trust-region reflective least squares within bounds (mu in
-[1e-3, 50], the model's range; sigma in [0, 3]; c and k within a factor 5 of the
+[1e-3, 1e3], the model's range; sigma in [0, 3]; c and k within a factor 5 of the
 stated), on the residuals (F_model - F_i) / s_F, s_F the noise of the far baseline,
 and with a stated uncertainty of the spring constant the prior's (k - k_s) / dk.
 The segment (approach, retract or both) and the piezo range fitted select the points;
@@ -27,11 +27,13 @@ the samples taken during a jump (the detector spreads it over a few) are on neit
 branch and left out.  Before the fit the curve is checked against the model's domain
 (:func:`domain_reasons`).
 
-Each evaluation at new (mu, K, sigma) traces one curve behind the spring (no error
-bars; cached).  The Jacobian's columns in ln mu, ln w and sigma are forward
-differences (relative step 2e-3) of the prediction *with each point kept on the
-branch it was on* (a jump does not move across a point within a difference), those
-of z_0 and F_0 exact on the traced curve.  Bars from the Jacobian at the optimum:
+Each evaluation at new (mu, K, sigma) traces one curve behind the spring (no error bars; cached), or, where the
+curve family table holds the model, interpolates it in milliseconds: then the solver traces one curve at the
+table's optimum and a Gauss-Newton step makes the result the solver's, the step added to the bars
+(:mod:`~petsc_adhesion.fitting.table_search`; ``CurveFit.path`` says which path).  The Jacobian's columns in
+ln mu, ln w and sigma are forward differences (relative step 2e-3) of the prediction *with each point kept on
+the branch it was on* (a jump does not move across a point within a difference), those of z_0 and F_0 exact on
+the traced curve.  Bars from the Jacobian at the optimum:
 covariance s^2 (J^T J)^-1, s^2 = sum of squared residuals / (n - p), carried to
 (ln E*, ln w) by the linear map of eq. (9), ln E* = ln w + (ln R - 3 ln mu - 3 ln eps)/2;
 the bar of w is w sd(ln w), that of E* is E* sd(ln E*) (a 95% interval is +-1.96 bars;
@@ -60,18 +62,19 @@ import numpy as np
 from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
 from .data import MeasuredCurve
-from .forward import APPROACH, RETRACT, ForwardCurve, curve_stop_reason
+from .forward import APPROACH, RETRACT, ForwardCurve, curve_stop_reason, open_table, table_covers, table_legs
 from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
                      domain_reasons, features, refuse_a_line, refuse_empty)
 from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, verdicts
 from .pull_off import maugis_dugdale_gamma
 from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misfit, misfit_p
+from .table_search import START_MUS, TableStep, cpu, solver_steps, table_bounds
 
 if TYPE_CHECKING:
     from ..tracing.trace import GridChoice, SolverChoice
 
 __all__ = ["CurveFit", "CurveFitError", "OutsideDomain", "FitProgress", "FittedModel", "domain_reasons",
-           "calibrated_invols", "fit_curve", "features", "MU_BOUNDS", "SIGMA_MAX", "predict_curve"]
+           "calibrated_invols", "fit_curve", "features", "MU_BOUNDS", "SIGMA_MAX", "predict_curve", "TableStep"]
 
 #: Relative step of the Jacobian's differences in ln mu, ln w (and the step in sigma).
 _STEP = 2e-3
@@ -116,6 +119,8 @@ class _Problem:
     best_chi2: float = math.inf
     progress: Callable[[FitProgress], None] | None = None     # after each evaluation (None: silent)
     t0: float = field(default_factory=time.perf_counter)
+    table: object = None            # the FamilyTable the search runs on (None: the solver's curves)
+    upper: np.ndarray | None = None     # the search's upper bounds (a table's differences turn back at them)
 
     def __post_init__(self):
         self.legs = np.r_[np.zeros(self.data.turn, int), np.ones(self.data.z.size - self.data.turn, int)]
@@ -206,6 +211,12 @@ class _Problem:
 
     def forward(self, p: dict) -> ForwardCurve:
         key = (round(p["mu"], 12), round(math.log(p["K"]), 12), round(p["sigma"], 12))
+        if key not in self.cache and self.table is not None:
+            if len(self.cache) > 64:
+                self.cache.pop(next(iter(self.cache)))
+            Z = self.Z(p)           # the far branch tabulated beyond the data, with room for z0 to move
+            reach = float(Z.min()) - 10.0 - 0.1 * float(np.ptp(Z))
+            self.cache[key] = table_legs(self.table, p["mu"], p["sigma"], p["K"], reach)
         if key not in self.cache:
             from ..tracing.trace import CurveRequest, curve_settings, trace_curve
 
@@ -302,6 +313,8 @@ class _Problem:
         n_pieces = len(self.forward(p).pieces)
         for j, name in enumerate(self.names):
             h = 1e-4 if name == "z0" else 1.0 if name in ("F0", "slope", "drag") else _STEP
+            if self.table is not None and self.upper is not None and x[j] + h > self.upper[j]:
+                h = -h                  # the table ends at its last node: the difference turns back
             xh = x.copy()
             xh[j] += h
             q = self.unpack(xh)
@@ -313,7 +326,7 @@ class _Problem:
 
 def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitChoice | None = None,
               model: Model | None = None, grid=None, solver=None, comm=None, progress=None,
-              spread_rules: tuple | None = None) -> CurveFit:
+              spread_rules: tuple | None = None, table="default") -> CurveFit:
     """Fit the model to a measured force-distance curve (see the module for the model and the method).
 
     Parameters
@@ -339,6 +352,10 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     spread_rules : tuple
         The roughness laws (:class:`~petsc_adhesion.tracing.model_spread.Rule`) the optimum is moved to, the
         model spread of w and E* (None: none; a rough model only).
+    table : str, FamilyTable or None
+        The curve family table the search runs on where it holds the model (:mod:`.table_search`): "default"
+        (the package's), a shipped table's name, a file, a FamilyTable; "none" or None: the solver's curves
+        throughout.  The result's ``path`` says which: a :class:`TableStep`, or why the solver alone.
 
     Returns the :class:`~petsc_adhesion.fitting.results.CurveFit`, its ``warnings`` saying where it does not
     hold (a parameter at a bound or undetermined, Missing then; a misfit; the cap on evaluations reached; a
@@ -351,6 +368,11 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     from ..tracing.trace import GridChoice, SolverChoice
 
     t0 = time.perf_counter()
+    try:
+        family = open_table(table)
+    except ValueError as e:
+        raise CurveFitError(f"the table: {e}") from None
+    label = "none" if family is None else table if isinstance(table, str) else "given"
     choice = choice or FitChoice()
     template = model or Model()
     grid, solver = grid or GridChoice(), solver or SolverChoice()
@@ -391,12 +413,17 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
                   None if choice.modulus or modulus is None else float(modulus),
                   choice.roughness, sigma0, noise, feat, float(data.F.max()), choice=choice, progress=progress)
     pb.notes += notes
+    why_not = "-fit_table none" if family is None else \
+        table_covers(family, template, template.rmax if template.rmax is not None else grid.default_rmax,
+                     choice.roughness, sigma0)
+    pb.table = family if why_not is None else None
     P = feat.pull_off_N * choice.invols_scale        # the pull-off as the true sensitivity makes it
     names = pb.names
+    reach = MU_BOUNDS if pb.table is None else (float(pb.table.mu[0]), float(pb.table.mu[-1]))
 
     def start(E: float) -> tuple[np.ndarray, float]:
         w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
-        mu = min(max(tabor(R, w, E, eps), MU_BOUNDS[0] * 1.01), MU_BOUNDS[1] * 0.99)
+        mu = min(max(tabor(R, w, E, eps), reach[0] * 1.01), reach[1] * 0.99)
         # the baseline's start: the far approach's median, or with its slope fitted its line at the contact point
         sloped = choice.virtual_deflection
         given = {"ln_mu": math.log(mu), "ln_gamma": math.log(w), "sigma": sigma0, "z0": 0.0,
@@ -410,22 +437,33 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
             x[names.index("F0")] = (base[0] + base[1] * x[j] * eps) / noise
         return x, float(np.sum(pb._all(pb.unpack(x))[0] ** 2))
 
+    c0 = cpu()
     if modulus is not None:
         x0, _ = start(float(modulus))
     else:
         w_guess = bodies.gamma or P / (1.75 * math.pi * R)
-        tries = [start(w_guess * math.sqrt(R / (m**3 * eps**3))) for m in (0.1, 0.3, 1.0, 3.0)]
+        mus = (0.1, 0.3, 1.0, 3.0) if pb.table is None else \
+            [m for m in START_MUS if reach[0] <= m <= reach[1]] or [math.sqrt(reach[0] * reach[1])]
+        tries = [start(w_guess * math.sqrt(R / (m**3 * eps**3))) for m in mus]
         x0 = min(tries, key=lambda t: t[1])[0]
     pb.leave_out_edges(x0)
     lo, hi = bounds(pb, choice, modulus)
+    if pb.table is not None:
+        lo, hi = table_bounds(pb.table, names, lo, hi, modulus, R, eps)
+        pb.upper = hi
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo if np.all(np.isfinite(hi - lo)) else 1), hi - 1e-9)
     pb.evaluations = 0
     res = least_squares(pb.residuals, x0, jac=pb.jacobian, bounds=(lo, hi), method="trf", x_scale="jac",
                         ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=choice.max_evaluations)
-    x = res.x
-    p = pb.unpack(x)
-    r, _ = pb._all(p)
-    J = pb.jacobian(x)
+    A = _to_moduli(names)
+    d, path = None, f"the solver's curves throughout: {why_not}"
+    if pb.table is not None:
+        x, x_curve, J, d, path = solver_steps(pb, res.x, lo, hi, A, label, pb.evaluations, cpu() - c0)
+    else:
+        x = x_curve = res.x
+        J = pb.jacobian(x)
+    p, p_curve = pb.unpack(x), pb.unpack(x_curve)
+    r, _ = pb._all(p_curve)
     n, m = pb.points, x.size
     chi2 = float(r @ r)
     s2 = chi2 / max(n - m, 1)
@@ -435,15 +473,14 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     except np.linalg.LinAlgError:
         JtJ_inv = None
         cov = np.full((m, m), np.nan)
-    # to (ln E*, ln w): ln E* = ln w - 1.5 ln mu + const
-    A = _to_moduli(names)
-    cov_p = A @ cov @ A.T
+    # to (ln E*, ln w): ln E* = ln w - 1.5 ln mu + const; the table's step a systematic term (table_search.py)
+    cov_p = A @ cov @ A.T + (np.outer(d, d) if d is not None else 0.0)
     var = np.diag(cov_p)
     sd = np.where(np.isfinite(var) & (var >= 0), np.sqrt(np.abs(var)), np.nan)
     out_names = tuple("ln_E_star" if n_ == "ln_mu" else n_ for n_ in names)
     get = {k_: (float(v) if math.isfinite(v) else None) for k_, v in zip(out_names, sd)}
-    Fm, pieces = pb.model_force(p)
-    fc = pb.forward(p)
+    Fm, pieces = pb.model_force(p_curve)
+    fc = pb.forward(p_curve)
     quantities, warned = verdicts(pb, choice, x, lo, hi, p, get, modulus)
     instrument, warned_i = instrument_values(pb, choice, x, lo, hi, p, get)
     warned += warned_i
@@ -469,13 +506,22 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
                     noise_stated=choice.noise is not None, p_value=misfit_p(chi2, n - m, noise_dof),
                     residual_rms_N=float(np.sqrt(np.mean((Fm - data.F)[used] ** 2))),
                     parameters=out_names, covariance=cov_p, data=data, F_fit=Fm, used=used, leg=pb.legs,
-                    branch=pb.labels, measured=feat, fitted=_fitted_features(pb, p, fc), bodies=bodies,
+                    branch=pb.labels, measured=feat, fitted=_fitted_features(pb, p_curve, fc), bodies=bodies,
                     spring=spring, choice=choice, traces=pb.traces, iterations=int(res.nfev),
                     status=str(res.message), wall_time_s=time.perf_counter() - t0,
-                    notes=tuple(dict.fromkeys(pb.notes + fc.notes)), warnings=tuple(warned),
-                    forward=FittedModel(fc, p["z0"], p["F0"], p["gain"] * 2 * math.pi * R * p["w"], eps,
-                                        data.direction, p["slope"], p["drag"]),
-                    instrument=instrument, segment=choice.segment, z_range=choice.z_range, spread=spread)
+                    notes=tuple(dict.fromkeys(pb.notes + fc.notes + [_path_note(path)])), warnings=tuple(warned),
+                    forward=FittedModel(fc, p_curve["z0"], p_curve["F0"], p_curve["gain"] * 2 * math.pi * R *
+                                        p_curve["w"], eps, data.direction, p_curve["slope"], p_curve["drag"]),
+                    instrument=instrument, segment=choice.segment, z_range=choice.z_range, spread=spread, path=path)
+
+
+def _path_note(path) -> str:
+    """The fit's note on its path: the table's search and the solver's step (TableStep), or the solver alone."""
+    if isinstance(path, str):
+        return path
+    return path.describe({"ln_E_star": "E*", "ln_gamma": "w", "z0": "z0", "F0": "F0", "sigma": "sigma",
+                          "ln_invols": "the sensitivity", "ln_k": "k", "slope": "the virtual deflection",
+                          "drag": "the drag"})
 
 
 def _to_moduli(names: tuple) -> np.ndarray:

@@ -230,6 +230,9 @@ class CurveFit:
     segment: str = "both"
     z_range: tuple | None = None
     spread: object = field(repr=False, default=None)    # ModelSpread | Missing | None: w, E* under other laws
+    #: how the optimum was found: a curve_fit.TableStep (the search on the table, then the solver), or why the
+    #: solver's curves throughout (a line)
+    path: object = field(repr=False, default=None)
 
     @property
     def reduced_chi2(self) -> float:

@@ -1,0 +1,126 @@
+"""A curve fit's search on the curve family table, and the solver's curve at its optimum (docs/fitting.md, "The
+search on the table").
+
+Where the table (:mod:`petsc_adhesion.family.table`) holds the model a fit asks for, the
+least squares of :func:`~petsc_adhesion.fitting.curve_fit.fit_curve` run on the table's
+interpolated curves (milliseconds an evaluation, against the solver's 0.1 to 85 s a
+curve).  What is reported is then made the solver's: at the table's optimum x_t one
+curve is traced and, with the table's Jacobian J there, one Gauss-Newton step
+
+    dx = -(J^T J)^-1 J^T r_s(x_t)
+
+is taken on the solver's residuals r_s.  At the table's optimum J^T r_t = 0 (r_t its residuals), so
+dx = -(J^T J)^-1 J^T (r_s - r_t): the first-order move of the optimum that the table's error r_t - r_s made,
+measured here against the solver.  It vanishes where the table is the solver (at a node, to the sampling's
+error).  After the step what is left of it is of the order of dx times the table's relative error in J, less
+than dx itself; so dx is added to the covariance as a systematic term, d d^T (d = dx in the reported
+coordinates): the table's contribution to each bar, reported beside it.  Where the step moves a
+parameter by more than STEP_BARS of its statistical bar another curve is traced at the stepped point and the step
+repeated (SOLVER_CURVES at most): the linearisation is not trusted beyond its bar.
+
+The chi^2, the residuals, the events and the fitted curve are the solver's last curve's; the parameters are one
+step from it (:class:`TableStep` says how far).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..family.table import FamilyTable
+
+__all__ = ["TableStep", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "table_bounds", "solver_steps"]
+
+#: The solver's curves at most after a search on the table.
+SOLVER_CURVES = 3
+#: A step larger than this many statistical bars in any coordinate is taken and another curve traced there.
+STEP_BARS = 1.0
+#: The Tabor parameters the search on the table starts from (the best of them; the solver's search tries 0.1 to 3).
+START_MUS = (0.003, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0)
+
+
+@dataclass(frozen=True)
+class TableStep:
+    """How a fit went through the table: ``table`` (its name or file), the least squares' ``evaluations`` on it
+    and their CPU ``seconds``; the solver's ``curves`` at the optimum; the last Gauss-Newton ``step`` in each
+    reported coordinate (``coordinates``: ln_E_star, ln_gamma, z0, ...; the fit's units), ``bars``, the step in
+    units of each coordinate's statistical bar (its largest is what decided another curve), and
+    ``contribution``, the table's share of each bar: the systematic term |step| beside the statistical bar;
+    ``first``, the largest first step in bars (from the table's optimum itself)."""
+
+    table: str
+    evaluations: int
+    seconds: float
+    curves: int
+    coordinates: tuple
+    step: np.ndarray
+    bars: np.ndarray
+    contribution: np.ndarray
+    first: float = math.nan
+
+    def describe(self, names: dict) -> str:
+        """One line for the fit's notes: the path, the step, the table's share of each bar (``names``: the
+        reported coordinate's label for each of ``coordinates``)."""
+        share = ", ".join(f"{names.get(c, c)} {b:.2g} bars" for c, b in zip(self.coordinates, self.bars))
+        return (f"the search ran on the table {self.table} ({self.evaluations} evaluations), then the solver traced "
+                f"{self.curves} curve{'s' * (self.curves != 1)} at its optimum: chi^2, "
+                f"the residuals and the events are the solver's, the parameters one Gauss-Newton step from its "
+                f"last curve, the step added to each bar ({share})")
+
+
+def table_bounds(table: FamilyTable, names: tuple, lo: np.ndarray, hi: np.ndarray, modulus: float | None,
+                 R: float, eps: float) -> tuple[np.ndarray, np.ndarray]:
+    """The search's bounds narrowed to the table's mu (ln mu; ln w through mu at a held modulus, eq. 9)."""
+    lo, hi = lo.copy(), hi.copy()
+    m0, m1 = float(table.mu[0]), float(table.mu[-1])
+    if "ln_mu" in names:
+        j = names.index("ln_mu")
+        lo[j], hi[j] = max(lo[j], math.log(m0)), min(hi[j], math.log(m1))
+    elif modulus is not None:
+        j = names.index("ln_gamma")
+        E = float(modulus)
+        lo[j] = max(lo[j], math.log(math.sqrt(m0**3 * E**2 * eps**3 / R)))
+        hi[j] = min(hi[j], math.log(math.sqrt(m1**3 * E**2 * eps**3 / R)))
+    return lo, hi
+
+
+def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarray, label: str,
+                 evaluations: int, seconds: float):
+    """From the table's optimum ``x`` to the solver's (module docstring): (the stepped parameters, the point of
+    the solver's last curve, the table's Jacobian there, the step d in the reported coordinates (``A`` maps the
+    fitted coordinates to them), the :class:`TableStep`).  ``pb`` (the fit's problem) leaves the table and
+    keeps the solver's last curve in its cache."""
+    J = pb.jacobian(x)
+    pb.table = None
+    pb.cache.clear()
+    try:
+        JtJ_inv = np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        JtJ_inv = np.linalg.pinv(J.T @ J)
+    G = JtJ_inv @ J.T
+    dof = max(pb.points - x.size, 1)
+    curves, first = 0, math.nan
+    while True:
+        r = pb._all(pb.unpack(x))[0]         # one solver curve (cached for what the fit reads of it)
+        curves += 1
+        stepped = np.clip(x - G @ r, lo, hi)
+        dx = stepped - x
+        sd = np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r @ r) / dof)
+        moved = float(np.max(np.abs(dx) / np.where(sd > 0, sd, np.inf))) if dx.size else 0.0
+        first = moved if curves == 1 else first
+        if moved <= STEP_BARS or curves >= SOLVER_CURVES:
+            break
+        x = stepped
+    d = A @ dx
+    sd_out = np.sqrt(np.abs(np.diag(A @ JtJ_inv @ A.T)) * float(r @ r) / dof)
+    bars = np.abs(d) / np.where(sd_out > 0, sd_out, np.inf)
+    names = tuple("ln_E_star" if n == "ln_mu" else n for n in pb.names)
+    step = TableStep(label, evaluations, seconds, curves, names, d, bars, np.abs(d), first)
+    return stepped, x, J, d, step
+
+
+def cpu() -> float:
+    """The process's CPU seconds (the search's cost, as the benchmark measures it)."""
+    return time.process_time()
