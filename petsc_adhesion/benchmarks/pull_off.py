@@ -20,6 +20,8 @@ A benchmark is a measurement, not a test: the machine's load is printed with it.
 from __future__ import annotations
 
 import argparse
+import glob
+import json
 import math
 import os
 import sys
@@ -28,12 +30,13 @@ import time
 import numpy as np
 
 from ..errors import say
-from ..family.build import spread
-from ..family.pull_off import DEFAULT_PATH, PullOffTable, trace_pull_off
+from ..family.pull_off import DEFAULT_PATH, NodeValue, PullOffTable, trace_pull_off
+from ..tracing.measured import Measured
 
 #: The sigma nodes: the pull-off falls fastest between 0.1 and 0.4 (from 0.92 to 0.18 of the smooth one at mu =
-#: 0.01), and like sigma^-2 beyond 1 (ln |F_po| nearly linear in sigma there).
-SIGMA_NODES = (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.6, 1.0, 1.75, 3.0)
+#: 0.01), its sharpest bend between 0.15 and 0.2 (the error at that cell's centre was 1e-2 with nodes 0.05 apart:
+#: hence 0.175), and like sigma^-2 beyond 1 (ln |F_po| nearly linear in sigma there).
+SIGMA_NODES = (0.0, 0.05, 0.1, 0.15, 0.175, 0.2, 0.25, 0.3, 0.4, 0.6, 1.0, 1.75, 3.0)
 #: The mu nodes: about two a decade through the change from the rigid sphere's -1 to JKR's -3/4 (mu 0.1 to 10),
 #: one a decade beyond, where the pull-off approaches JKR's like mu^-1.5 (docs/soft.md) and a node costs most.
 MU_NODES = (1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0, 1000.0)
@@ -46,32 +49,91 @@ def cost(case: tuple[float, float]) -> float:
     return (0.1 + 0.7 * mu ** 0.7) * (1.0 if sigma < 0.5 else 0.3)
 
 
-def build(mu: tuple, sigma: tuple, comm=None, tell=print, keep=None) -> PullOffTable:
-    """The table of the nodes ``mu`` x ``sigma`` with its error measured at the cells' centres (collective);
-    RuntimeError naming every node that failed.  ``keep(table)`` is given the nodes' table before the centres
-    are traced (so that a build stopped then keeps them)."""
+def points(mu: tuple, sigma: tuple) -> list[tuple[str, float, float]]:
+    """What a build traces, in the order it is done: each row of nodes in mu, then the centres of the cells
+    below it (so that the rows done by any time make a table: :func:`assemble`)."""
+    out = []
+    lm = np.log(np.asarray(mu, float))
+    smid = 0.5 * (np.asarray(sigma[1:]) + np.asarray(sigma[:-1]))
+    for k, m in enumerate(mu):
+        out += [("node", float(m), float(s)) for s in sigma]
+        if k:
+            out += [("centre", float(math.exp(0.5 * (lm[k] + lm[k - 1]))), float(s)) for s in smid]
+    return out
+
+
+def _key(kind: str, mu: float, sigma: float) -> str:
+    return f"{kind} {mu:.10g} {sigma:.10g}"
+
+
+def _record(kind: str, n: NodeValue) -> str:
+    def m(q):
+        return None if q is None else [q.value, q.err, q.grid]
+    return json.dumps({"kind": kind, "mu": n.mu, "sigma": n.sigma, "F": m(n.F), "lam": m(n.lam),
+                       "seconds": n.seconds, "failed": n.failed})
+
+
+def journal(out: str) -> dict:
+    """The points traced so far by builds into ``out`` (their journals ``out.journal<rank>.jsonl``): key ->
+    NodeValue."""
+    done = {}
+    for path in sorted(glob.glob(glob.escape(out) + ".journal*.jsonl")):
+        with open(path) as fh:
+            for line in fh:
+                if not line.strip():
+                    continue
+                r = json.loads(line)
+                q = [None if r[k] is None else Measured(r[k][0], r[k][1], r[k][2]) for k in ("F", "lam")]
+                done[_key(r["kind"], r["mu"], r["sigma"])] = NodeValue(r["mu"], r["sigma"], q[0], q[1],
+                                                                       r["seconds"], r["failed"])
+    return done
+
+
+def build(mu: tuple, sigma: tuple, out: str, comm=None, tell=print) -> None:
+    """Trace every point of :func:`points` not yet in ``out``'s journal, spread over the ranks of ``comm`` (in
+    their order, each to the least loaded rank), each appended to its rank's journal as it is done (so that a
+    build stopped keeps its work and a second one continues it).  Collective."""
     from petsc4py import PETSc
 
-    cases = [(float(m), float(s)) for m in mu for s in sigma]
-    t0 = time.perf_counter()
+    mpi = (comm or PETSc.COMM_WORLD).tompi4py()
+    size, rank = mpi.Get_size(), mpi.Get_rank()
+    done = journal(out)
+    todo = [p for p in points(mu, sigma) if _key(*p) not in done]
+    load = [0.0] * size
+    mine = []
+    for p in todo:
+        r = int(np.argmin(load))
+        load[r] += cost(p[1:])
+        if r == rank:
+            mine.append(p)
+    tell(f"{len(todo)} points to trace ({len(done)} in the journal) on {size} ranks")
+    with open(f"{out}.journal{rank}.jsonl", "a") as fh:
+        for kind, m, s in mine:
+            n = trace_pull_off(m, s, kind == "node", PETSc.COMM_SELF)
+            fh.write(_record(kind, n) + "\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+            print(f"{kind} mu {m:g} sigma {s:g}: " + (f"F {n.F.value:.8g} +- {n.F.err or math.nan:.2g}"
+                  if n.failed is None else f"FAILED {n.failed}") + f", {n.seconds:.2f} s CPU", flush=True)
+    mpi.barrier()
 
-    def node(c, bars=True):
-        n = trace_pull_off(c[0], c[1], bars, PETSc.COMM_SELF)
-        print(f"{'node' if bars else 'centre'} mu {n.mu:g} sigma {n.sigma:g}: " +
-              (f"F {n.F.value:.8g} +- {n.F.err if n.F.err is not None else math.nan:.2g}" if n.failed is None
-               else f"FAILED {n.failed}") + f", {n.seconds:.2f} s CPU", flush=True)
-        return n
-    nodes = spread(cases, node, cost, comm)
-    table = PullOffTable.of_nodes(mu, sigma, nodes)
-    t1 = time.perf_counter()
-    tell(f"nodes: {len(cases)} in {t1 - t0:.1f} s wall, {np.sum(table.seconds):.1f} s CPU of traces")
-    if keep is not None:
-        keep(table)
-    centres = table.centres()
-    done = spread(centres, lambda c: node(c, False), cost, comm)
-    table = table.measure(done)
-    tell(f"centres: {len(centres)} in {time.perf_counter() - t1:.1f} s wall, {np.sum(table.cell_seconds):.1f} s CPU")
-    return table
+
+def assemble(mu: tuple, sigma: tuple, out: str) -> PullOffTable:
+    """The table of the journal's rows: the nodes up to the largest mu whose row, and every row and centre
+    below it, is traced; its error from the centres.  RuntimeError where fewer than 4 rows are, or a node
+    failed."""
+    done = journal(out)
+    rows = 0
+    for k, m in enumerate(mu):
+        pts = [p for p in points(mu[:k + 1], sigma) if p[1] >= (mu[k - 1] if k else 0) * (1 + 1e-12)]
+        if not all(_key(*p) in done for p in pts):
+            break
+        rows = k + 1
+    if rows < 4:
+        raise RuntimeError(f"only {rows} rows of nodes traced (4 at least make a table)")
+    nodes = [done[_key("node", float(m), float(s))] for m in mu[:rows] for s in sigma]
+    table = PullOffTable.of_nodes(mu[:rows], sigma, nodes)
+    return table.measure([done[_key("centre", m, s)] for m, s in table.centres()])
 
 
 def report(table: PullOffTable, tell=print) -> None:
@@ -89,8 +151,9 @@ def report(table: PullOffTable, tell=print) -> None:
 
 
 def fit_cost(mus, sigmas, tell=print) -> None:
-    """The CPU of a pull-off fit with the table and with the solver's secant alone, at each (mu, sigma): R = 20
-    nm, epsilon = 0.3 nm, w = 0.05 J/m^2, E* from mu by eq. (9); P the model's own pull-off (the table's)."""
+    """The CPU of a pull-off fit with the table and with the solver's secant alone (the path before the table,
+    which refused mu above 50), at each (mu, sigma): R = 20 nm, epsilon = 0.3 nm, w = 0.05 J/m^2, E* from mu by
+    eq. (9); P the table's pull-off there, its bar 1%."""
     from ..fitting.pull_off import fit_pull_off
     from ..model.physical import Bodies
 
@@ -105,6 +168,9 @@ def fit_cost(mus, sigmas, tell=print) -> None:
             P = abs(float(table.pull_off(mu, sigma)[0])) * 2 * math.pi * R * w
             row = [f"{mu:g}", f"{sigma:g}"]
             for use in (True, False):
+                if not use and mu > 50:
+                    row += ["(refused before the table: mu above 50)", "-", "-"]
+                    continue
                 t = time.process_time()
                 try:
                     f = fit_pull_off(P, b, P_err=0.01 * P, use_table=use)
@@ -144,12 +210,17 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--out", default=DEFAULT_PATH)
     b.add_argument("--mu", nargs="+", type=float, default=list(MU_NODES))
     b.add_argument("--sigma", nargs="+", type=float, default=list(SIGMA_NODES))
+    a = sub.add_parser("assemble")
+    a.add_argument("--out", default=DEFAULT_PATH)
+    a.add_argument("--mu", nargs="+", type=float, default=list(MU_NODES))
+    a.add_argument("--sigma", nargs="+", type=float, default=list(SIGMA_NODES))
     r = sub.add_parser("report")
     r.add_argument("table", nargs="?", default=DEFAULT_PATH)
     f = sub.add_parser("fit")
     f.add_argument("--mu", nargs="+", type=float, default=[0.1, 1.0, 10.0, 300.0])
     f.add_argument("--sigma", nargs="+", type=float, default=[0.0, 0.3])
-    for q in (b, r, f):
+    f.add_argument("--map-only", action="store_true")
+    for q in (b, a, r, f):
         q.error = p.error                                 # type: ignore[method-assign]
     return p
 
@@ -166,9 +237,20 @@ def main(argv=None) -> int:
             return 2
         return 0
     if args.command == "fit":
-        fit_cost(args.mu, args.sigma)
+        if not args.map_only:
+            fit_cost(args.mu, args.sigma)
         map_cost()
         return 0
+    if args.command == "assemble":
+        try:
+            table = assemble(tuple(args.mu), tuple(args.sigma), args.out)
+        except RuntimeError as e:
+            say(f"benchmarks.pull_off: {e}")
+            return 3
+        table.save(args.out)
+        report(table, tell)
+        tell(f"written {args.out} ({os.path.getsize(args.out) / 1e3:.1f} kB): mu up to {table.mu[-1]:g}")
+        return 0 if np.all(np.isfinite(table.cell_F)) else 3
     from petsc4py import PETSc
 
     rank = PETSc.COMM_WORLD.getRank()
@@ -179,17 +261,12 @@ def main(argv=None) -> int:
         say(f"benchmarks.pull_off: --mu {' '.join(f'{m:g}' for m in mu)} --out {args.out}: expected at least 4 "
             f"increasing mu > 0 and an existing folder")
         return 2
-    try:
-        table = build(mu, tuple(args.sigma), PETSc.COMM_WORLD, tell,
-                      keep=(lambda t: t.save(args.out + ".nodes.npz")) if rank == 0 else None)
-    except (RuntimeError, ValueError) as e:
-        say(f"benchmarks.pull_off: {e}")
-        return 3
+    t0 = time.perf_counter()
+    build(mu, tuple(args.sigma), args.out, PETSc.COMM_WORLD, tell)
+    tell(f"traced in {time.perf_counter() - t0:.1f} s wall")
     if rank == 0:
-        table.save(args.out)
-        report(table, tell)
-        tell(f"written {args.out} ({os.path.getsize(args.out) / 1e3:.1f} kB)")
-    return 0 if np.all(np.isfinite(table.cell_F)) else 3
+        return main(["assemble", "--out", args.out, "--mu", *map(str, mu), "--sigma", *map(str, args.sigma)])
+    return 0
 
 
 if __name__ == "__main__":

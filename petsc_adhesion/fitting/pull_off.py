@@ -6,17 +6,23 @@ depends on the unknown work of adhesion w by eq. (9), mu = (R w^2 / (E^2 eps^3))
 mu proportional to w^(2/3), with the roughness sigma = rms / eps fixed.  Given P, the
 bodies (R, E from eq. 2, eps, rms) and nothing of w, :func:`fit_pull_off` solves
 
-    g(w) = 2 pi R w |F_p(mu(w))| - P = 0
+    g(w) = ln(2 pi R w |F_p(mu(w))| / P) = 0
 
-for w: a secant iteration in ln w from the Maugis-Dugdale value, each step a curve
-traced to its pull-off on the grid (no error bars), then one curve with error bars at
-the root, whose best F_p (extrapolated over nested grids) corrects w by one Newton
-step.  Its bar, from the pull-off's bar F_err and the measurement's P_err:
+for w.  Where the pull-off table (:class:`~petsc_adhesion.family.pull_off.PullOffTable`)
+holds the root and describes the model (its roughness rule and domain): the table's
+root (:func:`gamma_from_pull_offs`) is the start, one curve with error bars there gives
+the best F_p (extrapolated over nested grids) and its bar, a Newton step with the
+table's slope s = d ln P / d ln w = 1 + (2/3) d ln|F_p| / d ln mu moves w, one curve on
+the grid at the new w (scaled by the first's best over its grid value) and a second
+Newton step end it: two curves.  Elsewhere (mu below the table's 1e-3, sigma beyond its
+3, another roughness law) the secant in ln w on the solver's pull-off on the grid, from
+the table's root or the Maugis-Dugdale value, then one curve with error bars at the
+root and a Newton step onto its best F_p, s by central differences (two more curves, mu
+(1 +- 1.3%)).  The bar, from the pull-off's bar F_err, the measurement's P_err and the
+iteration's last step in ln w (zero after the secant):
 
-    dP/dw = 2 pi R |F_p| (1 + (2/3) d ln|F_p| / d ln mu)
-    gamma_err = sqrt((2 pi R w F_err)^2 + P_err^2) / (dP/dw)
+    gamma_err = gamma sqrt(((F_err / F_p)^2 + (P_err / P)^2) / s^2 + step^2)
 
-with d ln|F_p| / d ln mu by central differences (two more curves, mu (1 +- 1.3%)).
 Beside it, what the closed forms would have said: DMT's w = P / (2 pi R), JKR's
 w = P / (1.5 pi R) and Maugis-Dugdale's, solved self-consistently in the same way with
 its pull-off at lambda_MD = 1.157 mu (:mod:`~petsc_adhesion.model.reference.maugis_dugdale`;
@@ -26,17 +32,20 @@ With roughness, gamma's model spread (``spread_rules``;
 :mod:`~petsc_adhesion.tracing.model_spread`): the same root solve under each other
 roughness law, on the grid without bars, the largest distance from gamma and the
 warning of a curve's spread (beyond ten of gamma's bars or 10 % of it).
+
+Many pull-offs at once (a force map's adhesion): :func:`gamma_from_pull_offs`, by the
+table alone, each value with the table's bar and the measurement's carried into w.
 """
 from __future__ import annotations
 
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
+
 from .. import brent
 from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
