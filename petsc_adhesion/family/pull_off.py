@@ -312,6 +312,12 @@ class PullOffTable:
         lam = self._eval("lam", lm, s) * (1.0 + np.exp(lm))
         return F, lam
 
+    def ln_pull_off(self, mu, sigma) -> np.ndarray:
+        """ln |F_po| of the interpolant at (mu, sigma) (broadcast; OutOfRange outside), without bars: what an
+        inversion evaluates."""
+        lm, s = self._checked(mu, sigma)
+        return self._eval("F", lm, s)
+
     def slope(self, mu, sigma) -> np.ndarray:
         """d ln|F_po| / d ln mu at (mu, sigma) (broadcast; OutOfRange outside): the interpolant's."""
         lm, s = self._checked(mu, sigma)

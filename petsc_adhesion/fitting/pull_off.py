@@ -341,11 +341,11 @@ def gamma_from_pull_offs(P, bodies: Bodies, P_err=0.0, table: PullOffTable | Non
         lo, hi = math.log(tab.mu[0]), math.log(tab.mu[-1])
 
         def h(x):
-            return 1.5 * x + np.log(-tab.pull_off(np.exp(x), sigma)[0]) - target
+            return 1.5 * x + tab.ln_pull_off(np.exp(x), sigma) - target
         h_lo, h_hi = h(np.full(target.shape, lo)), h(np.full(target.shape, hi))
         below, above = h_lo > 0, h_hi < 0
         a, b = np.full(target.shape, lo), np.full(target.shape, hi)
-        for _ in range(60):                    # the bracket halved to 1e-17 of the table's ln mu range
+        for _ in range(48):                    # the bracket halved to 4e-15 of the table's ln mu range
             m = 0.5 * (a + b)
             up = h(m) > 0
             b, a = np.where(up, m, b), np.where(up, a, m)
