@@ -58,7 +58,8 @@ __all__ = ["FORMAT", "FORMAT_VERSION", "F_STOP", "SAFETY", "DEFAULT_PATH", "OutO
 FORMAT = "petsc-adhesion pull-off table"
 FORMAT_VERSION = 1
 #: The load a node's curve is traced to: it stops when F rises back through it after the pull-off (the most
-#: tensile load lies before it; checked against curves traced to F = 2: the same F_min to its grid's round-off).
+#: tensile load lies before it: at the nodes tested the same F_min as the default curve traced to F = 2, within
+#: their bars).  At large mu it saves little: the JKR curve's load is back at 0 only at lambda = 1.95 mu.
 F_STOP = 0.1
 #: What the error stated about a point is of the largest measured at the cell centres about it (the error varies
 #: within a cell; the curve family's measured 1.4 times at a third of a cell: docs/family.md).
