@@ -233,9 +233,12 @@ def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | No
 
 def _table_start(P: float, bodies: Bodies, sigma: float, table, mu_of) -> tuple | None:
     """(ln w, d ln(w |F_p|) / d ln w) of the table's inversion of P, or None where the table does not hold the
-    root (mu below its range, or sigma beyond it: the secant then starts from Maugis-Dugdale); PullOffFitError
-    where the root lies above mu = 1000, the model's range."""
-    tab = table if table is not None else PullOffTable.default()
+    root (mu outside its range, or sigma beyond it) or is not installed: the secant then starts from
+    Maugis-Dugdale; PullOffFitError where the root lies above mu = 1000, the model's range."""
+    try:
+        tab = table if table is not None else PullOffTable.default()
+    except FileNotFoundError:           # a package installed without its data: the secant alone, as before
+        return None
     found = gamma_from_pull_offs(np.array([P]), replace(bodies, rms=sigma * bodies.epsilon), 0.0, tab)
     if found.found[0]:
         mu = float(found.mu[0])
