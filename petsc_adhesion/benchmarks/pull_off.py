@@ -179,6 +179,8 @@ def fit_cost(mus, sigmas, tell=print) -> None:
                             str(f.curves), f"{time.process_time() - t:.2f}"]
                 except ValueError as e:
                     row += [f"refused: {e}", "-", f"{time.process_time() - t:.2f}"]
+                except RuntimeError as e:          # a solver's curve that failed: said in the row, the rest run
+                    row += [f"failed: {str(e).splitlines()[0]}", "-", f"{time.process_time() - t:.2f}"]
             tell("| " + " | ".join(row) + " |")
 
 
