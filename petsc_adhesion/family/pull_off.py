@@ -29,8 +29,9 @@ the pull-off (its F_min located again on nested grids and extrapolated,
 :mod:`~petsc_adhesion.tracing.error_bars`).  The interpolation's error is measured
 at the centre of every cell (the midpoint in ln mu and sigma) against the solver
 there and stored per cell; the error stated at a point is ``SAFETY`` times the
-largest of the cells about it (its own and their neighbours), and a value's bar is
-that plus the largest solver bar at the corners of its cell.
+largest relative error of the cells about it (its own and their neighbours) times the
+pull-off there, and a value's bar is that plus the largest solver bar at the corners of
+its cell (lambda's: absolute errors).
 
 The file: .npz with its format name and version, the program's version, the nodes,
 their values, bars and costs, the error per cell; written all together or not at
@@ -327,11 +328,12 @@ class PullOffTable:
     def pull_off(self, mu, sigma) -> tuple[np.ndarray, np.ndarray]:
         """(F, err) at (mu, sigma), numpy arrays of their broadcast shape, units 2 pi R w: the interpolated
         pull-off and its bar, the largest solver bar at the corners of its cell plus the interpolation error
-        (``SAFETY`` times the largest measured at the centres of its cell and their neighbours; inf on a table
-        whose error was not measured).  OutOfRange (one line) outside the table."""
+        (``SAFETY`` times the largest relative error measured at the centres of its cell and their neighbours,
+        times |F|: the pull-off spans three decades in sigma; inf on a table whose error was not measured).
+        OutOfRange (one line) outside the table."""
         lm, s = self._checked(mu, sigma)
         F = -np.exp(self._eval("F", lm, s))
-        return F, self._node_bar(lm, s, self.F_err) + self._cell_error(lm, s, "cell_F")
+        return F, self._node_bar(lm, s, self.F_err) + self._cell_error(lm, s, "cell_F") * np.abs(F)
 
     def pull_off_lambda(self, mu, sigma) -> tuple[np.ndarray, np.ndarray]:
         """(lambda, err) at the pull-off, as :meth:`pull_off` (the approach in epsilon)."""
@@ -359,6 +361,9 @@ class PullOffTable:
         cache = self.__dict__.setdefault("_near", {})
         if name not in cache:
             e = np.asarray(getattr(self, name), float)
+            if name == "cell_F":        # relative: the pull-off spans three decades, its error with it
+                centres = np.array(self.centres())
+                e = e / np.abs(self.interpolated(centres[:, 0], centres[:, 1])[0]).reshape(e.shape)
             e = np.where(np.isfinite(e), e, np.inf)
             p = np.pad(e, 1, mode="edge")
             n, m = e.shape
