@@ -54,7 +54,7 @@ from ..version import __version__
 from .table import OutOfRange
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "F_STOP", "SAFETY", "DEFAULT_PATH", "OutOfRange", "PullOffTable",
-           "NodeValue", "trace_pull_off", "table_model"]
+           "NodeValue", "trace_pull_off", "table_model", "describes", "makima_slopes", "hermite", "INTERPOLANT"]
 
 FORMAT = "petsc-adhesion pull-off table"
 FORMAT_VERSION = 1
