@@ -126,7 +126,8 @@ def test_the_classes_conform_to_their_protocols_and_a_law_without_wall_does_not(
 
 
 def test_wheel_leaves_out_the_benchmarks(tmp_path):
-    """The wheel built with pyproject.toml's settings: every library module and the options' table, no benchmark."""
+    """The wheel built with pyproject.toml's settings: every library module, the options' table and the shipped
+    tables of family/, no benchmark."""
     src = tmp_path / "src"
     src.mkdir()
     for f in ("pyproject.toml", "README.md"):
@@ -143,3 +144,6 @@ def test_wheel_leaves_out_the_benchmarks(tmp_path):
     assert not [n for n in names if n.startswith("petsc_adhesion/benchmarks")]
     assert {n for n in names if n.endswith(".py")} == _library_modules()
     assert "petsc_adhesion/app/options/petsc_options.txt" in names
+    # the shipped tables: an installed package without them would fall back to the solver without a word
+    shipped = {os.path.relpath(f, ROOT) for f in glob.glob(os.path.join(PACKAGE, "family", "**", "*.npz"), recursive=True)}
+    assert shipped and shipped <= names, (shipped, sorted(n for n in names if n.endswith(".npz")))
