@@ -350,3 +350,20 @@ def test_a_footprint_past_the_edge_is_refused_or_clipped_with_a_note():
     fp = footprint(topo, (-1e-9, 100e-9), 20e-9, EPS, clip=True)      # the centre on the scan's edge
     assert "past the scan's edge" in fp.note
     assert fp.pixels == pytest.approx(math.pi * 10 ** 2 / 2, rel=0.1)
+
+
+def test_the_shipped_table_evaluates_inside_its_range_and_flags_the_rest():
+    """Through the package's own PullOffTable: a footprint's (mu, sigma) inside the table gets the Gaussian rule's
+    pull-off, equal to the solver's at that point within the table's bar; one beyond the table's sigma is Missing
+    with the reason (the table refuses it: it is never asked)."""
+    from petsc_adhesion.family.pull_off import PullOffTable
+    from petsc_adhesion.population.evaluate import TableEvaluator
+    from petsc_adhesion.tracing.measured import Missing
+
+    table = PullOffTable.default()
+    inside, beyond = (0.4, 0.5), (0.4, float(table.sigma[-1]) + 1.5)
+    got = TableEvaluator(table).evaluate_many(np.array([inside[0], beyond[0]]), np.array([inside[1], beyond[1]]))
+    solver = GaussianRule().one(*inside)
+    assert abs(got[0].value - solver.value) <= got[0].err + (solver.err or 0.0), (got[0], solver)
+    assert isinstance(got[1], Missing)
+    assert "outside the table" in got[1].reason

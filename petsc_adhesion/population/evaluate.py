@@ -214,7 +214,10 @@ class TableEvaluator:
         if mu.size == 0:
             return []
         inside = np.asarray(self.model.covers(mu, sigma), dtype=bool)
-        F, err = (np.asarray(x, dtype=float) for x in self.model.pull_off(mu, sigma))
+        # the table refuses a point outside its range (OutOfRange): ask it for the points it covers only
+        F, err = np.full(mu.shape, np.nan), np.full(mu.shape, np.nan)
+        if inside.any():
+            F[inside], err[inside] = (np.asarray(x, dtype=float) for x in self.model.pull_off(mu[inside], sigma[inside]))
         return [Measured(float(f), float(e)) if ok and np.isfinite(f) else
                 Missing(f"mu = {m:.4g}, sigma = {s:.4g} outside the table's range")
                 for f, e, ok, m, s in zip(F, err, inside, mu, sigma)]
