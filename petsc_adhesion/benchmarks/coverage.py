@@ -2,6 +2,8 @@
 
     ./run coverage              # all cases (about 15 minutes on 2 cores), then the table
     ./run coverage -table       # the table from docs/data/coverage.json only
+    ./run coverage -mu 3 5 7    # only the cases of these mu (their stored rows replaced), then the table
+    ./run coverage -jobs 1      # one case at a time (two without it)
 
 For each case (mu, sigma) the default curve is traced and every event (and each
 fold's landing) is located again on its own grid at the levels the program
@@ -197,12 +199,43 @@ def table(rows: list) -> str:
     return "\n".join(lines)
 
 
+def selected(argv: list[str], cases: list) -> tuple:
+    """(the cases whose mu ``-mu MU ...`` names, all of them without it; the processes at once, ``-jobs N``,
+    2 without it), or (None, why) for arguments that are not that."""
+    jobs, mus, rest = 2, None, list(argv)
+    known = sorted({c[0] for c in cases})
+    try:
+        while rest:
+            flag = rest.pop(0)
+            if flag == "-jobs":
+                jobs = int(rest.pop(0))
+                if jobs < 1:
+                    raise ValueError
+            elif flag == "-mu":
+                mus = []
+                while rest and not rest[0].startswith("-j"):
+                    mus.append(float(rest.pop(0)))
+                if not mus or any(m not in known for m in mus):
+                    raise ValueError
+            else:
+                raise ValueError
+    except (ValueError, IndexError):
+        return None, ("the study takes -mu MU ... (of " + ", ".join(f"{m:g}" for m in known)
+                      + ") and -jobs N (a positive integer)")
+    return [c for c in cases if mus is None or c[0] in mus], jobs
+
+
 def main(argv: list[str]) -> int:
-    """The study (or one case with -case mu sigma, or the table alone with -table)."""
+    """The study (or one case with -case mu sigma, the cases of some mu with -mu MU ..., or the table alone
+    with -table)."""
     if argv[:1] == ["-case"]:
         print(json.dumps(case(float(argv[1]), float(argv[2]))))
         return 0
     if argv[:1] != ["-table"]:
+        cases, jobs = selected(argv, CASES)
+        if cases is None:
+            print(f"coverage: {jobs}", file=sys.stderr)
+            return 2
         # each case's rows replace that case's stored ones as soon as it is done, so that a study cut short
         # leaves the cases it finished, and the others as they were (the table says which hold what)
         os.makedirs(os.path.dirname(DATA), exist_ok=True)
@@ -210,8 +243,8 @@ def main(argv: list[str]) -> int:
         if os.path.exists(DATA):
             with open(DATA) as f:
                 stored = json.load(f)
-        with ThreadPoolExecutor(2) as pool:
-            for done in pool.map(_run, CASES):
+        with ThreadPoolExecutor(jobs) as pool:
+            for done in pool.map(_run, cases):
                 where = {(r["mu"], r["sigma"]) for r in done}
                 stored = [r for r in stored if (r["mu"], r["sigma"]) not in where] + done
                 with open(DATA + ".part", "w") as f:

@@ -3,6 +3,8 @@
     python -m petsc_adhesion.benchmarks.energy_coverage          # all cases (two at a time), then the table
     python -m petsc_adhesion.benchmarks.energy_coverage -table   # the table from docs/data/energy_coverage.json
     python -m petsc_adhesion.benchmarks.energy_coverage -case 1 0 0.05   # one case (mu sigma K|rigid), printed
+    python -m petsc_adhesion.benchmarks.energy_coverage -mu 5 -jobs 1    # the cases of mu = 5 only, one at a
+                                                   # time (their stored rows replaced, the others kept)
 
 For each case (mu, sigma, machine: the rigid machine or a spring of stiffness
 K) the program's energy of one approach-retract cycle and its bar are those of
@@ -524,13 +526,35 @@ def main(argv: list[str]) -> int:
                     json.dump({"made": data["made"], "rows": rows}, f, indent=1)
                 os.replace(DATA + ".part", DATA)
     elif argv[:1] != ["-table"]:
+        from .coverage import selected
+        cases, jobs = selected(argv, CASES)
+        if cases is None:
+            print(f"energy_coverage: {jobs}", file=sys.stderr)
+            return 2
         t = time.perf_counter()
-        with ThreadPoolExecutor(2) as pool:
-            rows = list(pool.map(_run, CASES))
-        made = {"study_s": time.perf_counter() - t, **paths.source()}
-        os.makedirs(os.path.dirname(DATA), exist_ok=True)
-        with open(DATA, "w") as f:
-            json.dump({"made": made, "rows": rows}, f, indent=1)
+        if cases != CASES and os.path.exists(DATA):
+            # some cases measured again (program and truth): stored as each is done, in place of their old
+            # rows, each row naming the commit it measured (the others keep the study's)
+            with open(DATA) as f:
+                data = json.load(f)
+            where = {(r["mu"], r["sigma"], r["K"]): i for i, r in enumerate(data["rows"])}
+            with ThreadPoolExecutor(jobs) as pool:
+                for c, row in zip(cases, pool.map(_run, cases)):
+                    row["source"] = paths.source()
+                    if c in where:
+                        data["rows"][where[c]] = row
+                    else:
+                        data["rows"].append(row)
+                    with open(DATA + ".part", "w") as f:
+                        json.dump(data, f, indent=1)
+                    os.replace(DATA + ".part", DATA)
+        else:
+            with ThreadPoolExecutor(jobs) as pool:
+                rows = list(pool.map(_run, cases))
+            made = {"study_s": time.perf_counter() - t, **paths.source()}
+            os.makedirs(os.path.dirname(DATA), exist_ok=True)
+            with open(DATA, "w") as f:
+                json.dump({"made": made, "rows": rows}, f, indent=1)
     with open(DATA) as f:
         data = json.load(f)
     paths.write_section(DOC, section(data["rows"], data["made"]), HEADING)
