@@ -3,7 +3,7 @@
     ./run coverage              # all cases (about 15 minutes on 2 cores), then the table
     ./run coverage -table       # the table from docs/data/coverage.json only
     ./run coverage -mu 3 5 7    # only the cases of these mu (their stored rows replaced), then the table
-    ./run coverage -jobs 1      # one case at a time (two without it)
+    ./run coverage -mu 5 -sigma 0 -jobs 1   # and of these sigma, one case at a time (two without -jobs)
 
 For each case (mu, sigma) the default curve is traced and every event (and each
 fold's landing) is located again on its own grid at the levels the program
@@ -200,10 +200,10 @@ def table(rows: list) -> str:
 
 
 def selected(argv: list[str], cases: list) -> tuple:
-    """(the cases whose mu ``-mu MU ...`` names, all of them without it; the processes at once, ``-jobs N``,
-    2 without it), or (None, why) for arguments that are not that."""
-    jobs, mus, rest = 2, None, list(argv)
-    known = sorted({c[0] for c in cases})
+    """(the cases whose mu ``-mu MU ...`` and sigma ``-sigma S ...`` name, all of them without; the processes
+    at once, ``-jobs N``, 2 without it), or (None, why) for arguments that are not that."""
+    jobs, chosen, rest = 2, {}, list(argv)
+    known = {name: sorted({c[k] for c in cases}) for k, name in enumerate(("mu", "sigma"))}
     try:
         while rest:
             flag = rest.pop(0)
@@ -211,18 +211,21 @@ def selected(argv: list[str], cases: list) -> tuple:
                 jobs = int(rest.pop(0))
                 if jobs < 1:
                     raise ValueError
-            elif flag == "-mu":
-                mus = []
-                while rest and not rest[0].startswith("-j"):
-                    mus.append(float(rest.pop(0)))
-                if not mus or any(m not in known for m in mus):
+            elif flag in ("-mu", "-sigma"):
+                name = flag[1:]
+                chosen[name] = []
+                while rest and not rest[0].startswith("-j") and not rest[0].startswith("-s") \
+                        and not rest[0].startswith("-m"):
+                    chosen[name].append(float(rest.pop(0)))
+                if not chosen[name] or any(v not in known[name] for v in chosen[name]):
                     raise ValueError
             else:
                 raise ValueError
     except (ValueError, IndexError):
-        return None, ("the study takes -mu MU ... (of " + ", ".join(f"{m:g}" for m in known)
-                      + ") and -jobs N (a positive integer)")
-    return [c for c in cases if mus is None or c[0] in mus], jobs
+        return None, ("the study takes -mu MU ... (of " + ", ".join(f"{m:g}" for m in known["mu"]) + "), -sigma S ... "
+                      "(of " + ", ".join(f"{m:g}" for m in known["sigma"]) + ") and -jobs N (a positive integer)")
+    return [c for c in cases if all(c[k] in chosen[name] for k, name in enumerate(("mu", "sigma")) if name in chosen)], \
+        jobs
 
 
 def main(argv: list[str]) -> int:
