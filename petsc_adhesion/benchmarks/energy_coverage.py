@@ -413,9 +413,8 @@ def _span(xs: list) -> str:
 def _again(rows: list) -> str:
     """The cases measured again whole (program and truth) at a commit of their own (``-mu``), by commit."""
     by: dict = {}
-    for r in rows:
-        if r.get("source"):
-            by.setdefault((r["source"].get("commit") or "?")[:7], set()).add(r["mu"])
+    for r in (r for r in rows if r.get("source")):
+        by.setdefault((r["source"].get("commit") or "?")[:7], set()).add(r["mu"])
     return "".join(f"; the cases of mu = {', '.join(f'{m:g}' for m in sorted(mus))}, program and truth, at commit {c}"
                    for c, mus in sorted(by.items()))
 
@@ -565,7 +564,7 @@ def main(argv: list[str]) -> int:
                     json.dump({"made": data["made"], "rows": rows}, f, indent=1)
                 os.replace(DATA + ".part", DATA)
     elif argv[:1] != ["-table"]:
-        from .coverage import selected
+        from .selection import selected
         cases, jobs = selected(argv, CASES)
         if cases is None:
             print(f"energy_coverage: {jobs}", file=sys.stderr)
@@ -576,14 +575,10 @@ def main(argv: list[str]) -> int:
             # rows, each row naming the commit it measured (the others keep the study's)
             with open(DATA) as f:
                 data = json.load(f)
-            where = {(r["mu"], r["sigma"], r["K"]): i for i, r in enumerate(data["rows"])}
             with ThreadPoolExecutor(jobs) as pool:
                 for c, row in zip(cases, pool.map(_run, cases)):
-                    row["source"] = paths.source()
-                    if c in where:
-                        data["rows"][where[c]] = row
-                    else:
-                        data["rows"].append(row)
+                    data["rows"] = [r for r in data["rows"] if (r["mu"], r["sigma"], r["K"]) != c] + \
+                        [row | {"source": paths.source()}]
                     with open(DATA + ".part", "w") as f:
                         json.dump(data, f, indent=1)
                     os.replace(DATA + ".part", DATA)
