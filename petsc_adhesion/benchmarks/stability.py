@@ -145,9 +145,10 @@ TRUNCATION = 5e-3
 
 def truncated_check() -> list[str]:
     """mu = MU_TRUNCATED = 10 truncated at r_m = 10, traced past its equilibrium to F = 0.5 (3426 steps; 143 s
-    measured once, 2011 s of wall time at a load of 15 to 30: too slow for the suite; tests/test_truncated.py checks mu = 4): what is wrong, one line each (none
-    when the curve completes with exit 0 and no warning, has two fold pairs as the half-infinite model has,
-    within TRUNCATION of its turning points, a pull-off within 1% of JKR's -3/4 and one equilibrium)."""
+    measured once, 2011 s of wall time at a load of 15 to 30: too slow for the suite; tests/test_truncated.py
+    checks mu = 4): what is wrong, one line each (none when the curve completes with exit 0 and no warning,
+    has two fold pairs as the half-infinite model has, within TRUNCATION of its turning points, a pull-off
+    within 1% of JKR's -3/4 and one equilibrium)."""
     from ..model.reference.jkr import JKR_PULL_OFF
     from ..tracing.edge_grids import MU_TRUNCATED
 
