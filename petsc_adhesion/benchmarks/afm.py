@@ -146,18 +146,20 @@ def _table(head, rows) -> str:
 
 
 def _save(fig, name: str, table: str, seconds: float) -> None:
+    """The figure NAME.png and its table NAME.md; ``seconds``: the CPU time it took (this process's: the curves
+    are traced in it), not the wall time, which on a shared machine says more of the load than of the cost."""
     fig.tight_layout()
     fig.savefig(os.path.join(paths.FIGURES, f"{name}.png"), dpi=110)
     what = name.split("_", 1)[1]
     with open(os.path.join(paths.FIGURES, f"{name}.md"), "w") as f:
         f.write(f"<!-- made by: ./run figures {name} ({COMMAND} {what}) -->\n{table}\n\n"
-                f"Made in {seconds:.0f} s on one core ({COMMAND} {what}).\n")
+                f"Made in {seconds:.0f} s of CPU on one core ({COMMAND} {what}).\n")
 
 
 def example() -> None:
     """afm_example: the force-distance curves of the tip on glass and on polystyrene behind three cantilevers,
     and the table of their jumps, pull-off and energy."""
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     fig = figure(figsize=(13.5, 7.6))
     axes = fig.subplots(len(FLATS), len(CANTILEVERS))
     rows = []
@@ -208,13 +210,13 @@ def example() -> None:
               f"K = k epsilon / (2 pi R gamma) = {b.spring_stiffness(1.0):.5f} k (k in N/m).  Z and lambda are 0 "
               "where the undeformed tip would sit at the equilibrium spacing epsilon from the flat, negative "
               "before it: the jump-in distance is -Z of the jump-in.")
-    _save(fig, "afm_example", table, time.perf_counter() - t0)
+    _save(fig, "afm_example", table, time.process_time() - t0)
 
 
 def stiffness() -> None:
     """afm_stiffness: the jump-in distance, the energy of a cycle and the jump-off force against K for each mu
     of :data:`MUS`, with the limits K -> infinity (rigid machine) and K -> 0."""
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     fig = figure(figsize=(15.0, 4.6))
     ax_in, ax_e, ax_off = fig.subplots(1, 3)
     Ks = np.array(STIFFNESSES)
@@ -302,13 +304,13 @@ def stiffness() -> None:
                      "cycle reaches it: the table gives the primary jumps")
     if notes:
         table += "\n\n" + "\n".join(f"- {n}" for n in notes)
-    _save(fig, "afm_stiffness", table, time.perf_counter() - t0)
+    _save(fig, "afm_stiffness", table, time.process_time() - t0)
 
 
 def radius() -> None:
     """afm_radius: the contact radius against the load along the curve (rigid machine) for each mu of
     :data:`RADIUS_MUS`, with JKR, DMT and Maugis-Dugdale."""
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     fig = figure(figsize=(6.0 * len(RADIUS_MUS), 4.8))
     axes = fig.subplots(1, len(RADIUS_MUS))
     rows = []
@@ -340,7 +342,7 @@ def radius() -> None:
               "the separation first rises through the edge level H = 0.5 (a gap of 1.5 epsilon, inside the "
               "cohesive zone; docs/numerics.md), with its error bar; JKR's and DMT's are where the gap closes, "
               "Maugis-Dugdale's the inner radius of its Dugdale zone.")
-    _save(fig, "afm_radius", table, time.perf_counter() - t0)
+    _save(fig, "afm_radius", table, time.process_time() - t0)
 
 
 #: name -> the function that makes docs/figures/afm_NAME.png and .md

@@ -2,6 +2,8 @@
 
     ./run coverage              # all cases (about 15 minutes on 2 cores), then the table
     ./run coverage -table       # the table from docs/data/coverage.json only
+    ./run coverage -mu 3 5 7    # only the cases of these mu (their stored rows replaced), then the table
+    ./run coverage -mu 5 -sigma 0 -jobs 1   # and of these sigma, one case at a time (two without -jobs)
 
 For each case (mu, sigma) the default curve is traced and every event (and each
 fold's landing) is located again on its own grid at the levels the program
@@ -25,6 +27,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from . import paths
+from .selection import selected
 
 __all__ = ["CASES", "BEYOND", "case", "table", "main", "DATA", "DOC", "estimate", "truth", "DOC_TEXT"]
 
@@ -198,11 +201,16 @@ def table(rows: list) -> str:
 
 
 def main(argv: list[str]) -> int:
-    """The study (or one case with -case mu sigma, or the table alone with -table)."""
+    """The study (or one case with -case mu sigma, the cases of some mu with -mu MU ..., or the table alone
+    with -table)."""
     if argv[:1] == ["-case"]:
         print(json.dumps(case(float(argv[1]), float(argv[2]))))
         return 0
     if argv[:1] != ["-table"]:
+        cases, jobs = selected(argv, CASES)
+        if cases is None:
+            print(f"coverage: {jobs}", file=sys.stderr)
+            return 2
         # each case's rows replace that case's stored ones as soon as it is done, so that a study cut short
         # leaves the cases it finished, and the others as they were (the table says which hold what)
         os.makedirs(os.path.dirname(DATA), exist_ok=True)
@@ -210,8 +218,8 @@ def main(argv: list[str]) -> int:
         if os.path.exists(DATA):
             with open(DATA) as f:
                 stored = json.load(f)
-        with ThreadPoolExecutor(2) as pool:
-            for done in pool.map(_run, CASES):
+        with ThreadPoolExecutor(jobs) as pool:
+            for done in pool.map(_run, cases):
                 where = {(r["mu"], r["sigma"]) for r in done}
                 stored = [r for r in stored if (r["mu"], r["sigma"]) not in where] + done
                 with open(DATA + ".part", "w") as f:
