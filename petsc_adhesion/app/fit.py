@@ -319,10 +319,6 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
 
 def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     """A fit of the options database; its exit status (``helping``: checked only)."""
-    from .run import refuse_study_options
+    from .run import command_main
 
-    refuse_study_options(opts)
-    if helping:
-        collective(PETSc.COMM_WORLD, read, opts, PETSc.COMM_WORLD, argv)
-        return 0
-    return execute(opts, argv)[0]
+    return command_main(opts, argv, helping, read, execute)

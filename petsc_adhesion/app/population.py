@@ -218,8 +218,8 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
 
 
 def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
-    """A population of the options database; its exit status (``helping``: checked only)."""
-    if helping:
-        collective(PETSc.COMM_WORLD, read, opts, PETSc.COMM_WORLD, argv)
-        return 0
-    return execute(opts, argv)[0]
+    """A population of the options database; its exit status (``helping``: checked only; a study's options
+    refused, as every command of one request refuses them)."""
+    from .run import command_main
+
+    return command_main(opts, argv, helping, read, execute)

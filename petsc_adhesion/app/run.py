@@ -209,6 +209,16 @@ def refuse_study_options(opts: AppOptions) -> None:
                          f"-study_option); remove it")
 
 
+def command_main(opts: AppOptions, argv: list[str], helping: bool, read, execute) -> int:
+    """The exit status of a command of one request (a fit, a map, a population): a study's options refused;
+    ``helping`` (-help): ``read`` alone, on every rank, so that its refusals come first; else ``execute``'s status."""
+    refuse_study_options(opts)
+    if helping:
+        collective(PETSc.COMM_WORLD, read, opts, PETSc.COMM_WORLD, argv)
+        return 0
+    return execute(opts, argv)[0]
+
+
 def main(opts: AppOptions, argv: list[str], helping: bool = False) -> int:
     """One run of the options database (initialised from ``argv``); its exit status.
 

@@ -51,7 +51,7 @@ import numpy as np
 from ..model.parameters import Model
 from ..tracing.measured import Measured
 from ..version import __version__
-from .table import OutOfRange
+from .table import OutOfRange, load_npz, save_npz
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "F_STOP", "SAFETY", "DEFAULT_PATH", "OutOfRange", "PullOffTable",
            "NodeValue", "trace_pull_off", "table_model", "describes", "makima_slopes", "hermite", "INTERPOLANT"]
@@ -217,26 +217,12 @@ class PullOffTable:
         arrays.update(format=np.array(FORMAT), format_version=np.array(FORMAT_VERSION),
                       program_version=np.array(self.version), roughness=np.array(self.roughness),
                       F_stop=np.array(self.F_stop))
-        tmp = f"{path}.part{os.getpid()}.npz"
-        try:
-            with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, **arrays)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
+        save_npz(path, arrays)
 
     @classmethod
     def load(cls, path: str) -> PullOffTable:
         """The table in ``path``; ValueError, one line, for a file that is no pull-off table of this version."""
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                d = {k: z[k] for k in z.files}
-        except (OSError, ValueError, EOFError) as e:
-            why = str(e).splitlines()[0] if str(e) else type(e).__name__
-            raise ValueError(f"{path}: not a pull-off table ({why})") from None
+        d = load_npz(path, "pull-off table")
         if str(d.get("format", "")) != FORMAT:
             raise ValueError(f"{path}: not a pull-off table (no format '{FORMAT}')")
         if int(d["format_version"]) != FORMAT_VERSION:

@@ -33,7 +33,7 @@ from ..tracing.measured import Measured, Missing
 from ..version import __version__
 from .legs import APPROACH, RETRACT, Legs, spring_legs
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "SHIPPED", "shipped_path", "shipped", "OutOfRange", "TableError",
+__all__ = ["save_npz", "load_npz", "FORMAT", "FORMAT_VERSION", "SHIPPED", "shipped_path", "shipped", "OutOfRange", "TableError",
            "FamilyTable", "FamilyCurve", "SpringCurve", "TableEvent", "lagrange"]
 
 FORMAT = "petsc-adhesion curve family"
@@ -208,25 +208,12 @@ class FamilyTable:
                       seconds=np.full(self.s_lo.shape, np.nan) if self.seconds is None else self.seconds,
                       springs=self.springs, err_mu=self.err_mu, err_sigma=self.err_sigma,
                       **{f"err_{f}": self.errors.get(f, np.zeros(0)) for f in ERROR_FIELDS})
-        tmp = f"{path}.part{os.getpid()}.npz"
-        try:
-            with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, **arrays)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
+        save_npz(path, arrays)
 
     @classmethod
     def load(cls, path: str) -> FamilyTable:
         """The table in ``path``; ValueError, one line, for a file that is no table of this format version."""
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                d = {k: z[k] for k in z.files}
-        except (OSError, ValueError, EOFError) as e:
-            raise ValueError(f"{path}: not a curve family table ({str(e).splitlines()[0] if str(e) else type(e).__name__})") from None
+        d = load_npz(path, "curve family table")
         if str(d.get("format", "")) != FORMAT:
             raise ValueError(f"{path}: not a curve family table (no format '{FORMAT}')")
         if int(d["format_version"]) != FORMAT_VERSION:
@@ -343,3 +330,28 @@ class SpringCurve:
         ef, _ = self.curve._bar("jump_F")
         return tuple((Measured(float(z), ez, note=note), Measured(b, ef, note=note), Measured(a, ef, note=note))
                      for z, (b, a) in zip(self.legs.jumps[leg], self.legs.jump_forces(leg)))
+
+
+def save_npz(path: str, arrays: dict) -> None:
+    """``arrays`` into the .npz ``path``, all or nothing: a temporary file beside it, flushed to the disk and renamed
+    over it, so that a failed write never damages an earlier table (the family's and the pull-off table's files)."""
+    tmp = f"{path}.part{os.getpid()}.npz"
+    try:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def load_npz(path: str, what: str) -> dict:
+    """Every array of the .npz ``path``; ValueError, one line naming ``what`` it should be, for a file numpy cannot
+    read as one (no pickles: a table is data)."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except (OSError, ValueError, EOFError) as e:
+        raise ValueError(f"{path}: not a {what} ({str(e).splitlines()[0] if str(e) else type(e).__name__})") from None

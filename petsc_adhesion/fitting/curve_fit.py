@@ -71,6 +71,7 @@ from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misf
 from .table_search import START_MUS, TableStep, cpu, solver_steps, table_bounds
 
 if TYPE_CHECKING:
+    from ..family.table import FamilyTable
     from ..tracing.trace import GridChoice, SolverChoice
 
 __all__ = ["CurveFit", "CurveFitError", "OutsideDomain", "FitProgress", "FittedModel", "domain_reasons",
@@ -119,7 +120,7 @@ class _Problem:
     best_chi2: float = math.inf
     progress: Callable[[FitProgress], None] | None = None     # after each evaluation (None: silent)
     t0: float = field(default_factory=time.perf_counter)
-    table: object = None            # the FamilyTable the search runs on (None: the solver's curves)
+    table: FamilyTable | None = None   # the FamilyTable the search runs on (None: the solver's curves)
     upper: np.ndarray | None = None     # the search's upper bounds (a table's differences turn back at them)
 
     def __post_init__(self):
