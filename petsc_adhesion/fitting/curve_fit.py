@@ -425,6 +425,10 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     def start(E: float) -> tuple[np.ndarray, float]:
         w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
         mu = min(max(tabor(R, w, E, eps), reach[0] * 1.01), reach[1] * 0.99)
+        if pb.table is not None and "ln_gamma" in names:
+            # a held modulus: w is the coordinate, so its start too must lie where the table holds mu
+            # (eq. 9 inverted: w = sqrt(mu^3 E^2 epsilon^3 / R))
+            w = math.sqrt(mu**3 * E**2 * eps**3 / R)
         # the baseline's start: the far approach's median, or with its slope fitted its line at the contact point
         sloped = choice.virtual_deflection
         given = {"ln_mu": math.log(mu), "ln_gamma": math.log(w), "sigma": sigma0, "z0": 0.0,
