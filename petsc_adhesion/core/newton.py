@@ -27,7 +27,7 @@ from petsc4py import PETSc
 from ..core import capi
 from .capi import python_errors
 
-__all__ = ["Tolerances", "PetscSettings", "SolverOptions", "role_of", "is_solvers_own", "create_snes", "PCReuse", "solved", "fresh_retry", "krylov_retry", "guard", "Newton", "PC_REUSE_ITS", "TRUE_RESIDUAL"]
+__all__ = ["Tolerances", "PetscSettings", "SolverOptions", "role_of", "is_solvers_own", "create_snes", "PCReuse", "fresh_retry", "krylov_retry", "guard", "Newton", "PC_REUSE_ITS", "TRUE_RESIDUAL"]
 
 #: Keep a preconditioner while GMRES needs at most this many iterations with it.
 PC_REUSE_ITS = 10
@@ -295,25 +295,6 @@ class PCReuse:
         return {"pending": bool(self.pending(ksp)), "at": None if self.at is None else list(self.at)}
 
 
-def solved(snes: PETSc.SNES, X: PETSc.Vec) -> bool:
-    """Whether the last solve of ``snes`` left X a solution (collective): PETSc's reason converged, and where
-    the reason is rtol's relative decrease, the residual left at most rtol times the size of X (at least 1).
-
-    Why: rtol measures the decrease from the first iterate.  A first iterate whose residual is larger than
-    the unknowns themselves is no guess, and the decrease from it proves nothing: a predictor by the wall of
-    a truncated height distribution (where P grows like the gap's -8th power) started one solve at a
-    residual of about 1e11, and rtol "converged" it at 13, a point far off the curve that no later step
-    could leave (mu = 0.731, sigma = 0.20537, K = 3.6876, 201 uniform nodes: stuck at lambda = -1.099).
-    From a first iterate smaller than the unknowns this is rtol's own test.
-    """
-    reason = snes.getConvergedReason()
-    if reason <= 0:
-        return False
-    if reason != PETSc.SNES.ConvergedReason.CONVERGED_FNORM_RELATIVE:
-        return True
-    return snes.getFunctionNorm() <= snes.getTolerances()[0] * max(1.0, X.norm())
-
-
 def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse, work: PETSc.Vec) -> bool:
     """Solve from X in place; after a failure, once more from X with a fresh preconditioner.
 
@@ -324,7 +305,7 @@ def fresh_retry(snes: PETSc.SNES, X: PETSc.Vec, reuse: PCReuse, work: PETSc.Vec)
     for _ in range(2):
         with python_errors():
             snes.solve(None, X)
-        if solved(snes, X):
+        if snes.getConvergedReason() > 0:
             return True
         reuse.expire()
         work.copy(X)
@@ -467,7 +448,7 @@ class Newton:
             return fresh_retry(self.snes, x, self.reuse, self.work)
         with python_errors():
             self.snes.solve(None, x)
-        return solved(self.snes, x)
+        return self.snes.getConvergedReason() > 0
 
     @property
     def iterations(self) -> tuple[int, int]:
