@@ -289,6 +289,17 @@ def _model_curve(fit) -> dict:
     return {"z": z, "F_approach": predict_curve(fit, z, "approach"), "F_retract": predict_curve(fit, z, "retract")}
 
 
+def _implausible_result(fit) -> tuple:
+    """The warning line for a fitted work of adhesion outside what the field measures (plausible.py's range of
+    -phys_gamma): the model may reach it (mu up to 1000), yet a value of 1e4 J/m^2 says the input's units slipped."""
+    g = getattr(fit.gamma, "value", None)
+    p = PLAUSIBLE["phys_gamma"]
+    if g is None or p.lo <= g <= p.hi:
+        return ()
+    where = p.low if g < p.lo else p.high
+    return (f"the fitted work of adhesion {g:.4g} J/m^2 is {where}: check the measurement's units (N, m)",)
+
+
 def execute(opts: AppOptions, argv: list[str], report: bool = True):
     """The fit of the options database: (exit status, the library's fit).  The status is 3 where the fit does
     not hold (its warnings: a parameter at a bound or undetermined, a misfit; docs/fitting.md), its files
@@ -303,7 +314,7 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
         say(f"-fit_curve: outside the model's domain: {printable(str(e))}; -fit_outside_domain warn fits it all "
             f"the same")
         return 3, None
-    warn(req.warnings, report)      # with the result: a refusal of the fit (a pull-off no mu makes) stays one line
+    warn(req.warnings + _implausible_result(fit), report)   # with the result: a refused fit stays one line
     head = program_record(Program.of(comm))
     head["model"] = model_record(replace(req.model, mu=fit.mu, sigma=fit.sigma))   # the model fitted
     given = opts.given()

@@ -5,15 +5,13 @@ The measured force at piezo position z is modelled as
 
     F(z) = F_0 + b (z - z_0) + d [retract] + (k_s / (k c)) 2 pi R w f(Z; mu, K, sigma),   Z = s (z - z_0) / eps
 
-with f the model's force against the base position Z of a spring of stiffness
-K = k eps / (2 pi R w) on the approach or the retract
-(:class:`~petsc_adhesion.fitting.forward.ForwardCurve`: its jumps vertical in F at
+with f the model's force against the base position Z of a spring of stiffness K = k eps / (2 pi R w) on the
+approach or the retract (:class:`~petsc_adhesion.fitting.forward.ForwardCurve`: its jumps vertical in F at
 constant Z), mu by eq. (9) from w and the reduced modulus E*, sigma = rms / eps,
 s the direction of the approach, z_0 the contact point (where the undeflected
-spring holds the undeformed sphere at the flat, lambda = 0) and F_0 the force
-baseline there.  The instrument (docs/fitting.md, "The instrument in the fit"): the
-true deflection sensitivity c times the file's, the true spring constant k against
-the stated k_s (K = k eps / (2 pi R w)), the virtual deflection b (N/m) and the
+spring holds the undeformed sphere at the flat, lambda = 0) and F_0 the force baseline there.  The instrument
+(docs/fitting.md, "The instrument in the fit"): the true deflection sensitivity c times the file's, the true
+spring constant k against the stated k_s (K = k eps / (2 pi R w)), the virtual deflection b (N/m) and the
 retract's baseline offset d (the drag), each fitted or held (:class:`FitChoice`).  The
 unknowns are w and E* (optionally the rms roughness), with z_0, F_0 and the
 instrument's as nuisance parameters; R, eps and k_s are given.  They are fitted in
@@ -425,10 +423,8 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     def start(E: float) -> tuple[np.ndarray, float]:
         w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
         mu = min(max(tabor(R, w, E, eps), reach[0] * 1.01), reach[1] * 0.99)
-        if pb.table is not None and "ln_gamma" in names:
-            # a held modulus: w is the coordinate, so its start too must lie where the table holds mu
-            # (eq. 9 inverted: w = sqrt(mu^3 E^2 epsilon^3 / R))
-            w = math.sqrt(mu**3 * E**2 * eps**3 / R)
+        if pb.table is not None and "ln_gamma" in names:     # a held modulus: w's start, too, where the
+            w = math.sqrt(mu**3 * E**2 * eps**3 / R)           # table holds mu (eq. 9 inverted)
         # the baseline's start: the far approach's median, or with its slope fitted its line at the contact point
         sloped = choice.virtual_deflection
         given = {"ln_mu": math.log(mu), "ln_gamma": math.log(w), "sigma": sigma0, "z0": 0.0,
