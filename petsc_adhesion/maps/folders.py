@@ -46,6 +46,8 @@ _ASYLUM_GRID_KEYS = ("FMapScanPoints", "FMapScanLines", "FastScanSize", "SlowSca
 #: Why an ARDF file is refused, and what to do.
 ARDF_REFUSAL = ("an Asylum ARDF force map, which afmformats does not read: export its curves as .ibw from the "
                 "Asylum software (a folder of <name>LineNNNNPointNNNN.ibw) and give the folder")
+#: The most pixels a grid made of positions may have a curve: beyond it the positions are on no grid.
+_SPARSE = 16
 #: How far a position may lie from its pixel's centre on a grid made of positions, in pixels: the positions a
 #: file writes are its grid's to their printed digits.
 _ON_GRID = 1e-3
@@ -277,6 +279,9 @@ def _workshop(files: list, name: str, shape: tuple | None) -> Layout | None:
                               f"curve") from None
     x0, dx, nx, ix = _axis(xs, "x", name)
     y0, dy, ny, iy = _axis(ys, "y", name)
+    if nx * ny > _SPARSE * len(files):     # positions a hair apart make a spacing of a hair: no scan's grid
+        raise LayoutError(f"{name}: the curves' positions make a grid of {nx} x {ny} pixels for {len(files)} "
+                          f"curves (spacings of {dx * 1e6:.3g} and {dy * 1e6:.3g} um): positions on no scan's grid")
     if shape is not None and tuple(shape) != (nx, ny):
         raise LayoutError(f"{name}: its curves' positions make a grid of {nx} x {ny}; -fit_map_shape "
                           f"{shape[0]},{shape[1]} disagrees: leave it out")
