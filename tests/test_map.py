@@ -235,6 +235,28 @@ def test_a_folder_of_two_instruments_two_maps_or_two_grids_is_refused(tmp_path):
         open_map(str(f / "map0001.ARDF"))
 
 
+def test_the_instruments_refusals_at_the_command_line_write_nothing(tmp_path):
+    """Through -fit_map: an ARDF file, a folder of two instruments, an Asylum folder with another
+    -fit_map_shape: one line each naming -fit_map and what is wrong, exit 2; the earlier -out untouched."""
+    import zipfile
+
+    out = tmp_path / "m.h5"
+    out.write_bytes(b"an earlier result")
+    ardf = tmp_path / "map0001.ARDF"
+    ardf.write_bytes(b"ARDF")
+    tip = ("-phys_radius", R, "-phys_epsilon", EPS, "-out", out)
+    assert "export its curves as .ibw" in _refused(run_cli("-fit_map", ardf, *tip), "fit_map")
+    mixed = tmp_path / "mixed"
+    _asylum_map(mixed, 2, 1)
+    with zipfile.ZipFile(WORKSHOP) as z:
+        (mixed / "ws.csv").write_bytes(z.read(z.namelist()[0]))
+    assert "more than one instrument" in _refused(run_cli("-fit_map", mixed, *tip), "fit_map")
+    (mixed / "ws.csv").unlink()
+    assert "-fit_map_shape 1,2 disagrees" in _refused(run_cli("-fit_map", mixed, *tip, "-fit_map_shape", "1,2"),
+                                                      "fit_map")
+    assert out.read_bytes() == b"an earlier result" and not os.path.exists(str(out) + ".journal")
+
+
 def test_an_afm_workshop_folder_gives_the_grid_afmformats_gives(tmp_path):
     """AFM Workshop's map (tests/data, 16 curves of Mode: Mapping in a zip) unzipped into a folder: its grid
     and each curve's pixel and position equal those afmformats makes of the zip (its grid index, shape,
