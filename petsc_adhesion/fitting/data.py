@@ -25,7 +25,9 @@ an AFM file afmformats reads
     file of several curves (a force map) gives the one of ``index``.  A sensitivity
     ``invols`` given replaces the file's (its force rescaled by their ratio: the
     deflection is the measured voltage times it); a file that states no spring
-    constant takes ``spring`` for its deflection column.
+    constant takes ``spring`` for its deflection column.  An AFM Workshop curve in
+    volts (``T-B(V)``) whose header states no calibration is read with ``invols``
+    and ``spring`` (afmformats' ``meta_override``), :class:`NeedsInstrument` without.
 
 Approach and retract are split where the displacement turns: at its extreme
 farthest from the first sample.  Either sign convention of the displacement is
