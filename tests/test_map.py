@@ -5,6 +5,7 @@ interrupted; bad input refused in one line with nothing written, or flagged per 
 import csv
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -89,6 +90,8 @@ def test_a_jpk_map_fitted_flags_each_pixel_with_its_reason(tmp_path):
     for r in rows:
         assert "indentation reaches" in r["reasons"] and "tether" in r["reasons"]
         assert r["gamma_J_m2"] == r["E_star_Pa"] == ""
+        # what the curve shows by itself and does not have is said, beside the fit's reasons
+        assert r["jump_in_N"] == "" and r["missing"] == "jump_in: the approach does not jump by more than 10 noise"
         assert 1e-11 < float(r["pull_off_N"]) < 1e-8 and 0 < float(r["pull_off_err"]) < float(r["pull_off_N"])
         assert float(r["energy_J"]) > 10 * float(r["energy_err"]) > 0
     with h5py.File(out) as f:
@@ -100,6 +103,240 @@ def test_a_jpk_map_fitted_flags_each_pixel_with_its_reason(tmp_path):
                        capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     assert fig.stat().st_size > 10_000
+
+
+# -- Asylum and AFM Workshop folders ------------------------------------------------------------------------------
+SIN = os.path.join(DATA, "fmt-igor-fd_SiN_FD_plot.ibw")
+WORKSHOP = os.path.join(DATA, "fmt-afm-workshop-fd_mapping_16_2018-08-01_13.07.zip")
+
+
+def _note_set(data: bytes, key: str, value: str) -> bytes:
+    """An Igor wave with the note's ``key: value`` written anew, in place (the value right-aligned in the old
+    one's width: the note's size, and so the file's layout, unchanged)."""
+    m = re.search(b"\r" + key.encode() + b":([^\r]*)", data)
+    old = m.group(1)
+    assert len(value) <= len(old), (key, old, value)
+    return data[:m.start(1)] + value.encode().rjust(len(old)) + data[m.end(1):]
+
+
+def _asylum_map(folder, nx, ny, skip=(), base="Map", lines=False):
+    """The MFP-3D curve of tests/data copied as an Asylum force map of ``nx`` x ``ny`` would save it: named
+    ``<base>LineLLLLPointPPPP.ibw`` (in ``FMLineLLLL/`` subfolders with ``lines``), its note stating the grid
+    (FMapScanPoints ``nx``, FMapScanLines ``ny``) and each copy's place as its sensors read it
+    (XLVDT, YLVDT: the pixel's centre on the note's 1 um scan about its XOffset, YOffset, the slow scan
+    running down as the note's FMapScanDown 1 says: line 0 the top).  ``skip``: the (point, line) not
+    written.  Returns {(point, line): (x, y)} of the copies written."""
+    src = open(SIN, "rb").read()
+    src = _note_set(_note_set(src, "FMapScanPoints", str(nx)), "FMapScanLines", str(ny))
+    x0, y0, size = -3.2718e-05, 2.6456e-05, 1e-6          # the note's XOffset, YOffset, FastScanSize
+    placed = {}
+    for line in range(ny):
+        for point in range(nx):
+            if (point, line) in skip:
+                continue
+            x = x0 - size / 2 + (point + 0.5) * size / nx
+            y = y0 + size / 2 - (line + 0.5) * size / ny           # scanned down: line 0 at the top
+            data = _note_set(_note_set(src, "XLVDT", f"{x:.14e}"), "YLVDT", f"{y:.14e}")
+            where = folder / f"FMLine{line:04d}" if lines else folder
+            where.mkdir(parents=True, exist_ok=True)
+            (where / f"{base}Line{line:04d}Point{point:04d}.ibw").write_bytes(data)
+            placed[point, line] = (float(f"{x:.14e}"), float(f"{y:.14e}"))
+    return placed
+
+
+def test_an_igor_note_read_alone_is_the_note_igor2_reads():
+    """The note of the Asylum curve, read from its header and note alone (the map's folder is read at once),
+    equals the note igor2 reads with the whole wave, key by key."""
+    from igor2 import binarywave
+
+    from petsc_adhesion.maps.folders import ibw_note
+
+    want = {}
+    for line in binarywave.load(SIN)["wave"]["note"].decode("latin-1").split("\r"):
+        if ":" in line:
+            k, v = line.split(":", 1)
+            want.setdefault(k.strip(), v.strip())
+    got = ibw_note(SIN)
+    assert got == want and got["FMapScanPoints"] == "32" and float(got["XLVDT"]) == -3.46937223456067e-05
+
+
+@pytest.mark.parametrize("lines", [False, True])
+def test_an_asylum_folder_gives_its_grid_and_positions(tmp_path, lines):
+    """Five curves of an Asylum map of 3 x 2 (one missing), in the folder or a subfolder a line: the grid the
+    notes state (3 x 2 over 1 um, about the note's offsets), each curve at the pixel its name gives (line 0 at
+    the top: the scan ran down) and at the position its note states (to 1e-12 m), that position the centre of
+    its pixel on the grid read; the missing pixel an entry whose curve is read as missing, with why.  Given,
+    the same shape is taken; another, refused."""
+    from petsc_adhesion.fitting.data import CurveFileError
+    from petsc_adhesion.maps.source import MapSourceError, open_map
+
+    placed = _asylum_map(tmp_path, 3, 2, skip={(2, 1)}, lines=lines)
+    m = open_map(str(tmp_path))
+    assert m.grid.shape == (3, 2) and len(m) == 6 and len(m.files) == 5
+    assert m.grid.size == pytest.approx((1e-6, 1e-6), rel=1e-12)
+    px, py = m.grid.pixel
+    for e in m.entries:
+        line, point = (int(v) for v in re.fullmatch(r"MapLine(\d{4})Point(\d{4})\.ibw", e.label).groups())
+        assert (e.ix, e.iy) == (point, 1 - line)
+        if (point, line) not in placed:
+            assert e.x is None and e.y is None
+            with pytest.raises(CurveFileError, match="missing: the Asylum map's grid of 3 x 2 has pixel"):
+                m.curve(e)
+            continue
+        assert abs(e.x - placed[point, line][0]) < 1e-12 and abs(e.y - placed[point, line][1]) < 1e-12
+        assert abs(m.grid.origin[0] + e.ix * px - e.x) < 1e-12 and abs(m.grid.origin[1] + e.iy * py - e.y) < 1e-12
+        assert m.curve(e).spring == pytest.approx(1.1841)
+    assert open_map(str(tmp_path), (3, 2)).grid.shape == (3, 2)
+    with pytest.raises(MapSourceError, match=r"grid of 3 x 2 \(FMapScanPoints, FMapScanLines\); -fit_map_shape 6,1"):
+        open_map(str(tmp_path), (6, 1))
+
+
+def test_a_folder_of_two_instruments_two_maps_or_two_grids_is_refused(tmp_path):
+    """Refused in one line each, naming what is mixed: Asylum curves beside an AFM Workshop curve; the curves of
+    two Asylum maps (two bases); of two grids (a note of 4 points a line among those of 2); a curve named
+    beyond the note's grid; an Asylum curve without a line and a point in its name among named ones; an ARDF
+    file, alone or as the map (what to do said)."""
+    import zipfile
+
+    from petsc_adhesion.maps.source import MapSourceError, open_map
+
+    def refused(folder, what):
+        with pytest.raises(MapSourceError, match=what) as e:
+            open_map(str(folder))
+        assert "\n" not in str(e.value)
+
+    a = tmp_path / "a"
+    _asylum_map(a, 2, 1)
+    with zipfile.ZipFile(WORKSHOP) as z:
+        (a / "ws.csv").write_bytes(z.read(z.namelist()[0]))
+    refused(a, r"more than one instrument \(Asylum 2 .*AFM Workshop 1")
+    b = tmp_path / "b"
+    _asylum_map(b, 2, 1)
+    _asylum_map(b, 2, 1, base="Other")
+    refused(b, "two Asylum maps")
+    c = tmp_path / "c"
+    _asylum_map(c, 2, 1)
+    (c / "MapLine0000Point0001.ibw").write_bytes(_note_set((c / "MapLine0000Point0001.ibw").read_bytes(),
+                                                           "FMapScanPoints", "4"))
+    refused(c, "two grids: 'MapLine0000Point0000.ibw' states FMapScanPoints 2, 'MapLine0000Point0001.ibw' 4")
+    d = tmp_path / "d"
+    _asylum_map(d, 2, 1)
+    (d / "MapLine0003Point0000.ibw").write_bytes((d / "MapLine0000Point0000.ibw").read_bytes())
+    refused(d, "at point 0 of line 3, beyond the grid of 2 x 1")
+    e = tmp_path / "e"
+    _asylum_map(e, 2, 1)
+    (e / "lone.ibw").write_bytes(open(SIN, "rb").read())
+    refused(e, "'lone.ibw' is no curve of an Asylum map")
+    f = tmp_path / "f"
+    f.mkdir()
+    (f / "map0001.ARDF").write_bytes(b"ARDF")
+    refused(f, "export its curves as .ibw from the Asylum software")
+    with pytest.raises(MapSourceError, match="ARDF force map, which afmformats does not read: export"):
+        open_map(str(f / "map0001.ARDF"))
+
+
+def test_the_instruments_refusals_at_the_command_line_write_nothing(tmp_path):
+    """Through -fit_map: an ARDF file, a folder of two instruments, an Asylum folder with another
+    -fit_map_shape: one line each naming -fit_map and what is wrong, exit 2; the earlier -out untouched."""
+    import zipfile
+
+    out = tmp_path / "m.h5"
+    out.write_bytes(b"an earlier result")
+    ardf = tmp_path / "map0001.ARDF"
+    ardf.write_bytes(b"ARDF")
+    tip = ("-phys_radius", R, "-phys_epsilon", EPS, "-out", out)
+    assert "export its curves as .ibw" in _refused(run_cli("-fit_map", ardf, *tip), "fit_map")
+    mixed = tmp_path / "mixed"
+    _asylum_map(mixed, 2, 1)
+    with zipfile.ZipFile(WORKSHOP) as z:
+        (mixed / "ws.csv").write_bytes(z.read(z.namelist()[0]))
+    assert "more than one instrument" in _refused(run_cli("-fit_map", mixed, *tip), "fit_map")
+    (mixed / "ws.csv").unlink()
+    assert "-fit_map_shape 1,2 disagrees" in _refused(run_cli("-fit_map", mixed, *tip, "-fit_map_shape", "1,2"),
+                                                      "fit_map")
+    assert out.read_bytes() == b"an earlier result" and not os.path.exists(str(out) + ".journal")
+
+
+def test_an_afm_workshop_folder_gives_the_grid_afmformats_gives(tmp_path):
+    """AFM Workshop's map (tests/data, 16 curves of Mode: Mapping in a zip) unzipped into a folder: its grid
+    and each curve's pixel and position equal those afmformats makes of the zip (its grid index, shape,
+    size, centre; the positions to 1e-12 m); a curve taken out leaves its pixel, read as missing; a single
+    curve among them refused; -fit_map_shape other than the positions' grid refused."""
+    import zipfile
+
+    import afmformats
+
+    from petsc_adhesion.fitting.data import CurveFileError
+    from petsc_adhesion.maps.source import MapSourceError, open_map
+
+    with zipfile.ZipFile(WORKSHOP) as z:
+        z.extractall(tmp_path)
+    truth = [d.metadata for d in afmformats.load_data(WORKSHOP, meta_override={"spring constant": 1.0,
+                                                                                "sensitivity": 1e-8})]
+    m = open_map(str(tmp_path))
+    assert m.grid.shape == (truth[0]["grid shape x"], truth[0]["grid shape y"]) == (4, 4)
+    assert m.grid.size == pytest.approx((truth[0]["grid size x"], truth[0]["grid size y"]), rel=1e-12)
+    assert m.grid.origin[0] + m.grid.size[0] / 2 - m.grid.pixel[0] / 2 == pytest.approx(truth[0]["grid center x"],
+                                                                                        abs=1e-12)
+    assert m.grid.origin[1] + m.grid.size[1] / 2 - m.grid.pixel[1] / 2 == pytest.approx(truth[0]["grid center y"],
+                                                                                        abs=1e-12)
+    for e, t in zip(m.entries, truth):
+        assert (e.ix, e.iy) == (t["grid index x"], t["grid index y"])
+        assert abs(e.x - t["position x"]) < 1e-12 and abs(e.y - t["position y"]) < 1e-12
+    gone = sorted(tmp_path.iterdir())[6]
+    gone.unlink()
+    m = open_map(str(tmp_path))
+    assert len(m) == 16 and len(m.files) == 15 and m.entries[6].x is None
+    with pytest.raises(CurveFileError, match=r"missing: the AFM Workshop map's grid of 4 x 4 has pixel \(2, 1\)"):
+        m.curve(m.entries[6])
+    with pytest.raises(MapSourceError, match="positions make a grid of 4 x 4; -fit_map_shape 2,8 disagrees"):
+        open_map(str(tmp_path), (2, 8))
+    # a curve in volts: its force the file's T-B (V) times the sensitivity and the spring constant given
+    first = sorted(tmp_path.iterdir())[0]
+    c = m.curve(m.entries[0], spring=20.0, invols=1e-8)
+    volts = np.loadtxt(first, skiprows=11, delimiter=",")
+    assert c.F == pytest.approx(np.r_[volts[:, 1], volts[:, 3]] * 1e-8 * 20.0, rel=1e-14, abs=0)
+    assert (c.spring, c.sensitivity) == (20, 1e-8)
+    single = open(first).read().replace("Mode:\tMapping", "Mode:\tSingle")
+    (tmp_path / "z_single.csv").write_text(single)
+    with pytest.raises(MapSourceError, match="'z_single.csv' is no curve of a map"):
+        open_map(str(tmp_path))
+
+
+def test_the_real_asylum_and_afm_workshop_maps_fitted_flag_each_pixel(tmp_path):
+    """The Asylum map of 2 x 2 made of the MFP-3D curve (one pixel's file missing) and AFM Workshop's map
+    (4 x 4) through -fit_map with a 20 nm tip assumed: each curve that is read indents the tip beyond R/4
+    (the MFP-3D curve by 14.5 nm, 0.72 R, as -fit_curve says of it, docs/fitting.md): 'outside' with that
+    reason and no w; the missing pixel 'unreadable', missing; exit status 3.  AFM Workshop's curves are in
+    volts: without -fit_invols the map is refused in one line naming it, nothing written; with afmformats'
+    own test calibration (10 nm/V, 20 N/m) every pixel is read, at its position, and outside."""
+    import zipfile
+
+    asylum = tmp_path / "asylum"
+    _asylum_map(asylum, 2, 2, skip={(1, 1)})
+    table = tmp_path / "asylum.csv"
+    p = run_cli("-fit_map", asylum, "-phys_radius", R, "-phys_epsilon", EPS, "-csv", table)
+    assert p.returncode == 3, p.stderr
+    rows = {(r["ix"], r["iy"]): r for r in _rows(table)}
+    assert len(rows) == 4 and rows["1", "0"]["status"] == "unreadable"
+    assert "missing" in rows["1", "0"]["reasons"] and rows["1", "0"]["x_m"] == ""
+    for key in [("0", "1"), ("1", "1"), ("0", "0")]:
+        r = rows[key]
+        assert r["status"] == "outside" and "indentation reaches 14.5 nm, 0.72 of the tip's radius" in r["reasons"]
+        assert r["gamma_J_m2"] == r["E_star_Pa"] == "" and float(r["pull_off_N"]) == pytest.approx(12.84e-9, rel=1e-3)
+    ws = tmp_path / "ws"
+    with zipfile.ZipFile(WORKSHOP) as z:
+        z.extractall(ws)
+    table = tmp_path / "ws.csv"
+    _refused(run_cli("-fit_map", ws, "-phys_radius", R, "-phys_epsilon", EPS, "-csv", table), "fit_invols")
+    assert not table.exists()
+    p = run_cli("-fit_map", ws, "-phys_radius", R, "-phys_epsilon", EPS, "-fit_invols", 1e-8, "-phys_spring", 20,
+                "-csv", table)
+    assert p.returncode == 3, p.stderr
+    rows = _rows(table)
+    assert len(rows) == 16 and {r["status"] for r in rows} == {"outside"}
+    assert all("indentation reaches" in r["reasons"] and r["gamma_J_m2"] == "" for r in rows)
+    assert float(rows[5]["x_m"]) == pytest.approx(7.333333333333333e-6, abs=1e-12)
 
 
 # -- what a curve shows by itself -----------------------------------------------------------------------------

@@ -25,7 +25,9 @@ an AFM file afmformats reads
     file of several curves (a force map) gives the one of ``index``.  A sensitivity
     ``invols`` given replaces the file's (its force rescaled by their ratio: the
     deflection is the measured voltage times it); a file that states no spring
-    constant takes ``spring`` for its deflection column.
+    constant takes ``spring`` for its deflection column.  An AFM Workshop curve in
+    volts (``T-B(V)``) whose header states no calibration is read with ``invols``
+    and ``spring`` (afmformats' ``meta_override``), :class:`NeedsInstrument` without.
 
 Approach and retract are split where the displacement turns: at its extreme
 farthest from the first sample.  Either sign convention of the displacement is
@@ -48,6 +50,7 @@ import numpy as np
 from ..errors import printable as _printable
 
 __all__ = ["CurveFileError", "NeedsInstrument", "MeasuredCurve", "VOLT_UNITS", "read_curve", "load_afm", "afm_curve",
+           "workshop_header",
            "AFM_EXTENSIONS",
            "LENGTH_UNITS", "FORCE_UNITS",
            "MIN_POINTS", "MAX_TEXT_BYTES"]
@@ -139,7 +142,7 @@ def read_curve(path: str, index: int = 0, spring: float | None = None, invols: f
     ext = os.path.splitext(str(path))[1].lower()
     ext = ".jpk-" + str(path).lower().rsplit(".jpk-", 1)[1] if ".jpk-" in str(path).lower() else ext
     text_error = None
-    if ext not in AFM_EXTENSIONS or ext in (".csv", ".txt"):
+    if ext not in AFM_EXTENSIONS or (ext in (".csv", ".txt") and workshop_header(path) is None):
         try:
             if index:
                 raise CurveFileError(f"{_name(path)}: a text file holds one curve; index {index} asked for")
@@ -320,19 +323,68 @@ def _read_text(path: str, spring: float | None = None, invols: float | None = No
 
 
 # -- afmformats ------------------------------------------------------------------
+def workshop_header(path: str) -> dict | None:
+    """The header of an AFM Workshop curve (``.csv``: a first line ``Force-Distance Curve``, then ``key:
+    value`` lines, then the columns' names): its keys and values as written (``Mode``, ``Point``, ``X, um``,
+    ``Y, um``, ...) and ``columns``; None for a file that is not one (or cannot be read)."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            lines = [f.readline() for _ in range(64)]       # the header is about a dozen lines
+    except OSError:
+        return None
+    if not lines[0].strip().startswith("Force-Distance Curve"):
+        return None
+    head = {}
+    for line in lines[1:]:
+        if line.count(",") >= 3:            # the columns' names, as afmformats finds them
+            head["columns"] = [c.strip() for c in line.strip().split(",")]
+            return head
+        if ":" in line:
+            key, value = line.split(":", 1)
+            head[key.strip()] = value.strip()
+    return None
+
+
+def _workshop_override(path: str, spring_given: float | None, invols: float | None) -> dict | None:
+    """What afmformats needs to read an AFM Workshop file whose deflection is in volts (``T-B(V)``, the
+    photodiode's top-bottom signal): the sensitivity and the spring constant, the caller's where the header
+    states none (AFM Workshop writes 1 for a value not set, and afmformats takes 1 as none)."""
+    head = workshop_header(path) if str(path).lower().endswith(".csv") else None
+    if head is None or not any("T-B(V)" in c for c in head["columns"]):
+        return None
+    stated = {k: head.get(k, "1") for k in ("Light Lever Gain, mV/nm", "Force Constant, nN/nm")}
+    if all(_float(v) not in (None, 1.0) for v in stated.values()):
+        return None                         # the file calibrates itself
+    if invols is None:
+        raise NeedsInstrument(f"{_name(path)}: its deflection is in volts (AFM Workshop's T-B(V)) and it states no "
+                              f"sensitivity: give it in m/V", "fit_invols")
+    if spring_given is None:
+        raise NeedsInstrument(f"{_name(path)}: its deflection is in volts and it states no spring constant: give "
+                              f"it in N/m", "phys_spring")
+    return {"sensitivity": invols, "spring constant": spring_given}
+
+
+def _float(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
 def _read_afm(path: str, index: int, spring_given: float | None = None,
               invols: float | None = None) -> MeasuredCurve:
-    curves = load_afm(path)
+    curves = load_afm(path, _workshop_override(path, spring_given, invols))
     if not 0 <= index < len(curves):
         raise CurveFileError(f"{_name(path)}: holds {len(curves)} curve{'s' * (len(curves) != 1)}; index {index} "
                              f"asked for")
     return afm_curve(curves[index], path, index, len(curves), spring_given, invols)
 
 
-def load_afm(path: str) -> list:
+def load_afm(path: str, override: dict | None = None) -> list:
     """The force-distance curves afmformats reads in ``path`` (its data objects, in the file's order; a force
-    map's curves each once: a map is opened once, not once per curve); CurveFileError (one line) for a file it
-    cannot read or one without a curve."""
+    map's curves each once: a map is opened once, not once per curve), with ``override`` the metadata the
+    file lacks (afmformats' ``meta_override``); CurveFileError (one line) for a file it cannot read or one
+    without a curve."""
     try:
         import afmformats
     except ImportError:
@@ -351,7 +403,7 @@ def load_afm(path: str) -> list:
         with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()), \
                 contextlib.redirect_stderr(io.StringIO()):
             warnings.simplefilter("ignore")
-            curves = afmformats.load_data(str(path), modality="force-distance")
+            curves = afmformats.load_data(str(path), modality="force-distance", meta_override=override)
     except (Exception, *own) as e:
         why = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         raise CurveFileError(f"{_name(path)}: not a force-distance curve afmformats reads "

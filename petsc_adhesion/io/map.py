@@ -268,7 +268,9 @@ def write_map_csv(path: str, result) -> None:
             for q in QUANTITY_UNITS:
                 v = getattr(p, q)
                 row += [_cell(v.value), _cell(v.err)] if isinstance(v, Measured) else ["", ""]
-                if isinstance(v, Missing) and p.fitted:
+                # a flagged pixel's reasons say why its fit is absent; what its curve shows by itself (the
+                # jump-in, say) may be absent for a reason of its own, said here as for a fitted pixel
+                if isinstance(v, Missing) and (p.fitted or v.reason not in ("; ".join(p.reasons), *p.reasons)):
                     missing.append(f"{q}: {v.reason}")
             row += [_cell(p.reduced_chi2), _cell(p.p_value), "; ".join(p.reasons), "; ".join(missing)]
             w.writerow(row)

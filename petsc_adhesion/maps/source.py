@@ -1,6 +1,8 @@
 """Where a force map's curves come from, and where each lies on the sample: a map file afmformats reads (JPK
-``.jpk-force-map`` and ``.jpk-qi-data``, Asylum maps where afmformats reads them), a folder of single-curve
-files, or a list file of paths.
+``.jpk-force-map`` and ``.jpk-qi-data``, AFM Workshop's ``.zip``; an Asylum ``.ARDF`` is refused, with
+what to do), a folder of single-curve
+files (an instrument's folder of a map's curves placed by their names or headers: maps/folders.py), or a
+list file of paths.
 
 A map file's curves carry their place on the scan grid in afmformats' metadata: ``grid index x`` and
 ``grid index y`` (the pixel), ``grid shape x`` and ``grid shape y`` (the grid's pixels), ``grid size x`` and
@@ -8,7 +10,9 @@ A map file's curves carry their place on the scan grid in afmformats' metadata: 
 state none of it is a row of pixels in the file's order.  A folder's curves are its files in the order of
 their names, a list file's its lines (a path, relative to the list's folder, then optionally the pixel's
 indices ``ix iy``; ``#`` comments); both lie in a row unless a grid ``shape`` is given (nx, ny: the curves fill
-it row by row, x fastest).
+it row by row, x fastest), or, for a folder, the instrument's names or headers place them (Asylum's
+``LineNNNNPointNNNN.ibw`` and notes, AFM Workshop's mapping headers: maps/folders.py, which also refuses a
+folder of two instruments or two grids).
 
 The source is opened once per rank; :meth:`MapSource.curve` reads one curve, raising
 :class:`~petsc_adhesion.fitting.data.CurveFileError` (one line) for one that cannot be read: the map flags
@@ -22,6 +26,7 @@ import stat
 from dataclasses import dataclass, field
 
 from ..fitting.data import AFM_EXTENSIONS, CurveFileError, MeasuredCurve, afm_curve, load_afm, read_curve
+from .folders import ARDF_REFUSAL, Layout, LayoutError, list_folder, place_folder
 
 __all__ = ["MapSourceError", "MapEntry", "Grid", "MapSource", "open_map", "curves_map", "READ_ERRORS"]
 
@@ -77,6 +82,7 @@ class MapSource:
     _afm: list | None = field(default=None, repr=False)
     _files: tuple = field(default=(), repr=False)
     _curves: tuple = field(default=(), repr=False)
+    _missing: dict = field(default_factory=dict, repr=False)     # index: the instrument whose grid has it
 
     def __len__(self) -> int:
         return len(self.entries)
@@ -84,7 +90,9 @@ class MapSource:
     @property
     def files(self) -> tuple:
         """The files the map reads: its map file, or its curves' files (none for curves given as values)."""
-        return (self.path,) if self.kind == "afm" else tuple(self._files)
+        if self.kind == "afm":
+            return (self.path,)
+        return tuple(f for i, f in enumerate(self._files) if i not in self._missing)
 
     def curve(self, entry: MapEntry, spring: float | None = None, invols: float | None = None) -> MeasuredCurve:
         """The measured curve of ``entry`` (SI); ``spring``, ``invols`` as
@@ -102,6 +110,10 @@ class MapSource:
                                      f"({type(e).__name__}: {str(e).splitlines()[0][:100] if str(e) else ''})") \
                     from None
         path = self._files[entry.index]
+        if entry.index in self._missing:
+            g = self.grid.shape
+            raise CurveFileError(f"'{entry.label}': missing: the {self._missing[entry.index]} map's grid of {g[0]} x "
+                                 f"{g[1]} has pixel ({entry.ix}, {entry.iy}), the folder no curve for it")
         try:
             regular = stat.S_ISREG(os.stat(path).st_mode)
         except OSError as e:
@@ -138,16 +150,23 @@ def open_map(path: str, shape: tuple | None = None) -> MapSource:
     MapSourceError (one line) for a source that is no map."""
     base = os.path.basename(path.rstrip(os.sep)) or path
     if os.path.isdir(path):
-        files = sorted(os.path.join(path, f) for f in os.listdir(path)
-                       if not f.startswith(".") and os.path.isfile(os.path.join(path, f)))
+        files = list_folder(path)
         if not files:
             raise MapSourceError(f"'{base}': a folder without a curve file")
+        try:
+            layout = place_folder(files, f"'{base}'", shape)
+        except LayoutError as e:
+            raise MapSourceError(str(e)) from None
+        if layout is not None:
+            return _placed(path, layout)
         grid, cells = _row_grid(len(files), shape, f"'{base}'")
         entries = tuple(MapEntry(i, ix, iy, label=os.path.basename(f)) for i, (f, (ix, iy)) in
                         enumerate(zip(files, cells)))
         return MapSource(path, "folder", grid, entries, _files=tuple(files))
     if _is_list(path):
         return _open_list(path, shape)
+    if path.lower().endswith(".ardf"):
+        raise MapSourceError(f"'{base}': {ARDF_REFUSAL}")
     if not path.lower().endswith(AFM_EXTENSIONS):
         raise MapSourceError(f"'{base}': not a map: expected a folder of curves, a list file of paths (.list, "
                              f".lst) or a map file afmformats reads ({', '.join(AFM_EXTENSIONS[:4])}, ...)")
@@ -159,6 +178,16 @@ def open_map(path: str, shape: tuple | None = None) -> MapSource:
         raise MapSourceError(str(e)) from None
     entries, grid = _afm_grid(curves, base)
     return MapSource(path, "afm", grid, entries, _afm=curves)
+
+
+def _placed(path: str, layout: Layout) -> MapSource:
+    """The map of a folder whose files place their curves (maps/folders.py): every pixel of its grid, a
+    missing curve's pixel flagged when read."""
+    entries = tuple(MapEntry(i, p.ix, p.iy, p.x, p.y, os.path.basename(p.path))
+                    for i, p in enumerate(layout.pixels))
+    missing = {i: layout.instrument for i, p in enumerate(layout.pixels) if p.missing}
+    return MapSource(path, "folder", Grid(layout.shape, layout.size, layout.origin), entries,
+                     _files=tuple(p.path for p in layout.pixels), _missing=missing)
 
 
 def _is_list(path: str) -> bool:

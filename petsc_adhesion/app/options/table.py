@@ -274,12 +274,13 @@ TABLE = {o.name: o for o in [
            "indentation, mu beyond its range, a contact steeper than the lever, tethers): refuse before fitting "
            "(exit 3, nothing written) or fit and warn (exit 3)", choices=("refuse", "warn")),
     Option("fit_map", "string", None, "fit: a force map (a map file afmformats reads: JPK .jpk-force-map, "
-           ".jpk-qi-data; a folder of curve files; a list file .list of paths, each optionally with its pixel "
+           ".jpk-qi-data; a folder of curve files, an Asylum or AFM Workshop map's placed by its files; a list file "
+           ".list of paths, each optionally with its pixel "
            "'ix iy'): every curve fitted as -fit_curve fits one, over MPI ranks, each pixel's w, E*, pull-off, "
            "jump-in and energy of a cycle with their bars or the reason it has none; -out (HDF5) or -csv needed, "
            "the journal beside it resumes a killed map (docs/maps.md)"),
     Option("fit_map_shape", "reals", (), "fit: the grid nx,ny a -fit_map folder or list fills row by row (x "
-           "fastest; default a row)", 1.0, 1e6),
+           "fastest; default a row); an Asylum or AFM Workshop map's folder states its own (given, it must agree)", 1.0, 1e6),
     # a particle population on a topography (petsc_adhesion.population; docs/population.md)
     Option("pop_count", "int", None, "population: the number of particles, each landing on a random site of "
            "-adh_topography (default: as many as -pop_radius_file lists)", 1, 10**6),
