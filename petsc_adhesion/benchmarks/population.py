@@ -10,7 +10,9 @@ flat (E 70 GPa, nu 0.17, w 0.05 J/m^2, epsilon 0.4 nm), radii lognormal about 10
 
 ``speed``: particles per CPU second (``time.process_time``, this process; under
 ``mpiexec`` each rank's summed) through the solver (the measured law, the footprint
-iterated, error bars on) and through the table (the Gaussian rule at the footprint's
+iterated, error bars on), with each particle's energy of a cycle and without it
+(``--soft``: particles of E 0.6 GPa, mu about 9, where a smooth sphere's cycle has hysteresis), and
+through the table (the Gaussian rule at the footprint's
 rms).  The table is the family's ``PullOffTable`` where it is installed; where it is not,
 a PullOffModel made here for the timing alone: the solver's Gaussian rule at nodes of
 (ln mu, sigma) over the particles' range, interpolated bilinearly (its nodes' cost
@@ -36,7 +38,7 @@ import numpy as np
 from ..model.physical import Bodies
 from ..model.topography import read_topography
 from ..population.compute import population
-from ..population.evaluate import GaussianRule, SolverEvaluator, load_table, TableMissing
+from ..population.evaluate import GaussianRule, SolverEvaluator, TableMissing, Trace, load_table
 from ..population.footprint import footprint, footprint_radius
 from ..population.sample import RadiusLaw
 from .paths import ROOT
@@ -44,6 +46,9 @@ from .paths import ROOT
 AFM = os.path.join("tests", "data", "wsxm-afm-topography.top")
 BODIES = Bodies(radius=10e-6, young1=7e10, poisson1=0.17, gamma=0.05, epsilon=4e-10)
 LAW = RadiusLaw(median=10e-6, spread=1.3)
+#: Soft particles (a polymer's modulus) on the same flat: mu about 9 at 10 um, where a smooth sphere's cycle has
+#: hysteresis.
+SOFT = Bodies(radius=10e-6, young1=6e8, poisson1=0.4, gamma=0.05, epsilon=4e-10)
 
 
 class NodeTable:
@@ -79,15 +84,19 @@ def _load() -> str:
         return "load unknown"
 
 
-def speed(n_solver: int, n_table: int, seed: int = 1) -> None:
+def speed(n_solver: int, n_table: int, seed: int = 1, bodies: Bodies = BODIES) -> None:
     topo = read_topography(os.path.join(ROOT, AFM))
-    t = time.process_time()
-    r = population(topo, BODIES, LAW, n_solver, seed, "solver", spread_count=0)
-    cpu = time.process_time() - t
-    passes = [p.passes for p in r.particles]
-    print(f"solver: {n_solver} particles in {cpu:.1f} s CPU ({r.cpu_time:.1f} s over {r.ranks} rank(s)): "
-          f"{n_solver / r.cpu_time:.3g} particles per CPU second; solves per particle {np.mean(passes):.2f} "
-          f"(median pull-off {np.median(r.forces) * 1e9:.4g} nN); {_load()}")
+    for energy in (True, False):
+        t = time.process_time()
+        r = population(topo, bodies, LAW, n_solver, seed, "solver", spread_count=0, trace=Trace(energy=energy))
+        cpu = time.process_time() - t
+        passes = [p.passes for p in r.particles]
+        works = r.works
+        what = (f"{works.size} energies of a cycle, {int(np.sum(works == 0))} of them 0" if energy else
+                "without the energy of a cycle")
+        print(f"solver ({what}): {n_solver} particles in {cpu:.1f} s CPU ({r.cpu_time:.1f} s over {r.ranks} "
+              f"rank(s)): {n_solver / r.cpu_time:.3g} particles per CPU second; solves per particle "
+              f"{np.mean(passes):.2f} (median pull-off {np.median(r.forces) * 1e9:.4g} nN); {_load()}")
     try:
         table, what, nodes = load_table(), "the family's PullOffTable", 0.0
     except TableMissing:
@@ -114,7 +123,7 @@ def zone(count: int, seed: int = 1) -> None:
             continue
         a = np.sqrt(max(p.footprint_radius ** 2 / (p.radius * eps) - footprint_radius(0.0, 1.0, 1.0) ** 2, 0.0))
         wide = footprint(topo, p.site, footprint_radius(a, p.radius, eps, share=0.99), eps, clip=True)
-        F99 = ev.measured(p.mu, wide.heights)[0]
+        F99 = ev.measured(p.mu, wide.heights, energy=False).F
         print(f"particle {p.index}: R {p.radius * 1e6:.3g} um, footprint 95 % {p.footprint_radius * 1e9:.0f} nm "
               f"({p.pixels} pixels) F {p.pull_off.value:.6g}; 99 % {wide.radius * 1e9:.0f} nm ({wide.pixels} "
               f"pixels) F {F99.value:.6g}: relative change {(F99.value - p.pull_off.value) / abs(p.pull_off.value):+.3g}")
@@ -127,11 +136,12 @@ def main(argv=None) -> None:
     s = sub.add_parser("speed")
     s.add_argument("--solver", type=int, default=20)
     s.add_argument("--table", type=int, default=10000)
+    s.add_argument("--soft", action="store_true")
     z = sub.add_parser("zone")
     z.add_argument("--count", type=int, default=10)
     args = ap.parse_args(argv)
     if args.what == "speed":
-        speed(args.solver, args.table)
+        speed(args.solver, args.table, bodies=SOFT if args.soft else BODIES)
     else:
         zone(args.count)
 

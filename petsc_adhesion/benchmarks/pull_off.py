@@ -13,9 +13,10 @@ bars, is counted into the interpolation error it measures), each on one rank (``
 first, each to the least loaded rank (:func:`~petsc_adhesion.family.build.spread`); rank 0
 writes the table with its error (all or nothing) and prints the cost per node and the
 error per cell.  ``seed`` journals a built table's nodes for a build into ``--out`` over more
-nodes, which then traces the new nodes and every cell's centre only.  ``fit`` times :func:`~petsc_adhesion.fitting.pull_off.fit_pull_off` (CPU
-seconds, ``time.process_time``) on the pull-off of a sphere at each (mu, sigma), with the
-table and with the solver's secant alone (the path before the table), and the vectorised
+nodes, which then traces the new nodes and every cell's centre only.  ``fit`` times
+:func:`~petsc_adhesion.fitting.pull_off.fit_pull_off` (CPU seconds, ``time.process_time``) on
+the pull-off of a sphere at each (mu, sigma), with the table and with the solver's secant alone
+(the path before the table), and the vectorised
 :func:`~petsc_adhesion.fitting.pull_off.gamma_from_pull_offs` on a map of 128 x 128 pull-offs.
 A benchmark is a measurement, not a test: the machine's load is printed with it.
 """
