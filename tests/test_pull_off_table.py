@@ -219,3 +219,22 @@ def test_a_map_of_pull_offs_becomes_a_map_of_w():
         gamma_from_pull_offs(P, Bodies(radius=1e-6, young1=None, poisson1=None, epsilon=0.4e-9))
     far = gamma_from_pull_offs(P_tab, _bodies(1.0, sigma=float(TABLE.sigma[-1]) + 0.5))
     assert not far.found.any() and "outside the pull-off table" in far.reasons[0]
+
+
+def test_a_built_tables_nodes_resume_a_larger_build(tmp_path):
+    """benchmarks.pull_off seed: the shipped table's nodes journaled for a build over one more sigma node leave
+    that build the new node of every row and every cell's centre (new nodes change the interpolant about the
+    old cells), and the journaled nodes make the shipped table's nodes again, value for value."""
+    from petsc_adhesion.benchmarks.pull_off import _key, journal, points, seed
+
+    out = str(tmp_path / "bigger.npz")
+    assert seed(TABLE, out) == TABLE.F.size
+    done = journal(out)
+    sigma = tuple(float(s) for s in TABLE.sigma) + (12.0,)
+    todo = [p for p in points(tuple(float(m) for m in TABLE.mu), sigma) if _key(*p) not in done]
+    assert sorted((m, s) for k, m, s in todo if k == "node") == [(float(m), 12.0) for m in TABLE.mu]
+    assert sum(k == "centre" for k, _, _ in todo) == (TABLE.mu.size - 1) * (len(sigma) - 1)
+    again = PullOffTable.of_nodes(TABLE.mu, TABLE.sigma, [done[_key("node", float(m), float(s))]
+                                                          for m in TABLE.mu for s in TABLE.sigma])
+    for name in ("F", "F_err", "F_grid", "lam", "lam_err", "seconds"):
+        assert np.array_equal(getattr(again, name), getattr(TABLE, name)), name
