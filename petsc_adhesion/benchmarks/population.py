@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from collections import Counter
 
 import numpy as np
 
@@ -127,6 +128,15 @@ def speed(n_solver: int, n_table: int, seed: int = 1, flat: bool = False) -> Non
     print(f"table ({what}{f', its nodes {nodes:.1f} s CPU apart' if nodes else ''}): {n_table} particles in "
           f"{cpu:.1f} s CPU ({r.cpu_time:.1f} s over {r.ranks} rank(s)): {n_table / r.cpu_time:.4g} particles per "
           f"CPU second; {len(r.missing)} missing; {_load()}")
+    for reason, n in Counter(p.pull_off.reason for p in r.missing).most_common(3):
+        print(f"  missing ({n}): {reason}")
+    sig = np.array([p.sigma for p in r.particles if p.sigma is not None])
+    if sig.size:
+        q = np.percentile(sig, [0, 16, 50, 84, 100])
+        print(f"  local sigma {q[0]:.3g} to {q[4]:.3g} (median {q[2]:.3g}, 16-84 %: {q[1]:.3g} to {q[3]:.3g})")
+    if hasattr(r.fit, "median"):
+        print(f"  lognormal of |F|: median {r.fit.median.value * 1e9:.4g} +- {r.fit.median.err * 1e9:.2g} nN, gsd "
+              f"{r.fit.gsd.value:.4g} +- {r.fit.gsd.err:.2g} ({r.fit.count} pull-offs)")
 
 
 def zone(count: int, seed: int = 1) -> None:
