@@ -49,7 +49,7 @@ from .paths import ROOT
 AFM = os.path.join("tests", "data", "wsxm-afm-topography.top")
 BODIES = Bodies(radius=10e-6, young1=7e10, poisson1=0.17, gamma=0.05, epsilon=4e-10)
 LAW = RadiusLaw(median=10e-6, spread=1.3)
-#: Soft particles on a flat: mu about 2 at 10 um (1.6 to 2.7 over the radii), where a smooth sphere's cycle under a
+#: Soft particles on a flat: mu about 2 at 10 um, where a smooth sphere's cycle under a
 #: rigid machine has hysteresis.
 SOFT = Bodies(radius=10e-6, young1=7e9, poisson1=0.0, gamma=0.05, epsilon=4e-10)
 
