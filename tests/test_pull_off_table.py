@@ -152,9 +152,9 @@ LARGE_MU = 60.0
 def test_a_pull_off_at_large_mu_gives_w_back_through_the_table_and_the_solver():
     """w = 0.05 J/m^2 at mu = 60 (beyond the fit's old range, 50; between the table's nodes, where its
     interpolation has an error of its own): P from the solver's pull-off with its bar (a curve of its own), the
-    fit inverts the table and ends on the solver's root (two curves: the table's path, which at mu = 300 is the
-    same code at seven times a curve's cost), w back within its bar; the table's inversion alone within its own
-    wider bar."""
+    fit inverts the table and ends on the solver's root (two curves: the table's path, the same code as at mu =
+    300 for about a third of a curve's cost there), w back within its bar; the table's inversion alone within
+    its own wider bar."""
     b = _bodies(LARGE_MU)
     e = model_pull_off(Model(mu=LARGE_MU), error_bars=True)
     P = abs(e.F.value) * 2 * math.pi * b.R * 0.05
