@@ -29,7 +29,7 @@ import numpy as np
 
 from ..tracing.measured import Measured, Missing
 from .evaluate import EVALUATORS, Evaluator, GaussianRule, PullOffModel, SolverEvaluator, TableEvaluator, Trace
-from .footprint import MIN_PIXELS, ZONE_SHARE, Footprint
+from .footprint import MIN_PIXELS, ZONE_SHARE
 from .results import BOOTSTRAP, Particle, PopulationResult, SpreadSample, energy_fit, lognormal_fit, radius_bins
 from .sample import RadiusLaw, draw
 
