@@ -20,7 +20,8 @@ from petsc_adhesion.model.topography import Topography, statistics
 from petsc_adhesion.population import population
 from petsc_adhesion.population.evaluate import GaussianRule, Trace, _pull_off
 from petsc_adhesion.population.footprint import MIN_PIXELS, ZONE_SHARE, footprint, zone_radius
-from petsc_adhesion.population.results import lognormal_fit
+from petsc_adhesion.population.results import energy_fit, lognormal_fit
+from petsc_adhesion.tracing.measured import Measured, Missing
 from petsc_adhesion.population.sample import RadiusLaw, draw
 
 EPS = 4e-10
@@ -141,10 +142,50 @@ def test_a_flat_surface_gives_the_smooth_sphere_for_every_particle():
     assert len(r.forces) == 4
     for p in r.particles:
         assert p.sigma == 0.0
-        smooth, _ = _pull_off(Model(mu=p.mu, roughness="none"), Trace(), None)
+        smooth = _pull_off(Model(mu=p.mu, roughness="none"), Trace(), None).F
         assert p.pull_off.value == pytest.approx(smooth.value, abs=2 * smooth.err + 1e-12)
         assert p.mu < 0.01 and p.pull_off.value == pytest.approx(DMT_PULL_OFF, abs=0.03)
         assert p.force.value == pytest.approx(-p.pull_off.value * 2 * math.pi * p.radius * 0.05, rel=1e-12)
+        # a stiff sphere has no turning point of lambda: its cycle dissipates nothing, a computed 0, not a missing
+        assert isinstance(p.energy, Measured) and p.energy.value == 0.0 and p.work.value == 0.0
+    assert "4 particles without hysteresis" in r.energy_fit.reason and r.works.size == 4
+
+
+def test_a_flat_surface_gives_the_smooth_spheres_energy_of_a_cycle():
+    """A soft particle (mu = 2) on a flat: its energy of a cycle is the smooth sphere's from the main program's
+    own curve at that mu (traced to F = 2 with every event, the Curve's rigid cycle), within their bars, and
+    positive (the snap-on and snap-off of a rigid machine at mu above about 1); in J, times 2 pi R w epsilon.
+    Without it asked for (Trace.energy False) the same pull-off, the energy missing with the reason."""
+    from petsc_adhesion.tracing.trace import trace_curve
+
+    soft = Bodies(radius=1e-6, young1=2.2e9, poisson1=0.0, gamma=0.05, epsilon=EPS)
+    r = population(flat_surface(), soft, RadiusLaw(median=1e-6), count=1, seed=1, spread_count=0)
+    p = r.particles[0]
+    assert p.mu == pytest.approx(2.0, rel=0.01)
+    main = trace_curve(Model(mu=p.mu)).rigid.energy
+    assert main.value > 0.3 and p.energy.err > 0
+    assert abs(p.energy.value - main.value) <= p.energy.err + main.err, (p.energy, main)
+    assert p.work.value == pytest.approx(p.energy.value * 2 * math.pi * 1e-6 * 0.05 * EPS, rel=1e-12)
+    off = population(flat_surface(), soft, RadiusLaw(median=1e-6), count=1, seed=1, spread_count=0,
+                     trace=Trace(energy=False)).particles[0]
+    assert off.pull_off == p.pull_off
+    assert isinstance(off.energy, Missing) and "not asked for" in off.energy.reason
+
+
+def test_the_energies_lognormal_is_of_the_positive_ones():
+    """Zeros (particles without hysteresis) are counted, not fitted: a known lognormal's samples with zeros
+    among them give its median and gsd within three bootstrap bars in at least 90 of 100 samples; fewer than
+    three positive ones give no fit, saying how many were 0 and how many missing."""
+    hits = 0
+    for k in range(100):
+        x = np.exp(np.random.default_rng(k).normal(math.log(3e-16), math.log(1.6), 60))
+        fit = energy_fit(np.concatenate([x, np.zeros(25)]), missing=2, seed=k)
+        assert fit.count == 60
+        hits += fit.median.covers(3e-16, 3) and fit.gsd.covers(1.6, 3)
+    assert hits >= 90
+    none = energy_fit(np.array([0.0, 0.0, 0.0, 1e-16, 2e-16]), missing=4, seed=0)
+    assert isinstance(none, Missing) and none.reason.startswith("2 positive energies") and \
+        "3 particles without hysteresis" in none.reason and "4 without an energy" in none.reason
 
 
 # -- a Gaussian surface: the Gaussian rule -------------------------------------------------------
@@ -157,6 +198,9 @@ def test_the_table_path_on_a_gaussian_surface_is_the_rule_at_its_rms(rule_2um):
                    spread_count=0)
     F = np.array([p.pull_off.value for p in r.particles])
     assert F.size == 200 and all(p.note == "" for p in r.particles)
+    # the table holds pull-offs only: no energy of a cycle, each particle saying why (never a 0)
+    assert all(isinstance(p.energy, Missing) and "holds pull-offs only" in p.energy.reason for p in r.particles)
+    assert r.works.size == 0 and "200 without an energy" in r.energy_fit.reason
     truth, bar = rule_2um.pull_off([_mu(2e-6)], [topo.stats.rms.value / EPS])
     rf, L = r.particles[0].footprint_radius, topo.size[0]
     n_eff = min(F.size, (L - 2 * rf) ** 2 / (math.pi * rf * rf))
@@ -177,7 +221,7 @@ def test_the_solver_on_a_gaussian_surface_is_the_gaussian_law_at_its_top():
     mu = r.particles[0].mu
     law = Model(mu=mu, sigma=float(np.median(s)), roughness="truncated_gaussian",
                 roughness_cutoff=float(np.median(K)))
-    truth = _pull_off(law, Trace(), None)[0].value
+    truth = _pull_off(law, Trace(), None).F.value
     sampling = 1.2533 * F.std() / math.sqrt(F.size)
     assert abs(np.median(F) - truth) < 3 * sampling, (np.median(F), truth, sampling)
     hermite = GaussianRule().one(mu, float(np.median(s))).value
@@ -282,6 +326,13 @@ def test_one_and_two_ranks_give_the_same_population(tmp_path):
         math.exp(np.mean(np.log([float(r["force_N"]) for r in a]))), rel=1e-12)
     assert summary["model_spread"]["particles"] == 2
     assert os.path.getsize(tmp_path / "one.png") > 10000
+    # the energy of a cycle in every row, the same on two ranks (above), in the HDF5 and the JSON as in the CSV
+    assert all(r["energy"] != "" and r["energy_missing"] == "" and float(r["energy"]) >= 0 for r in a)
+    energy = summary["energy_of_a_cycle"]
+    assert energy["computed"] == 4 and energy["machine"] == "rigid"
+    assert energy["zero"] == sum(float(r["energy"]) == 0 for r in a)
+    with h5py.File(tmp_path / "one.h5") as f:
+        assert np.allclose(f["particles/work"][()], [float(r["energy_J"]) for r in a], rtol=1e-15, atol=0)
 
 
 @pytest.mark.parametrize("extra, named", [
@@ -294,6 +345,8 @@ def test_one_and_two_ranks_give_the_same_population(tmp_path):
     (("-pop_radius_spread", "0.5"), "-pop_radius_spread: expected a finite real in [1"),
     (("-plot", "x.txt"), "-plot: expected a file name ending in"),
     (("-arc_snes_rtol", "1e-9"), "-arc_snes_rtol: a population's solvers take their own settings"),
+    (("-pop_evaluator", "table", "-pop_energy", "true"), "-pop_energy: true is not with -pop_evaluator table"),
+    (("-pop_energy", "maybe"), "-pop_energy: expected true or false"),
 ])
 def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, extra, named):
     (tmp_path / "radii.txt").write_text("1e-6\n2e-6\n")

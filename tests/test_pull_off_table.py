@@ -1,5 +1,5 @@
 """The pull-off table (petsc_adhesion.family.pull_off) against the solver and the closed forms, the fit of a
-pull-off through it up to mu = 1000, and a map of pull-offs turned into a map of w (docs/fitting.md).
+pull-off through it at large mu, and a map of pull-offs turned into a map of w (docs/fitting.md).
 
 The truths: the solver's whole default curve (traced to F = 2, not the table's truncated one), the rigid sphere's
 pull-off (eq. 28: -1 smooth; with roughness the least of (8/3) times the averaged law integrated from the gap
@@ -38,13 +38,13 @@ def _node(mu, sigma):
 
 
 def test_the_shipped_table_spans_its_range_and_states_its_error():
-    """The shipped table: mu 1e-3 to at least 10 (docs/fitting.md: the rows above are the build's to resume),
-    sigma 0 to 3, its error measured in every cell, a bar at every node."""
-    assert TABLE.mu[0] == pytest.approx(1e-3) and TABLE.mu[-1] >= 10
-    assert TABLE.sigma[0] == 0 and TABLE.sigma[-1] == pytest.approx(3.0)
+    """The shipped table: mu 1e-3 to at least 100 (docs/fitting.md), sigma 0 to 10 (the footprints of a measured
+    AFM image reach 4.5: docs/population.md), its error measured in every cell, a bar at every node."""
+    assert TABLE.mu[0] == pytest.approx(1e-3) and TABLE.mu[-1] >= 100
+    assert TABLE.sigma[0] == 0 and TABLE.sigma[-1] == pytest.approx(10.0)
     assert TABLE.measured and np.all(np.isfinite(TABLE.cell_F)) and np.all(np.isfinite(TABLE.F_err))
-    F, err = TABLE.pull_off(np.array([[1e-3], [1.0], [TOP]]), np.array([0.0, 0.5, 3.0]))
-    assert F.shape == err.shape == (3, 3) and np.all(F < 0) and np.all((err > 0) & np.isfinite(err))
+    F, err = TABLE.pull_off(np.array([[1e-3], [1.0], [TOP]]), np.array([0.0, 0.5, 3.0, 10.0]))
+    assert F.shape == err.shape == (3, 4) and np.all(F < 0) and np.all((err > 0) & np.isfinite(err))
 
 
 @pytest.mark.parametrize("mu, sigma", [(0.1, 0.3), (3.0, 0.0)])
@@ -78,11 +78,11 @@ def _rigid_pull_off(sigma):
     return minimize_scalar(F, bracket=(hs[max(k - 1, 0)], hs[k], hs[k + 1]), tol=1e-10).fun
 
 
-@pytest.mark.parametrize("sigma", [0.0, 0.2, 1.0, 3.0])
+@pytest.mark.parametrize("sigma", [0.0, 0.2, 1.0, 3.0, 4.5, 10.0])
 def test_the_stiff_end_is_the_rigid_spheres(sigma):
     """mu -> 0: the rigid sphere's pull-off, -1 smooth (Bradley's 2 pi R w), and the averaged law's least
-    integral with roughness (-0.645 at sigma 0.2, -0.0309 at 1, -0.0035 at 3); at mu = 1e-3 the elastic
-    correction is below 1e-4 of it."""
+    integral with roughness (-0.645 at sigma 0.2, -0.0309 at 1, -0.0035 at 3, -3.2e-4 at 10; 4.5 between two
+    nodes); at mu = 1e-3 the elastic correction is below 1e-4 of it."""
     truth = -1.0 if sigma == 0 else _rigid_pull_off(sigma)
     if sigma == 0:
         assert _rigid_pull_off(0.0) == pytest.approx(-1.0, abs=1e-9)
@@ -101,7 +101,7 @@ def test_the_soft_end_approaches_jkrs():
     assert gap[-1] <= 0.2 * mu[-1] ** -1.5 + err[-1] and err[-1] < 5e-3
 
 
-@pytest.mark.parametrize("mu, sigma", [(0.05, 0.22), (0.3, 0.63), (1.3, 0.13), (4.0, 1.7)])
+@pytest.mark.parametrize("mu, sigma", [(0.05, 0.22), (0.3, 0.63), (1.3, 0.13), (4.0, 1.7), (0.45, 4.4), (20.0, 7.2)])
 def test_between_the_nodes_the_solver_is_within_the_stated_bar(mu, sigma):
     """Points off the nodes and off the cells' centres (where the error was measured): the solver's pull-off
     lies within the table's bar (its own bar added), which is not wider than a tenth of the pull-off."""
@@ -113,9 +113,10 @@ def test_between_the_nodes_the_solver_is_within_the_stated_bar(mu, sigma):
 
 
 def test_outside_the_table_is_refused_in_one_line(tmp_path):
-    assert list(TABLE.covers([1e-4, 1.0, 2 * TOP, 1.0, np.nan], [0.0, 3.5, 0.0, 1.0, 0.0])) == \
+    far = float(TABLE.sigma[-1]) + 0.5
+    assert list(TABLE.covers([1e-4, 1.0, 2 * TOP, 1.0, np.nan], [0.0, far, 0.0, 1.0, 0.0])) == \
         [False, False, False, True, False]
-    for mu, sigma in ((2 * TOP, 0.0), (1.0, 3.5), (np.nan, 0.0), (1.0, -0.1)):
+    for mu, sigma in ((2 * TOP, 0.0), (1.0, far), (np.nan, 0.0), (1.0, -0.1)):
         with pytest.raises(OutOfRange) as e:
             TABLE.pull_off(np.array([1.0, mu]), sigma)
         assert "\n" not in str(e.value) and f"the pull-off table holds mu in [0.001, {TOP:g}]" in str(e.value)
@@ -139,21 +140,32 @@ def test_outside_the_table_is_refused_in_one_line(tmp_path):
 def test_the_pull_off_determines_w_over_the_whole_table():
     """P = 2 pi R w |F_po| rises with w wherever 1 + (2/3) d ln|F_po| / d ln mu > 0: the inversion's bisection
     needs it, and it holds on a fine grid over the table."""
-    mu, sigma = np.meshgrid(np.geomspace(TABLE.mu[0], TABLE.mu[-1], 200), np.linspace(0, 3, 61), indexing="ij")
+    mu, sigma = np.meshgrid(np.geomspace(TABLE.mu[0], TABLE.mu[-1], 200), np.linspace(0, TABLE.sigma[-1], 201),
+                            indexing="ij")
     assert np.min(1 + TABLE.slope(mu, sigma) / 1.5) > 0.2
 
 
-def test_a_pull_off_at_mu_300_gives_w_back_through_the_table_and_the_solver():
-    """w = 0.05 J/m^2 at mu = 300 (beyond the fit's old range, 50, and the shipped table's 100: the secant on the
-    solver's pull-off from Maugis-Dugdale's w): P from the solver's pull-off with its bar (a curve of its own),
-    the fit gives w back within its bar."""
-    b = _bodies(300.0)
-    e = model_pull_off(Model(mu=300.0), error_bars=True)
+#: A large mu of the fit's table path: beyond the fit's old range (50), between the table's nodes 10 and 100.
+LARGE_MU = 60.0
+
+
+def test_a_pull_off_at_large_mu_gives_w_back_through_the_table_and_the_solver():
+    """w = 0.05 J/m^2 at mu = 60 (beyond the fit's old range, 50; between the table's nodes, where its
+    interpolation has an error of its own): P from the solver's pull-off with its bar (a curve of its own), the
+    fit inverts the table and ends on the solver's root (two curves: the table's path, the same code as at mu =
+    300 for about a third of a curve's cost there), w back within its bar; the table's inversion alone within
+    its own wider bar."""
+    b = _bodies(LARGE_MU)
+    e = model_pull_off(Model(mu=LARGE_MU), error_bars=True)
     P = abs(e.F.value) * 2 * math.pi * b.R * 0.05
-    f = fit_pull_off(P, b)
+    P_err = e.F.err * 2 * math.pi * b.R * 0.05
+    f = fit_pull_off(P, b, P_err=P_err)
     assert isinstance(f.gamma, Measured) and f.gamma.covers(0.05, 1.96), (f.gamma, f.F)
-    assert f.mu == pytest.approx(300.0, rel=1e-3) and f.trustworthy
+    assert f.curves == 2 and f.mu == pytest.approx(LARGE_MU, rel=1e-3) and f.trustworthy
     assert f.closed_form("jkr").gamma == pytest.approx(0.05, rel=2e-3)     # JKR holds there
+    alone = gamma_from_pull_offs(np.array([P]), b, np.array([P_err]))
+    assert alone.found[0] and abs(alone.gamma[0] - 0.05) <= 1.96 * alone.gamma_err[0]
+    assert alone.gamma_err[0] >= f.gamma.err
 
 
 def test_a_rough_pull_off_gives_w_back():
@@ -205,5 +217,24 @@ def test_a_map_of_pull_offs_becomes_a_map_of_w():
     assert len(m.quantities()) == P.size
     with pytest.raises(TypeError):
         gamma_from_pull_offs(P, Bodies(radius=1e-6, young1=None, poisson1=None, epsilon=0.4e-9))
-    far = gamma_from_pull_offs(P_tab, _bodies(1.0, sigma=3.5))
+    far = gamma_from_pull_offs(P_tab, _bodies(1.0, sigma=float(TABLE.sigma[-1]) + 0.5))
     assert not far.found.any() and "outside the pull-off table" in far.reasons[0]
+
+
+def test_a_built_tables_nodes_resume_a_larger_build(tmp_path):
+    """benchmarks.pull_off seed: the shipped table's nodes journaled for a build over one more sigma node leave
+    that build the new node of every row and every cell's centre (new nodes change the interpolant about the
+    old cells), and the journaled nodes make the shipped table's nodes again, value for value."""
+    from petsc_adhesion.benchmarks.pull_off import _key, journal, points, seed
+
+    out = str(tmp_path / "bigger.npz")
+    assert seed(TABLE, out) == TABLE.F.size
+    done = journal(out)
+    sigma = tuple(float(s) for s in TABLE.sigma) + (12.0,)
+    todo = [p for p in points(tuple(float(m) for m in TABLE.mu), sigma) if _key(*p) not in done]
+    assert sorted((m, s) for k, m, s in todo if k == "node") == [(float(m), 12.0) for m in TABLE.mu]
+    assert sum(k == "centre" for k, _, _ in todo) == (TABLE.mu.size - 1) * (len(sigma) - 1)
+    again = PullOffTable.of_nodes(TABLE.mu, TABLE.sigma, [done[_key("node", float(m), float(s))]
+                                                          for m in TABLE.mu for s in TABLE.sigma])
+    for name in ("F", "F_err", "F_grid", "lam", "lam_err", "seconds"):
+        assert np.array_equal(getattr(again, name), getattr(TABLE, name)), name

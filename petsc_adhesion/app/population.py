@@ -176,6 +176,10 @@ def read(opts: AppOptions, comm, argv: list[str]) -> PopulationRequest:
                          f"{'a profile' if topo.kind != 'map' else 'a map of no stated lateral size'}: particles "
                          f"land on a map with its size")
     evaluator = opts.choice("pop_evaluator")
+    energy = opts.flag("pop_energy")
+    if evaluator == "table" and opts.db.hasName("pop_energy") and energy:
+        raise InputError("-pop_energy: true is not with -pop_evaluator table, whose pull-off table holds pull-offs "
+                         "only (the solver gives the energy of a cycle); remove it")
     table = None
     if evaluator == "table":
         try:
@@ -193,7 +197,8 @@ def read(opts: AppOptions, comm, argv: list[str]) -> PopulationRequest:
         check_targets(targets, inputs)
     return PopulationRequest(topo, bodies, law, count, opts.int("pop_seed"), evaluator, table,
                              opts.int("pop_spread_count"), opts.int("pop_bins"), opts.int("pop_bootstrap"),
-                             Trace(farfield=opts.flag("adh_farfield")), targets)
+                             Trace(farfield=opts.flag("adh_farfield"), energy=energy and evaluator == "solver"),
+                             targets)
 
 
 def execute(opts: AppOptions, argv: list[str], report: bool = True):

@@ -3,6 +3,7 @@ cost with the table and without it (docs/fitting.md).
 
     OPENBLAS_NUM_THREADS=1 nice -n 10 mpiexec -n 2 python -m petsc_adhesion.benchmarks.pull_off build \\
         [--out petsc_adhesion/family/pull_off.npz] [--mu 1e-3 1e-2 ... 1e3] [--sigma 0 0.05 ... 3]
+    python -m petsc_adhesion.benchmarks.pull_off seed [TABLE] --out NEW.npz
     OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.benchmarks.pull_off fit [--mu 0.1 1 10 300] [--sigma 0 0.3]
 
 ``build`` traces every node (:func:`~petsc_adhesion.family.pull_off.trace_pull_off`: the
@@ -11,9 +12,11 @@ solver at the centre of every cell (on its grid, no bar: the grid's error, below
 bars, is counted into the interpolation error it measures), each on one rank (``PETSc.COMM_SELF``), the costliest
 first, each to the least loaded rank (:func:`~petsc_adhesion.family.build.spread`); rank 0
 writes the table with its error (all or nothing) and prints the cost per node and the
-error per cell.  ``fit`` times :func:`~petsc_adhesion.fitting.pull_off.fit_pull_off` (CPU
-seconds, ``time.process_time``) on the pull-off of a sphere at each (mu, sigma), with the
-table and with the solver's secant alone (the path before the table), and the vectorised
+error per cell.  ``seed`` journals a built table's nodes for a build into ``--out`` over more
+nodes, which then traces the new nodes and every cell's centre only.  ``fit`` times
+:func:`~petsc_adhesion.fitting.pull_off.fit_pull_off` (CPU seconds, ``time.process_time``) on
+the pull-off of a sphere at each (mu, sigma), with the table and with the solver's secant alone
+(the path before the table), and the vectorised
 :func:`~petsc_adhesion.fitting.pull_off.gamma_from_pull_offs` on a map of 128 x 128 pull-offs.
 A benchmark is a measurement, not a test: the machine's load is printed with it.
 """
@@ -35,8 +38,10 @@ from ..tracing.measured import Measured
 
 #: The sigma nodes: the pull-off falls fastest between 0.1 and 0.4 (from 0.92 to 0.18 of the smooth one at mu =
 #: 0.01), its sharpest bend between 0.15 and 0.2 (the error at that cell's centre was 1e-2 with nodes 0.05 apart:
-#: hence 0.175), and like sigma^-2 beyond 1 (ln |F_po| nearly linear in sigma there).
-SIGMA_NODES = (0.0, 0.05, 0.1, 0.15, 0.175, 0.2, 0.25, 0.3, 0.4, 0.6, 1.0, 1.75, 3.0)
+#: hence 0.175), and like sigma^-2 beyond 1: from 3 to 10, the footprints' sigma on a measured AFM image (about 4.5,
+#: docs/population.md), F_po = -1.28e-3 at sigma 5 and -3.23e-4 at 10 (mu 1e-3 to 100), ln |F_po| = -2 ln sigma +
+#: c, smooth in sigma, and a node there cheap (0.2 s at mu = 1, 1.5 s at 100, 3.2 s at 1000, one rank).
+SIGMA_NODES = (0.0, 0.05, 0.1, 0.15, 0.175, 0.2, 0.25, 0.3, 0.4, 0.6, 1.0, 1.75, 3.0, 4.0, 5.0, 6.5, 8.0, 10.0)
 #: The mu nodes: about two a decade through the change from the rigid sphere's -1 to JKR's -3/4 (mu 0.1 to 10),
 #: one a decade beyond, where the pull-off approaches JKR's like mu^-1.5 (docs/soft.md) and a node costs most.
 MU_NODES = (1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0, 1000.0)
@@ -116,6 +121,23 @@ def build(mu: tuple, sigma: tuple, out: str, comm=None, tell=print) -> None:
             print(f"{kind} mu {m:g} sigma {s:g}: " + (f"F {n.F.value:.8g} +- {n.F.err or math.nan:.2g}"
                   if n.failed is None else f"FAILED {n.failed}") + f", {n.seconds:.2f} s CPU", flush=True)
     mpi.barrier()
+
+
+def seed(table: PullOffTable, out: str) -> int:
+    """Journal ``table``'s nodes as done for a build into ``out`` (``out.journal-seeded.jsonl``), so that a build
+    over more nodes traces only the new ones: each node the solver's values and bars as that table's build traced
+    them (lambda's value on its grid is not kept in a table: absent), its CPU seconds that build's.  The cells'
+    centres are not seeded: new nodes change the interpolant about them, and the build traces them again.
+    Returns the number of nodes journaled."""
+    rows = []
+    for i, m in enumerate(table.mu):
+        for j, s in enumerate(table.sigma):
+            F = Measured(float(table.F[i, j]), float(table.F_err[i, j]), float(table.F_grid[i, j]))
+            lam = Measured(float(table.lam[i, j]), float(table.lam_err[i, j]), None)
+            rows.append(_record("node", NodeValue(float(m), float(s), F, lam, float(table.seconds[i, j]))))
+    with open(f"{out}.journal-seeded.jsonl", "w") as fh:
+        fh.write("\n".join(rows) + "\n")
+    return len(rows)
 
 
 def assemble(mu: tuple, sigma: tuple, out: str) -> PullOffTable:
@@ -216,13 +238,16 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--out", default=DEFAULT_PATH)
     a.add_argument("--mu", nargs="+", type=float, default=list(MU_NODES))
     a.add_argument("--sigma", nargs="+", type=float, default=list(SIGMA_NODES))
+    d = sub.add_parser("seed")
+    d.add_argument("table", nargs="?", default=DEFAULT_PATH)
+    d.add_argument("--out", required=True)
     r = sub.add_parser("report")
     r.add_argument("table", nargs="?", default=DEFAULT_PATH)
     f = sub.add_parser("fit")
     f.add_argument("--mu", nargs="+", type=float, default=[0.1, 1.0, 10.0, 300.0])
     f.add_argument("--sigma", nargs="+", type=float, default=[0.0, 0.3])
     f.add_argument("--map-only", action="store_true")
-    for q in (b, a, r, f):
+    for q in (b, a, d, r, f):
         q.error = p.error                                 # type: ignore[method-assign]
     return p
 
@@ -237,6 +262,14 @@ def main(argv=None) -> int:
         except ValueError as e:
             say(f"benchmarks.pull_off: {e}")
             return 2
+        return 0
+    if args.command == "seed":
+        try:
+            n = seed(PullOffTable.load(args.table), args.out)
+        except (ValueError, OSError) as e:
+            say(f"benchmarks.pull_off: {e}")
+            return 2
+        tell(f"{n} nodes of {args.table} journaled for {args.out}")
         return 0
     if args.command == "fit":
         if not args.map_only:

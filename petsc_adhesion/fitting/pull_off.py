@@ -14,8 +14,8 @@ root (:func:`gamma_from_pull_offs`) is the start, one curve with error bars ther
 the best F_p (extrapolated over nested grids) and its bar, a Newton step with the
 table's slope s = d ln P / d ln w = 1 + (2/3) d ln|F_p| / d ln mu moves w, one curve on
 the grid at the new w (scaled by the first's best over its grid value) and a second
-Newton step end it: two curves.  Elsewhere (mu below the table's 1e-3, sigma beyond its
-3, another roughness law) the secant in ln w on the solver's pull-off on the grid, from
+Newton step end it: two curves.  Elsewhere (mu below the table's 1e-3 or above its
+largest, sigma beyond its largest, another roughness law) the secant in ln w on the solver's pull-off on the grid, from
 the table's root or the Maugis-Dugdale value, then one curve with error bars at the
 root and a Newton step onto its best F_p, s by central differences (two more curves, mu
 (1 +- 1.3%)).  The bar, from the pull-off's bar F_err, the measurement's P_err and the

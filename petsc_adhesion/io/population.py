@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import math
+import textwrap
 
 import numpy as np
 
@@ -19,26 +20,32 @@ __all__ = ["population_summary", "write_population", "report_population", "COLUM
 
 #: The CSV's columns, a row per particle.
 COLUMNS = ("index", "radius_m", "site_x_m", "site_y_m", "mu", "footprint_radius_m", "pixels", "independent",
-           "rms_m", "skewness", "sigma", "F", "F_err", "force_N", "force_err_N", "passes", "note", "missing")
+           "rms_m", "skewness", "sigma", "F", "F_err", "force_N", "force_err_N", "passes", "note", "missing",
+           "energy", "energy_err", "energy_J", "energy_err_J", "energy_missing")
 
 
 def _num(x) -> object:
     return "" if x is None else x
 
 
+def _pair(q) -> list:
+    """A Measured's value and bar as two cells; a Missing's as two empty ones."""
+    return [q.value, _num(q.err)] if isinstance(q, Measured) else ["", ""]
+
+
 def _row(p) -> list:
-    po, f = p.pull_off, p.force
+    po = p.pull_off
     site = p.site or (None, None)
     return [p.index, p.radius, _num(site[0]), _num(site[1]), p.mu, _num(p.footprint_radius), p.pixels,
-            p.independent, _num(p.rms), _num(p.skewness), _num(p.sigma),
-            po.value if isinstance(po, Measured) else "", _num(po.err) if isinstance(po, Measured) else "",
-            f.value if isinstance(f, Measured) else "", _num(f.err) if isinstance(f, Measured) else "",
-            p.passes, p.note, "" if isinstance(po, Measured) else po.reason]
+            p.independent, _num(p.rms), _num(p.skewness), _num(p.sigma), *_pair(po), *_pair(p.force),
+            p.passes, p.note, "" if isinstance(po, Measured) else po.reason, *_pair(p.energy), *_pair(p.work),
+            "" if isinstance(p.energy, Measured) else p.energy.reason]
 
 
 def write_csv(path: str, result) -> None:
     """A row per particle (:data:`COLUMNS`): F in units 2 pi R w (negative), force_N its magnitude in N; a
-    missing pull-off empty with its reason under ``missing``."""
+    missing pull-off empty with its reason under ``missing``; the energy of a cycle in units 2 pi R w epsilon
+    and in J (0: no hysteresis), a missing one empty with its reason under ``energy_missing``."""
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(COLUMNS)
@@ -58,13 +65,22 @@ def _finite(a) -> list:
 REASONS = 5
 
 
-def _reasons(result) -> tuple[list, int]:
-    """The commonest reasons of the missing pull-offs with their counts (at most REASONS), and how many
-    other reasons there are."""
+def _reasons(result, energy: bool = False) -> tuple[list, int]:
+    """The commonest reasons of the missing pull-offs (``energy``: energies of a cycle) with their counts (at
+    most REASONS), and how many other reasons there are."""
     from collections import Counter
 
-    counts = Counter(p.pull_off.reason for p in result.missing).most_common()
+    which = [p.energy.reason for p in result.energy_missing] if energy else \
+        [p.pull_off.reason for p in result.missing]
+    counts = Counter(which).most_common()
     return counts[:REASONS], max(0, len(counts) - REASONS)
+
+
+def _lognormal(fit) -> dict:
+    if hasattr(fit, "median"):
+        return {"median": fit.median.value, "median_err": fit.median.err, "gsd": fit.gsd.value,
+                "gsd_err": fit.gsd.err, "count": fit.count, "resamples": fit.resamples}
+    return {"missing": fit.reason}
 
 
 def population_summary(head: dict, given: dict, result) -> dict:
@@ -88,6 +104,13 @@ def population_summary(head: dict, given: dict, result) -> dict:
                             "gsd_err": fit.gsd.err, "count": fit.count, "resamples": fit.resamples}
     else:
         pop["lognormal"] = {"missing": fit.reason}
+    works = result.works
+    reasons, others = _reasons(result, energy=True)
+    pop["energy_of_a_cycle"] = {
+        "machine": "rigid", "unit": "J", "computed": int(works.size), "zero": int(np.sum(works == 0)),
+        "positive": int(np.sum(works > 0)), "missing": len(result.energy_missing),
+        "missing_reasons": [{"reason": r, "count": n} for r, n in reasons], "missing_other_reasons": others,
+        "lognormal": {(f"{k}_J" if k.startswith("median") else k): v for k, v in _lognormal(result.energy_fit).items()}}
     bins = result.bins
     pop["radius_bins"] = {"missing": bins.reason} if not hasattr(bins, "edges") else {
         "edges_m": _finite(bins.edges), "count": [int(c) for c in bins.count], "median_N": _finite(bins.median),
@@ -110,7 +133,11 @@ _DATASETS = {"index": ("", "the particle's index (its draws from the seed)"), "r
              "skewness": ("", "its skewness (NaN: none, or flat)"), "sigma": ("epsilon", "rms / epsilon"),
              "F": ("2 pi R w", "pull-off load (NaN: missing, its reason in 'missing')"),
              "F_err": ("2 pi R w", "its bar (NaN: none)"), "force": ("N", "the pull-off force's magnitude"),
-             "force_err": ("N", "its bar"), "passes": ("", "solves of the footprint iteration (0: table)")}
+             "force_err": ("N", "its bar"), "passes": ("", "solves of the footprint iteration (0: table)"),
+             "energy": ("2 pi R w epsilon", "the energy a cycle under a rigid machine dissipates (0: no hysteresis; "
+                        "NaN: missing, its reason in 'energy_missing')"),
+             "energy_err": ("2 pi R w epsilon", "its bar (NaN: none)"), "work": ("J", "the energy of a cycle"),
+             "work_err": ("J", "its bar")}
 
 
 def _particle_arrays(result) -> dict:
@@ -128,7 +155,11 @@ def _particle_arrays(result) -> dict:
             "F_err": arr(lambda p: p.pull_off.err if isinstance(p.pull_off, Measured) else None),
             "force": arr(lambda p: p.force.value if isinstance(p.force, Measured) else None),
             "force_err": arr(lambda p: p.force.err if isinstance(p.force, Measured) else None),
-            "passes": np.array([p.passes for p in ps])}
+            "passes": np.array([p.passes for p in ps]),
+            "energy": arr(lambda p: p.energy.value if isinstance(p.energy, Measured) else None),
+            "energy_err": arr(lambda p: p.energy.err if isinstance(p.energy, Measured) else None),
+            "work": arr(lambda p: p.work.value if isinstance(p.work, Measured) else None),
+            "work_err": arr(lambda p: p.work.err if isinstance(p.work, Measured) else None)}
 
 
 def write_h5(path: str, summary: dict, result) -> None:
@@ -148,6 +179,8 @@ def write_h5(path: str, summary: dict, result) -> None:
         g.create_dataset("note", data=np.array([p.note for p in result.particles], dtype=object), dtype=s)
         g.create_dataset("missing", data=np.array(["" if isinstance(p.pull_off, Measured) else p.pull_off.reason
                                                    for p in result.particles], dtype=object), dtype=s)
+        g.create_dataset("energy_missing", data=np.array(["" if isinstance(p.energy, Measured) else p.energy.reason
+                                                          for p in result.particles], dtype=object), dtype=s)
         pop = f.create_group("population")
         pop.attrs["description"] = "the inputs, the lognormal fit of the forces (N), the bins, the model spread"
         pop.attrs["summary_json"] = json.dumps(summary["population"], default=float)
@@ -163,9 +196,28 @@ def write_h5(path: str, summary: dict, result) -> None:
             d.attrs["description"] = f"(rule - measured) / |measured| of the subsample; rule: {sp.rule_source}"
 
 
+def _histogram(ax, x: np.ndarray, fit, scale: float, unit: str, label: str) -> None:
+    """The histogram of the positive values ``x`` (SI) in ``unit`` (SI times ``scale``), log-spaced bins, with
+    the density of the lognormal ``fit`` (SI) where there is one."""
+    if x.size:
+        edges = np.geomspace(x.min(), x.max() * 1.0001, max(5, min(40, int(np.sqrt(x.size)) + 1)))
+        ax.hist(x, bins=edges, density=True, color="0.7", label=label)
+        ax.set_xscale("log")
+    if hasattr(fit, "median") and x.size:
+        grid = np.geomspace(x.min(), x.max(), 200)
+        m, s = math.log(fit.median.value * scale), math.log(fit.gsd.value)
+        if s > 0:
+            ax.plot(grid, np.exp(-(np.log(grid) - m) ** 2 / (2 * s * s)) / (grid * s * math.sqrt(2 * math.pi)), "k-",
+                    label=f"lognormal: median {fit.median.value * scale:.3g} {unit}, gsd {fit.gsd.value:.3g}")
+    ax.set_ylabel(f"density (1/{unit})")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=8)
+
+
 def figure(result, path: str, fmt: str) -> None:
-    """The histogram of |F| (N) with the fitted lognormal's density, and |F| against the radius with the
-    bins' median and 16-84 % band."""
+    """The histogram of |F| (N) with the fitted lognormal's density, |F| against the radius with the bins'
+    median and 16-84 % band, and the histogram of the positive energies of a cycle with theirs (or, where
+    there is none, why)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -173,21 +225,17 @@ def figure(result, path: str, fmt: str) -> None:
 
     F = result.forces * 1e9
     radii = np.array([p.radius for p in result.particles if isinstance(p.pull_off, Measured)]) * 1e6
-    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
-    if F.size:
-        edges = np.geomspace(F.min(), F.max() * 1.0001, max(5, min(40, int(np.sqrt(F.size)) + 1)))
-        a.hist(F, bins=edges, density=True, color="0.7", label=f"{F.size} particles ({result.evaluator})")
-        a.set_xscale("log")
-    fit = result.fit
-    if hasattr(fit, "median") and F.size:
-        x = np.geomspace(F.min(), F.max(), 200)
-        m, s = math.log(fit.median.value * 1e9), math.log(fit.gsd.value)
-        if s > 0:
-            a.plot(x, np.exp(-(np.log(x) - m) ** 2 / (2 * s * s)) / (x * s * math.sqrt(2 * math.pi)), "k-",
-                   label=f"lognormal: median {fit.median.value * 1e9:.3g} nN, gsd {fit.gsd.value:.3g}")
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(15, 4))
+    _histogram(a, F, result.fit, 1e9, "nN", f"{F.size} particles ({result.evaluator})")
     a.set_xlabel("pull-off force |F| (nN)")
-    a.set_ylabel("density (1/nN)")
-    a.legend(fontsize=8)
+    works = result.works
+    W = works[works > 0] * 1e15
+    _histogram(c, W, result.energy_fit, 1e15, "fJ", f"{W.size} particles with hysteresis")
+    c.set_xlabel("energy of a cycle, rigid machine (fJ)")
+    if not W.size or not hasattr(result.energy_fit, "median"):
+        why = result.energy_fit.reason if hasattr(result.energy_fit, "reason") else ""
+        c.text(0.5, 0.5, "\n".join(textwrap.wrap(f"no lognormal of the energies: {why}", 40)), ha="center",
+               va="center", transform=c.transAxes, fontsize=8)
     b.plot(radii, F, ".", ms=3, color="0.5", label="particles")
     bins = result.bins
     if hasattr(bins, "edges"):
@@ -235,6 +283,20 @@ def report_population(result, out=None) -> None:
                      f"pull-offs, {fit.resamples} bootstrap resamples)")
     else:
         lines.append(f"  no lognormal: {fit.reason}")
+    works = result.works
+    if works.size:
+        lines.append(f"  energy of a cycle (rigid machine): {works.size} computed, {int(np.sum(works == 0))} of them 0 "
+                     f"(no hysteresis), {len(result.energy_missing)} missing")
+    ef = result.energy_fit
+    if hasattr(ef, "median"):
+        lines.append(f"  lognormal of the positive energies: median {ef.median.value * 1e15:.5g} +- "
+                     f"{ef.median.err * 1e15:.2g} fJ, geometric standard deviation {ef.gsd.value:.4g} +- "
+                     f"{ef.gsd.err:.2g} ({ef.count} particles)")
+    elif works.size:
+        lines.append(f"  no lognormal of the energies: {ef.reason}")
+    else:
+        reasons, _ = _reasons(result, energy=True)
+        lines.append(f"  no energy of a cycle: {reasons[0][0] if reasons else ef.reason}")
     sp = result.spread
     if hasattr(sp, "indices") and sp.median is not None:
         lines.append(f"  model spread ({sp.relative.size} particles, rule: {sp.rule_source}): (rule - measured) / "

@@ -12,7 +12,10 @@ Particle i (its radius and site drawn from the seed by its index, sample.py) is
 evaluated on rank i mod (ranks): the same particles and the same values whatever the
 rank count; the results are gathered to every rank.  Each particle's Tabor parameter
 is that of the ``bodies`` at its radius (eq. 9), its roughness its footprint's heights
-(footprint.py), its pull-off by the evaluator asked for (evaluate.py).  The model
+(footprint.py), its pull-off by the evaluator asked for (evaluate.py), and with the
+solver the energy its cycle dissipates under a rigid machine (the curve traced just past
+the pull-off closes that cycle); the lognormal of the positive energies beside the
+pull-off forces'.  The model
 spread: the first ``spread_count`` particles with a footprint evaluated under both the
 measured law (the solver) and the Gaussian rule at their rms (the table where it is
 given, else the solver's rule), on the same footprints.
@@ -26,8 +29,8 @@ import numpy as np
 
 from ..tracing.measured import Measured, Missing
 from .evaluate import EVALUATORS, Evaluator, GaussianRule, PullOffModel, SolverEvaluator, TableEvaluator, Trace
-from .footprint import MIN_PIXELS, ZONE_SHARE, Footprint
-from .results import BOOTSTRAP, Particle, PopulationResult, SpreadSample, lognormal_fit, radius_bins
+from .footprint import MIN_PIXELS, ZONE_SHARE
+from .results import BOOTSTRAP, Particle, PopulationResult, SpreadSample, energy_fit, lognormal_fit, radius_bins
 from .sample import RadiusLaw, draw
 
 __all__ = ["population", "MAX_COUNT", "SPREAD_COUNT"]
@@ -54,14 +57,17 @@ def _check(topography, bodies, law, count: int, evaluator: str) -> None:
         raise ValueError("bodies: the moduli are needed for mu (eq. 9)")
 
 
-def _particle(d, mu: float, unit: float, fp: Footprint | None, F, passes: int, note: str,
-              epsilon: float) -> Particle:
+def _particle(d, mu: float, unit: float, ev, epsilon: float) -> Particle:
+    """The particle of draw ``d`` from its evaluation ``ev``; ``unit`` 2 pi R w (N), its energy's unit that
+    times ``epsilon`` (J)."""
+    fp, F, passes, note = ev.footprint, ev.pull_off, ev.passes, ev.note
     if fp is None:
-        return Particle(d.index, d.radius, None, mu, None, 0, 0.0, None, None, None, F, unit, passes, note)
+        return Particle(d.index, d.radius, None, mu, None, 0, 0.0, None, None, None, F, unit, ev.energy,
+                        unit * epsilon, passes, note)
     rms = fp.rms if fp.pixels else None
     note = note or (fp.note if isinstance(F, Measured) else "")
     return Particle(d.index, d.radius, fp.center, mu, fp.radius, fp.pixels, fp.independent, rms, fp.skewness,
-                    None if rms is None else rms / epsilon, F, unit, passes, note)
+                    None if rms is None else rms / epsilon, F, unit, ev.energy, unit * epsilon, passes, note)
 
 
 def _mine(count: int, rank: int, size: int) -> range:
@@ -92,7 +98,8 @@ def population(topography, bodies, law: RadiusLaw, count: int | None = None, see
     bins, resamples
         Bins of the pull-off against radius; bootstrap resamples of the lognormal's bars.
     trace
-        The solver's grid and settings (evaluate.Trace).
+        The solver's grid and settings (evaluate.Trace), and whether each particle's energy of a cycle is
+        given (``trace.energy``; the solver only: the table evaluator's particles have none, with the reason).
 
     Raises ValueError for inputs it cannot take (one line).
     """
@@ -122,16 +129,18 @@ def population(topography, bodies, law: RadiusLaw, count: int | None = None, see
     if evaluator == "table":
         assert tab is not None, "a table evaluator without its table: refused above"
         chosen = tab
-    mine = [_particle(d, mu, 2 * np.pi * d.radius * w, ev.footprint, ev.pull_off, ev.passes, ev.note, eps)
+    mine = [_particle(d, mu, 2 * np.pi * d.radius * w, ev, eps)
             for d, mu, ev in zip(draws, mus, chosen.evaluate_all(topography, draws, mus, eps))]
     particles = tuple(sorted((p for part in mpi.allgather(mine) for p in part), key=lambda p: p.index))
     spread = _spread(particles, topography, eps, spread_count, evaluator, solver, tab, trace, mpi)
     forces = np.array([p.force.value for p in particles if isinstance(p.pull_off, Measured)])
     radii = np.array([p.radius for p in particles if isinstance(p.pull_off, Measured)])
     fit = lognormal_fit(forces, seed, resamples)
+    works = np.array([p.work.value for p in particles if isinstance(p.energy, Measured)])
+    energies = energy_fit(works, sum(not isinstance(p.energy, Measured) for p in particles), seed, resamples)
     cpu = mpi.allreduce(time.process_time() - c0)
     return PopulationResult(particles, evaluator, int(seed), law, topography, bodies, ZONE_SHARE, fit,
-                            radius_bins(radii, forces, bins), spread, size, time.perf_counter() - t0, cpu)
+                            radius_bins(radii, forces, bins), spread, size, time.perf_counter() - t0, cpu, energies)
 
 
 def _spread(particles, topography, eps, spread_count, evaluator, solver, tab, trace, mpi) -> SpreadSample | Missing:
@@ -151,7 +160,8 @@ def _spread(particles, topography, eps, spread_count, evaluator, solver, tab, tr
     for k in range(rank, len(chosen), size):
         p = chosen[k]
         fp = footprint(topography, p.site, p.footprint_radius, eps, clip=True)
-        measured = p.pull_off if evaluator == "solver" else solver.measured(p.mu, fp.heights)[0]
+        # the spread compares pull-offs: its solves leave the energy out
+        measured = p.pull_off if evaluator == "solver" else solver.measured(p.mu, fp.heights, energy=False).F
         if evaluator == "table":
             ruled = p.pull_off
         elif rule is not None:

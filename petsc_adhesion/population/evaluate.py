@@ -5,7 +5,14 @@
 particle's own measured law (the footprint's heights, eq. 7 averaged over their
 histogram, model/roughness.py), only until just past the pull-off (the most tensile F,
 then the load's zero: ``observable_max`` 0), with its error bar from nested grids:
-exact for the model.  The footprint's size comes from the pull-off's own contact
+exact for the model.  That curve is also the whole of a cycle under a rigid machine
+(tracing/energy.py): it starts on the far branch and ends compressive, past every
+turning point of lambda (adhesion makes them tensile), so the energy the cycle
+dissipates, the closed integral of F d lambda over the approach's snap-on and the
+retraction's snap-off (units 2 pi R w epsilon), comes with it; its bar needs the two
+folds located again on nested grids (``Trace.energy``: kinds snap_on and snap_off
+asked for).  A curve without a turning point of lambda gives a computed 0 (no
+hysteresis), not a missing value.  The footprint's size comes from the pull-off's own contact
 radius, iterated (model/footprint.py): the heights of a footprint make a pull-off whose
 contact radius makes the next footprint, until the next footprint holds the same pixels
 to :data:`SETTLED` (at most :data:`PASSES` solves).
@@ -14,7 +21,8 @@ to :data:`SETTLED` (at most :data:`PASSES` solves).
 pull-off F(mu, sigma) tabulated and interpolated (``petsc_adhesion.family.pull_off``'s
 ``PullOffTable``, loaded by :func:`load_table`), at the footprint's rms: fast, and the
 rule, not the measured law.  Its footprint is sized by the smooth sphere's contact
-radius at pull-off (Maugis-Dugdale), no solve to iterate on.
+radius at pull-off (Maugis-Dugdale), no solve to iterate on.  The table holds pull-offs
+only: a particle's energy of a cycle is missing with that reason.
 
 :class:`GaussianRule` is the rule computed by the solver itself (the 16-point Hermite
 average, eq. 10, at each (mu, sigma)): what the model spread compares with where no
@@ -35,7 +43,7 @@ from ..tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settin
 from .footprint import Footprint, footprint, footprint_radius, md_contact_radius
 
 __all__ = ["Evaluator", "PullOffModel", "TableMissing", "load_table", "SolverEvaluator", "TableEvaluator", "GaussianRule",
-           "Evaluation", "PASSES", "SETTLED", "EVALUATORS"]
+           "Evaluation", "Solved", "Trace", "PASSES", "SETTLED", "EVALUATORS", "NO_ENERGY_TABLE", "NO_ENERGY_ASKED"]
 
 #: The most solves of the solver's footprint iteration.
 PASSES = 4
@@ -43,6 +51,10 @@ PASSES = 4
 SETTLED = 0.01
 #: -pop_evaluator's names.
 EVALUATORS = ("solver", "table")
+#: Why a table-evaluated particle has no energy of a cycle.
+NO_ENERGY_TABLE = "the pull-off table holds pull-offs only: no energy of a cycle (the solver evaluator gives it)"
+#: Why a particle has none when it was not asked for.
+NO_ENERGY_ASKED = "the energy of a cycle was not asked for (-pop_energy false; Trace.energy False)"
 
 
 class PullOffModel(Protocol):
@@ -87,27 +99,46 @@ def load_table() -> PullOffModel:
 
 @dataclass(frozen=True)
 class Trace:
-    """How the solver traces a pull-off: its grid and solvers, the far field, the error bars."""
+    """How the solver traces a pull-off: its grid and solvers, the far field, the error bars, and whether the
+    energy of the rigid machine's cycle is given with its bar (``energy``: its two folds located on nested
+    grids too)."""
 
     grid: GridChoice = GridChoice()
     solver: SolverChoice = SolverChoice()
     farfield: bool = True
     error_bars: bool = True
+    energy: bool = True
 
 
-def _pull_off(model: Model, how: Trace, comm) -> tuple[Measured | Missing, float | None]:
-    """The most tensile load of ``model``'s curve traced just past it, and its contact radius there."""
+@dataclass(frozen=True)
+class Solved:
+    """One curve's answer for a particle: the pull-off ``F`` (units 2 pi R w), the ``contact_radius`` there
+    (units sqrt(R epsilon); None where not had) and the ``energy`` of the rigid machine's cycle (units
+    2 pi R w epsilon: Measured, a computed 0 without hysteresis, or Missing with why)."""
+
+    F: Measured | Missing
+    contact_radius: float | None
+    energy: Measured | Missing
+
+
+def _pull_off(model: Model, how: Trace, comm) -> Solved:
+    """The most tensile load of ``model``'s curve traced just past it, its contact radius there, and the
+    energy of the cycle that curve closes (module docstring)."""
     settings = replace(curve_settings(step_scale(model)), observable_max=0.0)
+    kinds = ("F_min", "equilibrium") + (("snap_on", "snap_off") if how.energy else ())
     try:
         c = trace_curve(model, how.grid, how.solver, settings=settings,
-                        request=CurveRequest(kinds=("F_min", "equilibrium"), error_bars=how.error_bars), comm=comm)
+                        request=CurveRequest(kinds=kinds, error_bars=how.error_bars), comm=comm)
     except (RuntimeError, ValueError, FloatingPointError) as e:
-        return Missing(f"the solver failed: {first_line(e)}"), None
+        why = Missing(f"the solver failed: {first_line(e)}")
+        return Solved(why, None, why)
+    energy = c.rigid.energy if how.energy else Missing(NO_ENERGY_ASKED)
     po = c.pull_off
     if po is None:
-        return Missing("the curve has no pull-off: " + ("; ".join(c.assessment.warnings) or "it stopped before")), None
+        return Solved(Missing("the curve has no pull-off: " + ("; ".join(c.assessment.warnings) or
+                                                                "it stopped before")), None, energy)
     a = po.contact_radius.value if isinstance(po.contact_radius, Measured) else None
-    return po.F, a
+    return Solved(po.F, a, energy)
 
 
 def measured_model(mu: float, heights: np.ndarray, farfield: bool = True) -> Model:
@@ -122,10 +153,12 @@ def measured_model(mu: float, heights: np.ndarray, farfield: bool = True) -> Mod
 @dataclass(frozen=True)
 class Evaluation:
     """One particle evaluated: its ``footprint`` (None: none fits the scan), ``pull_off`` (units 2 pi R w) or
-    why it is missing, the solves of its footprint iteration (``passes``; 0 for the table) and a ``note``."""
+    why it is missing, the ``energy`` of its cycle (units 2 pi R w epsilon) or why it is missing, the solves
+    of its footprint iteration (``passes``; 0 for the table) and a ``note``."""
 
     footprint: Footprint | None
     pull_off: Measured | Missing
+    energy: Measured | Missing
     passes: int = 0
     note: str = ""
 
@@ -139,9 +172,11 @@ class SolverEvaluator:
     def __init__(self, trace: Trace = Trace(), comm=None):
         self.trace, self.comm = trace, comm
 
-    def measured(self, mu: float, heights: np.ndarray) -> tuple[Measured | Missing, float | None]:
-        """The pull-off and its contact radius of a particle of ``mu`` on ``heights`` (units of epsilon)."""
-        return _pull_off(measured_model(mu, heights, self.trace.farfield), self.trace, self.comm)
+    def measured(self, mu: float, heights: np.ndarray, energy: bool | None = None) -> Solved:
+        """The pull-off, its contact radius and the energy of a cycle of a particle of ``mu`` on ``heights``
+        (units of epsilon); ``energy`` False leaves the energy out (None: as the evaluator's Trace says)."""
+        how = self.trace if energy is None else replace(self.trace, energy=energy)
+        return _pull_off(measured_model(mu, heights, self.trace.farfield), how, self.comm)
 
     def evaluate(self, topography, draw, mu: float, epsilon: float) -> Evaluation:
         """The particle ``draw`` (:class:`~petsc_adhesion.population.sample.Draw`: its radius and site deviates)
@@ -159,21 +194,24 @@ class SolverEvaluator:
         fp = at(a)
         while True:
             if fp is None:
-                return Evaluation(None, Missing(f"the footprint (contact radius {a:.3g} sqrt(R epsilon) at "
-                                                f"pull-off) is larger than the scan"), passes)
+                why = Missing(f"the footprint (contact radius {a:.3g} sqrt(R epsilon) at pull-off) is larger than "
+                              f"the scan")
+                return Evaluation(None, why, why, passes)
             if not fp.usable:
-                return Evaluation(fp, Missing(fp.note), passes)
-            F, a_new = self.measured(mu, fp.heights)
+                return Evaluation(fp, Missing(fp.note), Missing(fp.note), passes)
+            got = self.measured(mu, fp.heights)
             passes += 1
+            F, a_new = got.F, got.contact_radius
             if not isinstance(F, Measured) or a_new is None:
-                return Evaluation(fp, F, passes)
+                return Evaluation(fp, F, got.energy, passes)
             nxt = at(a_new)
             # settled: the next footprint holds the same pixels to SETTLED (its heights, its pull-off the same)
             if nxt is not None and abs(nxt.pixels - fp.pixels) <= SETTLED * fp.pixels:
-                return Evaluation(fp, F, passes)
+                return Evaluation(fp, F, got.energy, passes)
             if passes == PASSES:
-                return Evaluation(fp, F, passes, f"the footprint had not settled after {PASSES} solves "
-                                                 f"({fp.pixels} then {nxt.pixels if nxt else 'no'} pixels)")
+                return Evaluation(fp, F, got.energy, passes, f"the footprint had not settled after {PASSES} solves "
+                                                             f"({fp.pixels} then {nxt.pixels if nxt else 'no'} "
+                                                             f"pixels)")
             fp, a = nxt, a_new
 
 
@@ -205,8 +243,9 @@ class TableEvaluator:
         usable = {k: fp for k, fp in enumerate(found) if isinstance(fp, Footprint) and fp.usable}
         values = dict(zip(usable, self.evaluate_many(np.array([mus[k] for k in usable]),
                                                      np.array([fp.rms / epsilon for fp in usable.values()]))))
-        return [Evaluation(fp, values.get(k, Missing(fp.note))) if isinstance(fp, Footprint) else
-                Evaluation(None, fp) for k, fp in enumerate(found)]
+        none = Missing(NO_ENERGY_TABLE)
+        return [Evaluation(fp, values.get(k, Missing(fp.note)), none) if isinstance(fp, Footprint) else
+                Evaluation(None, fp, none) for k, fp in enumerate(found)]
 
     def evaluate_many(self, mu: np.ndarray, sigma: np.ndarray) -> list[Measured | Missing]:
         """The rule's pull-off at each (mu, sigma), Missing outside the table."""
@@ -233,7 +272,7 @@ class GaussianRule:
     def one(self, mu: float, sigma: float) -> Measured | Missing:
         """The rule's pull-off at one (mu, sigma)."""
         model = Model(mu=mu, sigma=sigma, roughness="hermite" if sigma > 0 else "none", farfield=self.trace.farfield)
-        return _pull_off(model, self.trace, self.comm)[0]
+        return _pull_off(model, replace(self.trace, energy=False), self.comm).F
 
     def pull_off(self, mu: np.ndarray, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         out = [self.one(float(m), float(s)) for m, s in zip(np.ravel(mu), np.ravel(sigma))]

@@ -299,6 +299,8 @@ TABLE = {o.name: o for o in [
            "Gaussian rule on the same footprints, the model spread (0: none)", 0, 10**6),
     Option("pop_bins", "int", 8, "population: bins of the pull-off against radius (log-spaced)", 1, 1000),
     Option("pop_bootstrap", "int", 200, "population: bootstrap resamples of the lognormal fit's bars", 10, 10**5),
+    Option("pop_energy", "flag", True, "population: each particle's energy of a cycle under a rigid machine, with "
+           "its bar (the solver evaluator; false skips it: the folds are not located again on nested grids)"),
     # output
     Option("out", "string", None, "HDF5 result file"),
     Option("summary", "string", None, "JSON summary file"),
