@@ -9,7 +9,11 @@ of its own with error bars), the fit by the secant alone (use_table False) must 
 its bar although one of its curves failed.
 """
 import math
+import os
+import subprocess
+import sys
 
+import conftest
 import pytest
 
 from petsc_adhesion.fitting import pull_off as po
@@ -60,3 +64,21 @@ def test_a_pull_off_no_curve_reaches_is_one_line_naming_w(monkeypatch):
     w = float(msg.split("w = ")[1].split()[0])
     assert msg.startswith(f"the model's pull-off at w = {w:.6g} J/m^2 (mu = ")
     assert len(calls) == po.RETRIES + 1
+
+
+def test_the_command_line_says_it_in_one_line_and_exits_3(tmp_path):
+    """-fit_pull_off where the solver cannot trace the curve it needs (made to fail in the process): one line
+    naming the fit, the w and the solver's reason, exit status 3, nothing written (before: the tracer's bare
+    'event location failed near lambda = ...', exit 1)."""
+    code = ("from petsc_adhesion.fitting import pull_off as po; from petsc_adhesion.app.cli import main\n"
+            "def fail(*a, **k):\n    raise RuntimeError('event location failed near lambda = -2.75761')\n"
+            "po.model_pull_off = fail\n"
+            "raise SystemExit(main(['x', '-fit_pull_off', '1.37e-9', '-phys_radius', '20e-9', '-phys_young1', "
+            f"'{_bodies().young1!r}', '-phys_poisson1', '0', '-phys_epsilon', '0.3e-9', '-summary', 'fit.json']))")
+    proc = subprocess.run([sys.executable, "-c", code], env=conftest._env(), capture_output=True, text=True,
+                          cwd=tmp_path, timeout=600)
+    assert proc.returncode == 3, proc.stderr
+    (line,) = proc.stderr.strip().splitlines()
+    assert line.startswith("petsc-adhesion: -fit_pull_off: no work of adhesion: the model's pull-off at w = "), line
+    assert line.endswith("could not be computed: event location failed near lambda = -2.75761"), line
+    assert os.listdir(tmp_path) == []
