@@ -22,7 +22,7 @@ from ..errors import InputError, collective, printable, say
 from ..fitting.curve_fit import CurveFitError, FitProgress, OutsideDomain, fit_curve, predict_curve
 from ..fitting.data import CurveFileError, MeasuredCurve, NeedsInstrument, read_curve
 from ..fitting.forward import open_table
-from ..fitting.pull_off import PullOffFitError, fit_pull_off
+from ..fitting.pull_off import PullOffCurveError, PullOffFitError, fit_pull_off
 from ..fitting.results import FitChoice, Spring
 from ..io.fit import fit_summary, fit_tree, report_fit
 from ..io.inputs import check_input
@@ -313,6 +313,9 @@ def execute(opts: AppOptions, argv: list[str], report: bool = True):
     except OutsideDomain as e:          # refused before any work: nothing written, an earlier result intact
         say(f"-fit_curve: outside the model's domain: {printable(str(e))}; -fit_outside_domain warn fits it all "
             f"the same")
+        return 3, None
+    except PullOffCurveError as e:     # a curve the fit needed failed: what was not computed, nothing written
+        say(f"-fit_pull_off: no work of adhesion: {printable(str(e))}")
         return 3, None
     warn(req.warnings + _implausible_result(fit), report)   # with the result: a refused fit stays one line
     head = program_record(Program.of(comm))

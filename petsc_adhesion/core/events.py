@@ -199,9 +199,11 @@ class EventFinder:
         pseudo-arclength corrector throughout, which follows the curve through folds where the
         natural one (at fixed p) may have stepped over them."""
         cont = self.cont
-        # b's distance from a: along a's tangent for the arclength corrector, in p for the natural
+        # b's distance from a: along a's tangent for the arclength corrector, in p for the natural.  b's own
+        # step is that distance only where a is the point b was stepped from: a landing's piece may start at
+        # a point of a fold's arc inside the step (b.ds, the whole step's, then overshoots b)
         sb = b.ds if b.ds and b.corrector == ("natural" if cont.natural_ok(a) and not arclength else "arclength") \
-            else cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p)
+            and self._stepped(a, b) else cont.inner(a.xdot, b.x - a.x) + a.pdot * (b.p - a.p)
         correct = cont.arclength if arclength else cont.correct
         natural = cont.natural_ok(a) and not arclength
         cache: dict[float, Point] = {}
@@ -222,6 +224,11 @@ class EventFinder:
             return cache[s]
 
         return point, sb
+
+    def _stepped(self, a, b) -> bool:
+        """Whether b is the continuation's point after a (so b.ds is b's distance from a)."""
+        pts = self.cont.points
+        return any(pts[k + 1] is b and pts[k] is a for k in range(len(pts) - 2, -1, -1))
 
     def locate(self, a, b, f, level: float = 0.0, tangent: bool = True):
         """The point between a and b where f = level, to ``tol`` in the parameter.

@@ -58,7 +58,7 @@ from .results import BOUND_MARGIN, Z95, ClosedForm, PullOffFit, undetermined
 if TYPE_CHECKING:                    # tracing.model_spread traces curves: loaded where a spread is made
     from ..tracing.model_spread import ModelSpread
 
-__all__ = ["PullOffFit", "PullOffFitError", "fit_pull_off", "model_pull_off", "maugis_dugdale_gamma", "MU_RANGE",
+__all__ = ["PullOffFit", "PullOffFitError", "PullOffCurveError", "fit_pull_off", "model_pull_off", "maugis_dugdale_gamma", "MU_RANGE",
            "closed_forms", "PullOffMap", "gamma_from_pull_offs"]
 
 #: The Tabor parameters the model is solved for: from -adh_mu's least positive value (below the pull-off table's
@@ -70,6 +70,11 @@ _DLOGW = 0.02
 
 class PullOffFitError(ValueError):
     """A pull-off no work of adhesion gives within the model's range; one line."""
+
+
+class PullOffCurveError(RuntimeError):
+    """The model's pull-off at a work of adhesion the fit needed could not be computed (the solver's curve
+    failed there, and where the secant could, at the points it tried instead); one line naming w and why."""
 
 
 def model_pull_off(model: Model, grid=None, solver=None, error_bars: bool = False, comm=None):
@@ -176,11 +181,19 @@ def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | No
 
     cache = {}
 
+    def curve_at(w: float, error_bars: bool = False):
+        """The model's pull-off event at w; PullOffCurveError (one line naming w) where its curve fails."""
+        try:
+            return model_pull_off(model_at(w), grid, solver, error_bars=error_bars, comm=comm)
+        except RuntimeError as why:
+            raise PullOffCurveError(f"the model's pull-off at w = {w:.6g} J/m^2 (mu = {mu_of(w):.6g}) could not be "
+                                    f"computed: {str(why).splitlines()[0] if str(why) else type(why).__name__}") from None
+
     def pull(lnw: float) -> float:
         """|F_p| on the grid at w = exp(lnw)."""
         if lnw not in cache:
             w = math.exp(lnw)
-            e = model_pull_off(model_at(w), grid, solver, comm=comm)
+            e = curve_at(w)
             cache[lnw] = abs(pull_off_values(e)[0])
             history.append((w, mu_of(w), pull_off_values(e)[0]))
         return cache[lnw]
@@ -202,15 +215,14 @@ def fit_pull_off(P: float, bodies: Bodies, P_err: float = 0.0, model: Model | No
                               f"where mu = {mu_of(w_md):.3g} by eq. (9) is above {MU_RANGE[1]:g}, the model's "
                               f"range (-adh_mu)")
     if start is not None and describes(replace(template, sigma=sigma)):
-        lnw, F_best, F_err, Fg, slope_w, step, traced = _table_path(start, g, pull, lambda w: model_pull_off(
-            model_at(w), grid, solver, error_bars=True, comm=comm), P, R)
+        lnw, F_best, F_err, Fg, slope_w, step, traced = _table_path(start, g, pull, lambda w: curve_at(w, True), P, R)
         curves = traced
     else:
         x0 = start[0] if start is not None else math.log(min(max(w_md, lo_w), hi_w))
         lnw = _solve(g, x0, math.log(lo_w), math.log(hi_w), rtol, P, mu_of)
         w = math.exp(lnw)
         # the best pull-off at the root (extrapolated over nested grids), its bar, and the slope of |F_p| in mu
-        best = model_pull_off(model_at(w), grid, solver, error_bars=True, comm=comm)
+        best = curve_at(w, True)
         F_best, F_err, Fg = pull_off_values(best)
         up = min(lnw + _DLOGW, math.log(hi_w))
         down = max(lnw - _DLOGW, math.log(lo_w))
@@ -430,15 +442,36 @@ def _verdict(w: float, F: float, F_err: float | None, P: float, P_err: float, sl
     return Missing(why), [f"gamma undetermined: {why}"]
 
 
+#: Where the curve at a secant iterate fails, the iterate is moved this share of the way back to the last
+#: one, at most RETRIES times; a failing start moves RETRY_STEP in ln w (2% in w).
+RETRIES, RETRY_STEP = 3, 0.02
+
+
+def _tried(g, x: float, back: float) -> tuple:
+    """(x, g(x)) for the secant, or, where the curve at x fails (:class:`PullOffCurveError`: one solver failure
+    at one w, a fold pair it could not resolve, says nothing of the root), for a point moved half of the way
+    back towards ``back`` and again, RETRIES times; the first failure's error if all fail."""
+    first = None
+    for _ in range(RETRIES + 1):
+        try:
+            return x, g(x)
+        except PullOffCurveError as why:
+            first = first or why
+            x = back + 0.5 * (x - back)
+    raise first
+
+
 def _solve(g, x0: float, lo: float, hi: float, rtol: float, P: float, mu_of) -> float:
     """The root of g in ln w: secant steps from x0 (g is nearly ln w + const: its slope is 1 + (2/3) d ln|F_p|
     / d ln mu), then Brent's method on a bracket when the secant does not settle."""
-    xs, gs = [x0], [g(x0)]
+    x0, g0 = _tried(g, x0, min(x0 + RETRY_STEP, hi) if x0 < hi else x0 - RETRY_STEP)
+    xs, gs = [x0], [g0]
     x1 = min(max(x0 - gs[0], lo), hi)             # a unit slope's step
     if x1 == x0:
         x1 = x0 - math.copysign(1e-3, gs[0])
+    x1, g1 = _tried(g, x1, x0)
     xs.append(x1)
-    gs.append(g(x1))
+    gs.append(g1)
     for _ in range(12):
         if abs(gs[-1]) < rtol or abs(xs[-1] - xs[-2]) < rtol:
             return xs[-1]
@@ -454,8 +487,9 @@ def _solve(g, x0: float, lo: float, hi: float, rtol: float, P: float, mu_of) -> 
                                       f"{'small' if x > hi else 'large'}): outside the model's range of mu "
                                       f"[{MU_RANGE[0]:g}, {MU_RANGE[1]:g}] (-adh_mu)")
             x = edge
+        x, gx = _tried(g, x, xs[-1])
         xs.append(x)
-        gs.append(g(x))
+        gs.append(gx)
     # no settling: a bracket from the points seen, then Brent
     pts = sorted(zip(xs, gs))
     for (a, ga), (b, gb) in zip(pts, pts[1:]):
