@@ -69,6 +69,7 @@ def run(n: int) -> dict:
     return {"n": n, "pixels": n * n, "ranks": r.ranks, "make_s": made, "wall_s": wall, "cpu_s_by_rank": cpus,
             "pixels_per_s": n * n / wall, "cpu_s_per_pixel": None if cpus is None else sum(cpus) / (n * n),
             "ok": r.count("ok"), "flagged": n * n - r.count("ok"), "covered_95": covered,
+            "solver_curves_traced": sum(p.traces for p in r.pixels),
             "load_average": os.getloadavg()[0], "setup_cpu_s": c1 - c0}
 
 
@@ -84,7 +85,8 @@ def main(argv=None) -> int:
         print(f"map {n}x{n} on {out['ranks']} rank(s): {out['wall_s']:.1f} s wall, "
               f"{out['pixels_per_s']:.3g} pixels/s, {out['cpu_s_per_pixel']:.2f} CPU s a pixel; "
               f"{out['ok']} ok, {out['flagged']} flagged; 95% intervals cover w in {out['covered_95']['gamma']}, "
-              f"E* in {out['covered_95']['E_star']} of {n * n}; load average {out['load_average']:.1f}")
+              f"E* in {out['covered_95']['E_star']} of {n * n}; {out['solver_curves_traced']} solver curves traced; "
+              f"load average {out['load_average']:.1f}")
         os.makedirs(paths.DATA, exist_ok=True)
         with open(os.path.join(paths.DATA, f"maps_{n}_np{out['ranks']}.json"), "w") as f:
             json.dump({**out, "source": paths.source()}, f, indent=1)

@@ -19,14 +19,15 @@ parameter by more than STEP_BARS of its statistical bar another curve is traced 
 repeated (SOLVER_CURVES at most): the linearisation is not trusted beyond its bar.
 
 The first curve is not traced at x_t itself but at x_t with its ln mu moved to the nearest point of a lattice
-(:func:`on_lattice`): 8 points a decade, or 2^k times as many, the coarsest whose half-spacing is at most
+(:func:`on_lattice`): 8 points a decade, or 2^k times as many (k from -3 to 12), the coarsest whose half-spacing is at most
 LATTICE_BARS = 0.5 of ln mu's bar at x_t.  The solver's curve is a function of (mu, sigma) alone
 (:mod:`~petsc_adhesion.fitting.branches`: a branch traced once and read behind any spring), so the curve of a
 lattice point is traced once in a process and read by every later fit that lands near it (a map's pixels of
 one material).  The step then also takes the fit from the lattice point to the optimum: at first order it
 moves ln mu back by the offset (at most half a bar) and the others by nothing, and it is said and added to
-the bars as any step is; a step beyond STEP_BARS still traces at the stepped point itself.  The lattice
-point depends on the fit's own data alone, never on the fits before it: a fit gives the same numbers
+the bars as any step is.  A curve after a step beyond STEP_BARS is traced at the lattice point nearest the
+stepped point too, the last of SOLVER_CURVES at the stepped point itself.  A lattice point depends on the
+fit's own data alone, never on the fits before it: a fit gives the same numbers
 whichever curves its process had traced.
 
 The chi^2, the residuals, the events and the fitted curve are the solver's last curve's; the parameters are one
@@ -42,18 +43,21 @@ import numpy as np
 
 from ..family.table import FamilyTable
 
-__all__ = ["TableStep", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS",
+__all__ = ["TableStep", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
            "on_lattice", "table_bounds", "solver_steps"]
 
 #: The solver's curves at most after a search on the table.
 SOLVER_CURVES = 3
 #: A step larger than this many statistical bars in any coordinate is taken and another curve traced there.
 STEP_BARS = 1.0
-#: The lattice of ln mu the solver's first curve is traced on: LATTICE points a decade at its coarsest level,
-#: each finer level twice as many, down to LATTICE_LEVELS levels (8 * 2^12 a decade); the coarsest whose
+#: The lattice of ln mu the solver's first curve is traced on: LATTICE points a decade at level 0, each finer
+#: level twice as many, up to level LATTICE_LEVELS (8 * 2^12 a decade), each coarser half as many down to
+#: level -COARSER (one a decade); the coarsest whose
 #: half-spacing is at most LATTICE_BARS of ln mu's bar at the table's optimum (on_lattice).
 LATTICE = 8
 LATTICE_LEVELS = 12
+#: Coarser levels where ln mu is hardly determined (E* at the DMT end): down to a point a decade.
+COARSER = 3
 LATTICE_BARS = 0.5
 #: The Tabor parameters the search on the table starts from (the best of them; the solver's search tries 0.1 to 3).
 START_MUS = (0.003, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0)
@@ -111,21 +115,22 @@ def table_bounds(table: FamilyTable, names: tuple, lo: np.ndarray, hi: np.ndarra
     return lo, hi
 
 
-def on_lattice(x: np.ndarray, names: tuple, sd: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, int]:
+def on_lattice(x: np.ndarray, names: tuple, sd: np.ndarray, lo: np.ndarray,
+               hi: np.ndarray) -> tuple[np.ndarray, int | None]:
     """``x`` with its ln mu moved to the nearest point of the lattice (module docstring): LATTICE points a decade
-    at level 0, 2^k times as many at level k, the coarsest level whose half-spacing is at most LATTICE_BARS of
-    ln mu's bar ``sd``; (x, the level; -1 where x is left as it is: no ln mu fitted, or a bar finer than the
-    finest level)."""
+    at level 0, 2^k times as many at level k (-COARSER <= k <= LATTICE_LEVELS), the coarsest level whose
+    half-spacing is at most LATTICE_BARS of ln mu's bar ``sd``; (x, the level; None where x is left as it is: no
+    ln mu fitted, or a bar finer than the finest level)."""
     if "ln_mu" not in names:
-        return x, -1
+        return x, None
     j = names.index("ln_mu")
-    for level in range(LATTICE_LEVELS + 1):
+    for level in range(-COARSER, LATTICE_LEVELS + 1):
         h = math.log(10.0) / (LATTICE * 2**level)
         if 0.5 * h <= LATTICE_BARS * sd[j]:
             y = x.copy()
             y[j] = min(max(h * round(x[j] / h), lo[j]), hi[j])
             return y, level
-    return x, -1
+    return x, None
 
 
 def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarray, label: str,
@@ -144,8 +149,9 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
         JtJ_inv = np.linalg.pinv(J.T @ J)
     G = JtJ_inv @ J.T
     dof = max(pb.points - x.size, 1)
-    x, level = on_lattice(x, pb.names, np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r_t @ r_t) / dof), lo, hi)
-    lattice_mu = pb.unpack(x)["mu"] if level >= 0 else math.nan
+    sd_t = np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r_t @ r_t) / dof)
+    x, level = on_lattice(x, pb.names, sd_t, lo, hi)
+    lattice_mu = pb.unpack(x)["mu"] if level is not None else math.nan
     curves, first, traced = 0, math.nan, pb.traces
     while True:
         r = pb._all(pb.unpack(x))[0]         # one solver curve (cached for what the fit reads of it)
@@ -157,7 +163,8 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
         first = moved if curves == 1 else first
         if moved <= STEP_BARS or curves >= SOLVER_CURVES:
             break
-        x = stepped                          # the linearisation not trusted beyond its bar: a curve at the step
+        # the linearisation not trusted beyond its bar: a curve at the step, on the lattice but for the last
+        x = on_lattice(stepped, pb.names, sd_t, lo, hi)[0] if curves < SOLVER_CURVES - 1 else stepped
     d = A @ dx
     sd_out = np.sqrt(np.abs(np.diag(A @ JtJ_inv @ A.T)) * float(r @ r) / dof)
     bars = np.abs(d) / np.where(sd_out > 0, sd_out, np.inf)
