@@ -82,7 +82,7 @@ def test_a_later_fit_reads_the_branch_and_gives_the_same_numbers():
             (first.gamma.value, first.gamma.err, first.E_star.value, first.E_star.err, first.chi2)
     assert abs(first.gamma.value - W) <= 1.96 * first.gamma.err and abs(first.E_star.value - E) <= 1.96 * first.E_star.err
     assert any("the first at the lattice point" in n for n in first.notes) and \
-        any("traced before in this process" in n for n in again.notes)
+        any("read from a branch traced before" in n for n in again.notes)
 
 
 def test_the_lattice_point_is_within_half_a_bar_and_the_levels_nest():

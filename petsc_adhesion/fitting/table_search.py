@@ -92,8 +92,10 @@ class TableStep:
         share = ", ".join(f"{names.get(c, c)} {b:.2g} bars" for c, b in zip(self.coordinates, self.bars))
         return (f"the search ran on the table {self.table} ({self.evaluations} evaluations), then the solver's "
                 f"{self.curves} curve{'s' * (self.curves != 1)} near its optimum"
-                + (f" (the first at the lattice point mu = {self.lattice_mu:.6g})" if math.isfinite(self.lattice_mu) else "")
-                + (f", {self.shared} of them traced before in this process" if self.shared else "")
+                + (f" (the first at the lattice point mu = {self.lattice_mu:.6g})"
+                   if math.isfinite(self.lattice_mu) else "")
+                + (f", {self.shared} of them read from a branch traced before (by this fit or an earlier one)"
+                   if self.shared else "")
                 + ": chi^2, "
                 f"the residuals and the events are the solver's, the parameters one Gauss-Newton step from its "
                 f"last curve, the step added to each bar ({share})")
