@@ -30,8 +30,10 @@ stepped point too, the last of SOLVER_CURVES at the stepped point itself.  A lat
 fit's own data alone, never on the fits before it: a fit gives the same numbers
 whichever curves its process had traced.
 
-The chi^2, the residuals, the events and the fitted curve are the solver's last curve's; the parameters are one
-step from it (:class:`TableStep` says how far).
+The chi^2, the residuals, the events and the fitted curve are the solver's last curve's, read (where mu is
+fitted) with the parameters other than mu and sigma at their best for it, one Gauss-Newton step in them alone
+(a branch is read behind any spring; w moves K); the parameters are one step from it (:class:`TableStep`
+says how far).
 """
 from __future__ import annotations
 
@@ -97,8 +99,8 @@ class TableStep:
                 + (f", {self.shared} of them read from a branch traced before (by this fit or an earlier one)"
                    if self.shared else "")
                 + ": chi^2, "
-                f"the residuals and the events are the solver's, the parameters one Gauss-Newton step from its "
-                f"last curve, the step added to each bar ({share})")
+                f"the residuals and the events are the solver's last curve's, the parameters one Gauss-Newton step "
+                f"from it, the step added to each bar ({share})")
 
 
 def table_bounds(table: FamilyTable, names: tuple, lo: np.ndarray, hi: np.ndarray, modulus: float | None,
@@ -173,6 +175,15 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
     names = tuple("ln_E_star" if n == "ln_mu" else n for n in pb.names)
     step = TableStep(label, evaluations, seconds, curves, names, d, bars, np.abs(d), first, lattice_mu,
                      curves - min(pb.traces - traced, curves))
+    # what is reported of the curve (chi^2, residuals, events) is read on the last curve's branch (its mu and
+    # sigma) with the others at their best for it, one Gauss-Newton step in them alone: at the curve's own
+    # point, half a bar of ln mu from the optimum with w and z0 not moved along with it, chi^2 held 7 noise
+    # variances more (mu = 1, ln mu correlated with w and z0); the others at the full step's values, more still
+    others = np.array([n not in ("ln_mu", "sigma") for n in pb.names])
+    if "ln_mu" in pb.names and others.any():
+        y = x.copy()
+        y[others] = np.clip(x[others] - np.linalg.lstsq(J[:, others], r, rcond=None)[0], lo[others], hi[others])
+        x = y
     return stepped, x, J, d, step
 
 
