@@ -550,8 +550,7 @@ def _align(pb: _Problem, x: np.ndarray) -> float:
         return float(np.sum(pb._all(pb.unpack(y))[0] ** 2))
 
     width = 2.0 + 0.1 * abs(Z_off)
-    # to 0.02 epsilon: a start, which the least squares refine (to 1e-4 it took 20 evaluations a start, 9 here)
-    return brent.minimum(cost, guess - width, guess + width, xatol=2e-2)
+    return brent.minimum(cost, guess - width, guess + width, xatol=1e-4)
 
 
 def _fitted_features(pb: _Problem, p: dict, fc: ForwardCurve) -> FittedFeatures:
