@@ -12,6 +12,7 @@ from conftest import ROOT, run_cli
 from test_hostile import listing, one_line
 
 from petsc_adhesion.family.table import shipped
+from petsc_adhesion.fitting import table_search
 from petsc_adhesion.fitting.curve_fit import CurveFitError, TableStep, fit_curve
 from petsc_adhesion.fitting.forward import table_covers
 from petsc_adhesion.fitting.results import Spring
@@ -44,7 +45,7 @@ def test_a_fit_through_the_table_recovers_w_and_E(mu):
     scale = max(1.0, mu)
     data, E = _curve(mu, R_tip=R * scale, k=scale)
     fit = fit_curve(data, Bodies(radius=R * scale, young1=None, poisson1=None, epsilon=EPS), Spring(scale))
-    assert isinstance(fit.path, TableStep) and 1 <= fit.path.curves == fit.traces <= 3, fit.path
+    assert isinstance(fit.path, TableStep) and fit.traces <= fit.path.curves <= 3, fit.path
     assert abs(fit.gamma.value - W) <= 1.96 * fit.gamma.err
     if mu < 0.01:
         assert not fit.E_star and "interval" in fit.E_star.reason
@@ -56,10 +57,12 @@ def test_a_fit_through_the_table_recovers_w_and_E(mu):
     assert any(n.startswith("the search ran on the table default") for n in fit.notes), fit.notes
 
 
-def test_the_table_and_the_solver_agree_within_their_bars():
+def test_the_table_and_the_solver_agree_within_their_bars(monkeypatch):
     """One curve fitted through the table and by the solver alone (-fit_table none): w and E* within the smaller
     of the two bars of each other; the solver alone traced many curves, the table's path two (its first step,
-    from the table's optimum, was 3 bars: another curve was traced there)."""
+    from the table's optimum, was 3 bars: another curve was traced there).  The first curve at the table's
+    optimum itself (no lattice: the step is the table's error alone)."""
+    monkeypatch.setattr(table_search, "on_lattice", lambda x, names, sd, lo, hi: (x, None))
     data, _ = _curve(0.05, seed=2)
     t = fit_curve(data, TIP, Spring(1.0))
     s = fit_curve(data, TIP, Spring(1.0), table="none")
@@ -71,10 +74,12 @@ def test_the_table_and_the_solver_agree_within_their_bars():
     assert np.all(t.path.bars[:2] < 0.5), t.path.bars
 
 
-def test_the_step_vanishes_at_a_node():
+def test_the_step_vanishes_at_a_node(monkeypatch):
     """At mu = 1, a node of the table (there the table is the solver's curve sampled), the first step from the
     table's optimum is a small share of the bar (0.10 measured, in F0); half a cell away (mu = 10^0.125, a
-    cell's centre) it is more than a bar (1.3: another curve is traced)."""
+    cell's centre) it is more than a bar (1.3: another curve is traced).  The first curve at the table's optimum
+    itself (no lattice: the step is the table's error alone)."""
+    monkeypatch.setattr(table_search, "on_lattice", lambda x, names, sd, lo, hi: (x, None))
     assert np.any(np.isclose(shipped().mu, 1.0, rtol=1e-12))
     at = fit_curve(_curve(1.0, noise_share=0.003)[0], TIP, Spring(1.0)).path
     mid = fit_curve(_curve(10**0.125, noise_share=0.003)[0], TIP, Spring(1.0)).path

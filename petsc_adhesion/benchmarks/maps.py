@@ -50,7 +50,12 @@ def run(n: int) -> dict:
     m = synthetic_map((n, n), truth, spring, Sampling(noise=0.01 * 2 * math.pi * R * 0.05, points=100, z0=5e-9))
     made = time.perf_counter() - t0
     t1, c1 = time.perf_counter(), time.process_time()
-    r = fit_map(m, Bodies(radius=R, young1=30e9, poisson1=0.0, epsilon=EPS), spring)
+    def say(pr) -> None:            # rank 0's line every 256 pixels: a map stopped part way still measured
+        if pr.done % 256 == 0 or pr.done == pr.total:
+            print(f"{pr.done} of {pr.total} pixels, {pr.elapsed:.0f} s wall, rank 0 CPU "
+                  f"{time.process_time() - c1:.1f} s, load {os.getloadavg()[0]:.1f}", flush=True)
+
+    r = fit_map(m, Bodies(radius=R, young1=30e9, poisson1=0.0, epsilon=EPS), spring, progress=say)
     wall, cpu = time.perf_counter() - t1, time.process_time() - c1
     cpus = PETSc.COMM_WORLD.tompi4py().gather(cpu, root=0)
     covered = {"gamma": 0, "E_star": 0}
@@ -69,6 +74,7 @@ def run(n: int) -> dict:
     return {"n": n, "pixels": n * n, "ranks": r.ranks, "make_s": made, "wall_s": wall, "cpu_s_by_rank": cpus,
             "pixels_per_s": n * n / wall, "cpu_s_per_pixel": None if cpus is None else sum(cpus) / (n * n),
             "ok": r.count("ok"), "flagged": n * n - r.count("ok"), "covered_95": covered,
+            "solver_curves_traced": sum(p.traces for p in r.pixels),
             "load_average": os.getloadavg()[0], "setup_cpu_s": c1 - c0}
 
 
@@ -84,7 +90,8 @@ def main(argv=None) -> int:
         print(f"map {n}x{n} on {out['ranks']} rank(s): {out['wall_s']:.1f} s wall, "
               f"{out['pixels_per_s']:.3g} pixels/s, {out['cpu_s_per_pixel']:.2f} CPU s a pixel; "
               f"{out['ok']} ok, {out['flagged']} flagged; 95% intervals cover w in {out['covered_95']['gamma']}, "
-              f"E* in {out['covered_95']['E_star']} of {n * n}; load average {out['load_average']:.1f}")
+              f"E* in {out['covered_95']['E_star']} of {n * n}; {out['solver_curves_traced']} solver curves traced; "
+              f"load average {out['load_average']:.1f}")
         os.makedirs(paths.DATA, exist_ok=True)
         with open(os.path.join(paths.DATA, f"maps_{n}_np{out['ranks']}.json"), "w") as f:
             json.dump({**out, "source": paths.source()}, f, indent=1)

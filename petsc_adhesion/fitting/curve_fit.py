@@ -25,8 +25,9 @@ the samples taken during a jump (the detector spreads it over a few) are on neit
 branch and left out.  Before the fit the curve is checked against the model's domain
 (:func:`domain_reasons`).
 
-Each evaluation at new (mu, K, sigma) traces one curve behind the spring (no error bars; cached), or, where the
-curve family table holds the model, interpolates it in milliseconds: then the solver traces one curve at the
+Each evaluation at new (mu, sigma) reads the solver's branch, traced once without a spring and kept by the
+process (:mod:`~petsc_adhesion.fitting.branches`), behind the spring K, or, where the
+curve family table holds the model, interpolates it in milliseconds: then the solver traces one curve near the
 table's optimum and a Gauss-Newton step makes the result the solver's, the step added to the bars
 (:mod:`~petsc_adhesion.fitting.table_search`; ``CurveFit.path`` says which path).  The Jacobian's columns in
 ln mu, ln w and sigma are forward differences (relative step 2e-3) of the prediction *with each point kept on
@@ -50,7 +51,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
@@ -60,7 +60,8 @@ import numpy as np
 from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
 from .data import MeasuredCurve
-from .forward import APPROACH, RETRACT, ForwardCurve, curve_stop_reason, open_table, table_covers, table_legs
+from .branches import BRANCHES
+from .forward import APPROACH, RETRACT, ForwardCurve, open_table, table_covers, table_legs
 from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
                      domain_reasons, features, refuse_a_line, refuse_empty)
 from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, verdicts
@@ -217,22 +218,16 @@ class _Problem:
             reach = float(Z.min()) - 10.0 - 0.1 * float(np.ptp(Z))
             self.cache[key] = table_legs(self.table, p["mu"], p["sigma"], p["K"], reach)
         if key not in self.cache:
-            from ..tracing.trace import CurveRequest, curve_settings, trace_curve
-
+            # the solver's branch of (mu, sigma), traced once in the process and read behind this K (branches.py)
             f_max = max(1.3 * (self.Fmax_data - p["F0"]) / (p["gain"] * 2 * math.pi * self.R * p["w"]) + 0.3, 0.5)
+            Z = self.Z(p)
             model = replace(self.template, mu=p["mu"], sigma=p["sigma"], bodies=None)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)
-                c = trace_curve(model, self.grid, self.solver, curve_settings(observable_max=f_max),
-                                CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=p["K"]),
-                                comm=self.comm)
-            self.traces += 1
-            if not c.complete:
-                self.notes.append(f"the curve at mu = {p['mu']:.4g}, K = {p['K']:.4g} ended early "
-                                  f"({curve_stop_reason(c)}); continued linearly")
+            legs, traced = BRANCHES.legs(model, f_max, p["K"], float(Z.min()) - 10.0 - 0.1 * float(np.ptp(Z)),
+                                         self.grid, self.solver, self.comm)
+            self.traces += traced
             if len(self.cache) > 64:
                 self.cache.pop(next(iter(self.cache)))
-            self.cache[key] = ForwardCurve(c, p["K"])
+            self.cache[key] = legs
         return self.cache[key]
 
     def Z(self, p: dict) -> np.ndarray:

@@ -18,8 +18,22 @@ coordinates): the table's contribution to each bar, reported beside it.  Where t
 parameter by more than STEP_BARS of its statistical bar another curve is traced at the stepped point and the step
 repeated (SOLVER_CURVES at most): the linearisation is not trusted beyond its bar.
 
-The chi^2, the residuals, the events and the fitted curve are the solver's last curve's; the parameters are one
-step from it (:class:`TableStep` says how far).
+The first curve is not traced at x_t itself but at x_t with its ln mu moved to the nearest point of a lattice
+(:func:`on_lattice`): 8 points a decade, or 2^k times as many (k from -3 to 12), the coarsest whose half-spacing is at most
+LATTICE_BARS = 0.5 of ln mu's bar at x_t.  The solver's curve is a function of (mu, sigma) alone
+(:mod:`~petsc_adhesion.fitting.branches`: a branch traced once and read behind any spring), so the curve of a
+lattice point is traced once in a process and read by every later fit that lands near it (a map's pixels of
+one material).  The step then also takes the fit from the lattice point to the optimum: at first order it
+moves ln mu back by the offset (at most half a bar) and the others by nothing, and it is said and added to
+the bars as any step is.  A curve after a step beyond STEP_BARS is traced at the lattice point nearest the
+stepped point too, the last of SOLVER_CURVES at the stepped point itself.  A lattice point depends on the
+fit's own data alone, never on the fits before it: a fit gives the same numbers
+whichever curves its process had traced.
+
+The chi^2, the residuals, the events and the fitted curve are the solver's last curve's, read (where mu is
+fitted) with the parameters other than mu and sigma at their best for it, one Gauss-Newton step in them alone
+(a branch is read behind any spring; w moves K); the parameters are one step from it (:class:`TableStep`
+says how far).
 """
 from __future__ import annotations
 
@@ -31,12 +45,22 @@ import numpy as np
 
 from ..family.table import FamilyTable
 
-__all__ = ["TableStep", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "table_bounds", "solver_steps"]
+__all__ = ["TableStep", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
+           "on_lattice", "table_bounds", "solver_steps"]
 
 #: The solver's curves at most after a search on the table.
 SOLVER_CURVES = 3
 #: A step larger than this many statistical bars in any coordinate is taken and another curve traced there.
 STEP_BARS = 1.0
+#: The lattice of ln mu the solver's first curve is traced on: LATTICE points a decade at level 0, each finer
+#: level twice as many, up to level LATTICE_LEVELS (8 * 2^12 a decade), each coarser half as many down to
+#: level -COARSER (one a decade); the coarsest whose
+#: half-spacing is at most LATTICE_BARS of ln mu's bar at the table's optimum (on_lattice).
+LATTICE = 8
+LATTICE_LEVELS = 12
+#: Coarser levels where ln mu is hardly determined (E* at the DMT end): down to a point a decade.
+COARSER = 3
+LATTICE_BARS = 0.5
 #: The Tabor parameters the search on the table starts from (the best of them; the solver's search tries 0.1 to 3).
 START_MUS = (0.003, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0)
 
@@ -48,7 +72,9 @@ class TableStep:
     reported coordinate (``coordinates``: ln_E_star, ln_gamma, z0, ...; the fit's units), ``bars``, the step in
     units of each coordinate's statistical bar (its largest is what decided another curve), and
     ``contribution``, the table's share of each bar: the systematic term |step| beside the statistical bar;
-    ``first``, the largest first step in bars (from the table's optimum itself)."""
+    ``first``, the largest first step in bars (from the lattice point near the table's optimum); ``lattice_mu``,
+    the mu of that lattice point (NaN: the first curve at the table's optimum itself); ``shared``, the solver's
+    curves the process had traced before this fit (found, not traced again)."""
 
     table: str
     evaluations: int
@@ -59,15 +85,22 @@ class TableStep:
     bars: np.ndarray
     contribution: np.ndarray
     first: float = math.nan
+    lattice_mu: float = math.nan
+    shared: int = 0
 
     def describe(self, names: dict) -> str:
         """One line for the fit's notes: the path, the step, the table's share of each bar (``names``: the
         reported coordinate's label for each of ``coordinates``)."""
         share = ", ".join(f"{names.get(c, c)} {b:.2g} bars" for c, b in zip(self.coordinates, self.bars))
-        return (f"the search ran on the table {self.table} ({self.evaluations} evaluations), then the solver traced "
-                f"{self.curves} curve{'s' * (self.curves != 1)} at its optimum: chi^2, "
-                f"the residuals and the events are the solver's, the parameters one Gauss-Newton step from its "
-                f"last curve, the step added to each bar ({share})")
+        return (f"the search ran on the table {self.table} ({self.evaluations} evaluations), then the solver's "
+                f"{self.curves} curve{'s' * (self.curves != 1)} near its optimum"
+                + (f" (the first at the lattice point mu = {self.lattice_mu:.6g})"
+                   if math.isfinite(self.lattice_mu) else "")
+                + (f", {self.shared} of them read from a branch traced before (by this fit or an earlier one)"
+                   if self.shared else "")
+                + ": chi^2, "
+                f"the residuals and the events are the solver's last curve's, the parameters one Gauss-Newton step "
+                f"from it, the step added to each bar ({share})")
 
 
 def table_bounds(table: FamilyTable, names: tuple, lo: np.ndarray, hi: np.ndarray, modulus: float | None,
@@ -86,6 +119,24 @@ def table_bounds(table: FamilyTable, names: tuple, lo: np.ndarray, hi: np.ndarra
     return lo, hi
 
 
+def on_lattice(x: np.ndarray, names: tuple, sd: np.ndarray, lo: np.ndarray,
+               hi: np.ndarray) -> tuple[np.ndarray, int | None]:
+    """``x`` with its ln mu moved to the nearest point of the lattice (module docstring): LATTICE points a decade
+    at level 0, 2^k times as many at level k (-COARSER <= k <= LATTICE_LEVELS), the coarsest level whose
+    half-spacing is at most LATTICE_BARS of ln mu's bar ``sd``; (x, the level; None where x is left as it is: no
+    ln mu fitted, or a bar finer than the finest level)."""
+    if "ln_mu" not in names:
+        return x, None
+    j = names.index("ln_mu")
+    for level in range(-COARSER, LATTICE_LEVELS + 1):
+        h = math.log(10.0) / (LATTICE * 2**level)
+        if 0.5 * h <= LATTICE_BARS * sd[j]:
+            y = x.copy()
+            y[j] = min(max(h * round(x[j] / h), lo[j]), hi[j])
+            return y, level
+    return x, None
+
+
 def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarray, label: str,
                  evaluations: int, seconds: float):
     """From the table's optimum ``x`` to the solver's (module docstring): (the stepped parameters, the point of
@@ -93,6 +144,7 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
     fitted coordinates to them), the :class:`TableStep`).  ``pb`` (the fit's problem) leaves the table and
     keeps the solver's last curve in its cache."""
     J = pb.jacobian(x)
+    r_t = pb._all(pb.unpack(x))[0]          # the table's residuals at its optimum: ln mu's bar there
     pb.table = None
     pb.cache.clear()
     try:
@@ -101,7 +153,10 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
         JtJ_inv = np.linalg.pinv(J.T @ J)
     G = JtJ_inv @ J.T
     dof = max(pb.points - x.size, 1)
-    curves, first = 0, math.nan
+    sd_t = np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r_t @ r_t) / dof)
+    x, level = on_lattice(x, pb.names, sd_t, lo, hi)
+    lattice_mu = pb.unpack(x)["mu"] if level is not None else math.nan
+    curves, first, traced = 0, math.nan, pb.traces
     while True:
         r = pb._all(pb.unpack(x))[0]         # one solver curve (cached for what the fit reads of it)
         curves += 1
@@ -112,12 +167,23 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
         first = moved if curves == 1 else first
         if moved <= STEP_BARS or curves >= SOLVER_CURVES:
             break
-        x = stepped
+        # the linearisation not trusted beyond its bar: a curve at the step, on the lattice but for the last
+        x = on_lattice(stepped, pb.names, sd_t, lo, hi)[0] if curves < SOLVER_CURVES - 1 else stepped
     d = A @ dx
     sd_out = np.sqrt(np.abs(np.diag(A @ JtJ_inv @ A.T)) * float(r @ r) / dof)
     bars = np.abs(d) / np.where(sd_out > 0, sd_out, np.inf)
     names = tuple("ln_E_star" if n == "ln_mu" else n for n in pb.names)
-    step = TableStep(label, evaluations, seconds, curves, names, d, bars, np.abs(d), first)
+    step = TableStep(label, evaluations, seconds, curves, names, d, bars, np.abs(d), first, lattice_mu,
+                     curves - min(pb.traces - traced, curves))
+    # what is reported of the curve (chi^2, residuals, events) is read on the last curve's branch (its mu and
+    # sigma) with the others at their best for it, one Gauss-Newton step in them alone: at the curve's own
+    # point, half a bar of ln mu from the optimum with w and z0 not moved along with it, chi^2 held 7 noise
+    # variances more (mu = 1, ln mu correlated with w and z0); the others at the full step's values, more still
+    others = np.array([n not in ("ln_mu", "sigma") for n in pb.names])
+    if "ln_mu" in pb.names and others.any():
+        y = x.copy()
+        y[others] = np.clip(x[others] - np.linalg.lstsq(J[:, others], r, rcond=None)[0], lo[others], hi[others])
+        x = y
     return stepped, x, J, d, step
 
 
