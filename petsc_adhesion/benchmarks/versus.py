@@ -36,7 +36,8 @@ import tempfile
 
 from .paths import DOCS, ROOT, write_section
 
-__all__ = ["RUNS", "EVENTS", "cpu_of", "compare", "table", "counts_of", "count", "count_table", "main"]
+__all__ = ["RUNS", "EVENTS", "cpu_of", "compare", "table", "counts_of", "count", "count_table", "count_summary",
+           "main"]
 
 #: name -> the options of one run (files written into the run's own folder).
 RUNS = {
@@ -129,6 +130,26 @@ def count_table(results: dict, against: str) -> str:
     return "\n".join(lines)
 
 
+def count_summary(results: dict, against: str) -> str:
+    """The paragraph under :func:`count_table`: the ranges of the ratios, and what they say."""
+    def span(f):
+        v = [f(o, n) for o, n in results.values()]
+        return f"{100 * (min(v) - 1):.1f} to {100 * (max(v) - 1):.1f}%"
+    per = [(n["instructions"] / max(n["SNESFunctionEval"], 1)) / (o["instructions"] / max(o["SNESFunctionEval"], 1))
+           for o, n in results.values()]
+    verdict = ("so the typed results have not made the program slower; what it costs more is what it computes more"
+               if max(per) <= 1.0 else
+               f"up to {100 * (max(per) - 1):.1f}% more: this checkout is slower for the same work")
+    return (f"Here a run executes {span(lambda o, n: n['instructions'] / o['instructions'])} more instructions than at "
+            f"{against}, and {span(lambda o, n: n['SNESSolve'] / o['SNESSolve'])} more SNES solves "
+            f"({span(lambda o, n: n['SNESFunctionEval'] / o['SNESFunctionEval'])} more residual evaluations): the "
+            "runs compute more here (the energy's bar from a second refinement level, the contact radius along the "
+            "curve with its bar, behind a spring the instrument's legs).  The same unit of the solver's work costs "
+            f"{min(per):.3f} to {max(per):.3f} times the instructions it cost there (the last column), {verdict}.  "
+            "Counted by valgrind (cachegrind, no cache simulation) on one run each; two counts of the same run "
+            "differ by about 1%.")
+
+
 def _accepts(tree: str, option: str) -> bool:
     """Whether ``tree``'s option table knows ``option`` (an older commit's does not know the newer ones)."""
     for root, _, files in os.walk(os.path.join(tree, "petsc_adhesion", "app")):
@@ -203,7 +224,8 @@ def main(argv: list[str] | None = None) -> int:
                           f"petsc_adhesion.benchmarks.versus --count --against {a.against} --runs {a.runs} --write -->\n"
                           "What each whole process executes, independent of the load (one run each): instructions "
                           "counted by valgrind, the solver's work by PETSc's -log_view.  The last column is the cost "
-                          "of one residual evaluation's worth of work here against there.\n\n" + text + "\n")
+                          "of one residual evaluation's worth of work here against there.\n\n" + text + "\n\n"
+                          + count_summary(results, a.against) + "\n")
         return 0
     text = table(results, a.against)
     print(text)
