@@ -163,10 +163,11 @@ def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[floa
 
 
 def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: float = math.inf,
-            mu_min: float = 0.0) -> FamilyTable:
-    """The table with its interpolation error measured at its midpoints from ``mu_min`` up to ``mu_max`` (module
-    docstring), kept with the midpoints the table had measured outside that range (so that a table can be
-    measured in parts); about the others the table's error is Missing, not measured; collective."""
+            mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> FamilyTable:
+    """The table with its interpolation error measured at its midpoints from ``mu_min`` up to ``mu_max`` and
+    with sigma in ``sigma_range`` (module docstring), kept with the midpoints the table had measured outside
+    that range (so that a table can be measured in parts); about the others the table's error is Missing, not
+    measured; collective."""
     from petsc4py import PETSc
 
     if table.measured and not np.allclose(table.springs, springs):
@@ -188,7 +189,7 @@ def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: fl
         row["seconds"] = time.perf_counter() - t0
         return row
 
-    cases = [c for c in midpoints(table) if mu_min <= c[0] <= mu_max]
+    cases = [c for c in midpoints(table) if mu_min <= c[0] <= mu_max and sigma_range[0] <= c[1] <= sigma_range[1]]
     rows = spread(cases, work, lambda c: node_cost(c) * (1 + len(springs)), comm)
     if out is not None:
         out("| mu | sigma | F at Z | jump Z | jump F | event lambda | event F | solver (s) |")
@@ -310,6 +311,8 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--mu-max", type=float, default=math.inf, help="measure the midpoints up to this mu alone")
     m.add_argument("--mu-min", type=float, default=0.0,
                    help="measure the midpoints from this mu alone (those measured before kept)")
+    m.add_argument("--sigma-range", nargs=2, type=float, default=(0.0, math.inf),
+                   help="measure the midpoints with sigma in this range alone")
     sp = sub.add_parser("spacing")
     sp.add_argument("table")
     sp.add_argument("--keep", nargs="+", type=float, required=True, help="the sigma nodes the coarser table keeps")
@@ -368,7 +371,8 @@ def main(argv=None) -> int:
         except ValueError as e:
             say(f"benchmarks.family: {e}")
             return 2
-        return _measured(table, args.springs, args.table, tell, rank, time.perf_counter(), args.mu_max, args.mu_min)
+        return _measured(table, args.springs, args.table, tell, rank, time.perf_counter(), args.mu_max, args.mu_min,
+                         tuple(args.sigma_range))
     try:
         lo, hi = args.mu
         grid = TableGrid(mu=log_nodes(lo, hi, args.per_decade) if hi > lo else (lo,), sigma=tuple(args.sigma),
@@ -402,13 +406,13 @@ def main(argv=None) -> int:
 
 
 def _measured(table: FamilyTable, springs, out: str, tell, rank: int, t1: float, mu_max: float = math.inf,
-              mu_min: float = 0.0) -> int:
+              mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> int:
     """The table's error measured (at the midpoints from ``mu_min`` up to ``mu_max``) and the table written with it
     to ``out``; 3 where a midpoint's is infinite."""
     from petsc4py import PETSc
 
     try:
-        table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max, mu_min)
+        table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max, mu_min, sigma_range)
     except ValueError as e:
         say(f"benchmarks.family: {e}")
         return 2
