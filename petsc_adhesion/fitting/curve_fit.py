@@ -57,6 +57,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..family.table import SHIPPED, default_table
 from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
 from .data import MeasuredCurve
@@ -408,6 +409,10 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     sigma0 = 0.0 if bodies.rms is None else bodies.rms / eps
     if choice.roughness and bodies.rms is None:
         sigma0 = 0.3
+    if table == "default":     # the rough table where the fit has a roughness its range holds (family/table.py)
+        label = default_table(sigma0, choice.roughness, MU_BOUNDS)
+        family = open_table(label)
+        label = "default" if label == SHIPPED[0] else f"default {label}"
     pb = _Problem(data, bodies, spring, template, grid, solver, comm,
                   None if choice.modulus or modulus is None else float(modulus),
                   choice.roughness, sigma0, noise, feat, float(data.F.max()), choice=choice, progress=progress)
