@@ -170,7 +170,7 @@ class FamilyTable:
     def error(self, mu: float, sigma: float) -> TableError | Missing:
         """The interpolation error stated about (mu, sigma): SAFETY times the largest measured at the midpoints of
         the cells about it (its cell and their neighbours, in ln mu and sigma); Missing where the table was not
-        measured."""
+        measured, or not at its own cell's centre."""
         self.check(mu, sigma)
         if not self.measured:
             return Missing("the table's interpolation error was not measured (built without its midpoints)")
@@ -182,7 +182,11 @@ class FamilyTable:
         em = np.log(self.err_mu)
         near = (em >= lo_m - 1e-12) & (em <= hi_m + 1e-12) & (self.err_sigma >= lo_s - 1e-12) & \
             (self.err_sigma <= hi_s + 1e-12)
-        if not near.any():
+        # its own cell's centre measured, too: a table measured in parts may hold its neighbours' alone
+        s0, s1 = self.sigma[j - 1], self.sigma[min(j, self.sigma.size - 1)]
+        own = near & (em >= nodes[i - 1] - 1e-12) & (em <= nodes[min(i, nodes.size - 1)] + 1e-12) & \
+            (self.err_sigma >= s0 - 1e-12) & (self.err_sigma <= s1 + 1e-12)
+        if not own.any():
             return Missing(f"the table's interpolation error was not measured about mu = {mu:.4g}, sigma = "
                            f"{sigma:.4g} (its build measured the midpoints up to mu = {self.err_mu.max():.4g})")
         return TableError(**{f: SAFETY * float(np.max(self.errors[f][near])) for f in ERROR_FIELDS},
