@@ -188,8 +188,8 @@ class FamilyTable:
             (self.err_sigma >= s0 - 1e-12) & (self.err_sigma <= s1 + 1e-12)
         if not own.any():
             return Missing(f"the table's interpolation error was not measured about mu = {mu:.4g}, sigma = "
-                           f"{sigma:.4g} (its cell's centre was not; it was measured at {self.err_mu.size} cell centres, mu "
-                           f"{self.err_mu.min():.4g} to {self.err_mu.max():.4g})")
+                           f"{sigma:.4g} (its cell's centre was not; it was measured at {self.err_mu.size} cell "
+                           f"centres, mu {self.err_mu.min():.4g} to {self.err_mu.max():.4g})")
         return TableError(**{f: SAFETY * float(np.max(self.errors[f][near])) for f in ERROR_FIELDS},
                           points=int(near.sum()))
 
