@@ -23,7 +23,8 @@ from ..model.pressure import pressure_law
 from .coordinate import NotMonotone, Sampled, sample, width
 from .table import FamilyTable
 
-__all__ = ["select", "join", "TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points", "F_MAX", "ROUGHNESS"]
+__all__ = ["select", "join", "TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points",
+           "F_MAX", "ROUGHNESS"]
 
 #: The load the table's curves end at: the library's default stop (-cont_F_max 2).
 F_MAX = 2.0

@@ -78,8 +78,8 @@ def table_choice(spec, sigma: float, fitted: bool, mu_range: tuple) -> tuple[Fam
     """(the table a fit searches on, its label in the fit's notes): ``spec`` as :func:`open_table` takes it, but
     "default" is the rough table where the fit has a roughness (``fitted``, or held at ``sigma`` > 0) and the
     rough table's range holds the fit's (:func:`~petsc_adhesion.family.table.default_table`: its sigma and all of
-    ``mu_range``, the mu the search may reach), labelled "default rough"; the smooth one otherwise, "default".  ValueError, one line, for
-    a file that is no table."""
+    ``mu_range``, the mu the search may reach), labelled "default rough"; the smooth one otherwise, "default".
+    ValueError, one line, for a file that is no table."""
     if spec == "default":
         name = default_table(sigma, fitted, mu_range)
         return open_table(name), "default" if name == SHIPPED[0] else f"default {name}"
