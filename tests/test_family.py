@@ -244,3 +244,81 @@ def test_the_builder_s_bad_input_is_one_line_and_writes_nothing(tmp_path, args, 
     assert p.returncode == 2, p.stderr
     assert p.stderr.count("\n") == 1 and says in p.stderr, p.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def _rough():
+    from petsc_adhesion.family.table import shipped
+
+    return shipped("rough")
+
+
+def test_parts_join_into_one_table_and_a_coarser_one_is_selected():
+    """A table built in parts (along sigma or mu) is joined into the table of all their nodes, the first part's
+    node where two hold it, its error not measured (its cells are new); parts on other tau nodes are refused in
+    one line; a selection of nodes is the coarser table the sigma pilot compares with the left-out nodes
+    (docs/family.md).  On the shipped tables: no trace."""
+    from petsc_adhesion.family.build import join, select
+
+    rough = _rough()
+    whole = join([select(rough, sigma=[0, 1, 2]), select(rough, sigma=[2, 3, 4])])
+    assert np.array_equal(whole.sigma, rough.sigma) and np.array_equal(whole.F, rough.F) and not whole.measured
+    whole = join([select(rough, mu=[5, 6, 7]), select(rough, mu=[0, 1, 2, 3, 4, 5])])
+    assert np.array_equal(whole.mu, rough.mu[:8]) and np.array_equal(whole.lam, rough.lam[:8])
+    other = FamilyTable(mu=rough.mu[:1], sigma=np.array([0.3]), tau=np.linspace(-1, 1, 5), lam=np.zeros((1, 1, 5)),
+                        F=np.zeros((1, 1, 5)), s_lo=np.zeros((1, 1)), s_hi=np.ones((1, 1)), s0=np.zeros((1, 1)),
+                        delta=np.ones((1, 1)), F_max=2.0, roughness=rough.roughness)
+    with pytest.raises(ValueError, match="^the parts differ in their tau nodes"):
+        join([select(rough, mu=[0]), other])
+
+
+def test_the_rough_table_at_its_nodes_is_the_solver_s():
+    """The shipped rough table at two of its nodes: behind K = 0.5 the force at the solver's own points is the
+    solver's (the sampling's splines pass through them).  Where the traced points are dense (mu = 1, sigma = 0.15)
+    the pull-off is the solver's to 1e-4; where they are sparse (mu = 0.1, sigma = 0.05) the splines overshoot
+    between them (0.009 in the pull-off, docs/family.md) and the table's stated error there holds that."""
+    from petsc_adhesion.benchmarks.family import _spring
+
+    rough = _rough()
+    assert rough.mu[8] == pytest.approx(0.1) and rough.mu[12] == pytest.approx(1.0)
+    for mu, sigma, dense in ((float(rough.mu[8]), 0.05, False), (float(rough.mu[12]), 0.15, True)):
+        assert np.any(np.isclose(rough.sigma, sigma))
+        err = rough.error(mu, sigma)
+        eF, eZ, eJ = _spring(rough, mu, sigma, 0.5)
+        assert eF < 1e-4, (mu, sigma, eF)
+        (pl, pF), = [(e.lam.value, e.F.value) for e in rough.curve(mu, sigma).events() if e.kind == "pull_off"]
+        off = abs(pF - _solver_events(trace_node(mu, sigma))["pull_off"][0][1])
+        if dense:
+            assert off < 1e-4 and eZ < 1e-3 and eJ < 1e-4, (mu, sigma, off, eZ, eJ)
+        else:
+            assert 1e-3 < off <= err.event_F and eZ <= err.jump_Z and eJ <= err.jump_F, (mu, sigma, off, err)
+
+
+def test_the_rough_table_between_nodes_is_within_its_stated_error():
+    """At a cell centre of the rough table and a third of the way across another cell (mu and sigma both
+    between nodes), its pull-off and its force behind K = 0.5 are the solver's to within the error it states
+    there; and that error was measured at every cell centre of its range."""
+    from petsc_adhesion.benchmarks.family import _spring, midpoints
+
+    rough = _rough()
+    assert rough.err_mu.size == (rough.mu.size - 1) * (rough.sigma.size - 1) == len(midpoints(rough))
+    i, j = 6, 3                                   # mu between 0.0316 and 0.0562; sigma between two nodes
+    centre = (math.sqrt(rough.mu[i] * rough.mu[i + 1]), 0.5 * (rough.sigma[j] + rough.sigma[j + 1]))
+    third = (float(rough.mu[10] * (rough.mu[11] / rough.mu[10]) ** (1 / 3)),
+             float(rough.sigma[-3] + (rough.sigma[-2] - rough.sigma[-3]) / 3))
+    for mu, sigma in (centre, third):
+        err = rough.error(mu, sigma)
+        assert isinstance(err, TableError), err
+        (pl, pF), = [(e.lam.value, e.F.value) for e in rough.curve(mu, sigma).events() if e.kind == "pull_off"]
+        assert abs(pF - _solver_events(trace_node(mu, sigma))["pull_off"][0][1]) <= err.event_F, (mu, sigma, err)
+        eF, eZ, eJ = _spring(rough, mu, sigma, 0.5)
+        assert eF <= err.F_at_Z and eZ <= err.jump_Z and eJ <= err.jump_F, (mu, sigma, eF, eZ, eJ, err)
+
+
+def test_the_rough_table_refuses_what_it_was_not_built_for():
+    """Beyond the mu the rough table was built to, a curve is refused in one line (never extrapolated)."""
+    rough = _rough()
+    top = float(rough.mu[-1])
+    with pytest.raises(OutOfRange, match=rf"^mu {2 * top!r}: the table holds mu in \[0\.001, {top:g}\]$"):
+        rough.curve(2 * top, 1.0)
+    with pytest.raises(OutOfRange, match=r"^sigma 0\.5: the table holds sigma in \[0, 0\.2\]$"):
+        rough.curve(0.1, 0.5)

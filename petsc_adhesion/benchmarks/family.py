@@ -79,17 +79,26 @@ def _events(table: FamilyTable, mu: float, sigma: float, solver) -> tuple[float,
     def grid(m):
         return float(m.grid if m.grid is not None else m.value)
 
-    mine = table.curve(mu, sigma).events()
+    theirs = {k: [(grid(e.lam), grid(e.F)) for e in solver.events if e.kind == k] for k in ("snap_on", "snap_off")}
+    F_min = [(grid(e.lam), grid(e.F)) for e in solver.events if e.kind == "F_min"]
+    theirs["pull_off"] = [min(F_min, key=lambda x: x[1])] if F_min else []
+    return _event_error(_table_events(table.curve(mu, sigma)), theirs)
+
+
+def _table_events(curve) -> dict:
+    """A table curve's snap-on, snap-off and pull-off: (lambda, F) lists by kind."""
+    mine = curve.events()
+    return {k: [(e.lam.value, e.F.value) for e in mine if e.kind == k] for k in ("snap_on", "snap_off", "pull_off")}
+
+
+def _event_error(mine: dict, theirs: dict) -> tuple[float, float]:
+    """(largest error in lambda, in F) between two curves' events (lists of (lambda, F) by kind)."""
     el = ef = 0.0
-    for kind, theirs in (("snap_on", "snap_on"), ("snap_off", "snap_off"), ("pull_off", "F_min")):
-        t = [(e.lam.value, e.F.value) for e in mine if e.kind == kind]
-        s = [(grid(e.lam), grid(e.F)) for e in solver.events if e.kind == theirs]
-        if kind == "pull_off":
-            s = [min(s, key=lambda x: x[1])] if s else []
+    for kind in ("snap_on", "snap_off", "pull_off"):
+        t, s = mine[kind], theirs[kind]
         if bool(t) != bool(s):
             # a fold pair one side lacks (about the cusp where it is born): its width is the error
-            both = [(e.lam.value, e.F.value) for e in mine if e.kind in ("snap_on", "snap_off")] or \
-                [(grid(e.lam), grid(e.F)) for e in solver.events if e.kind in ("snap_on", "snap_off")]
+            both = (mine["snap_on"] + mine["snap_off"]) or (theirs["snap_on"] + theirs["snap_off"])
             lams, Fs = [x for x, _ in both], [y for _, y in both]
             el, ef = max(el, max(lams) - min(lams)), max(ef, max(Fs) - min(Fs))
             continue
@@ -153,10 +162,17 @@ def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[floa
     return eF, eZ, eJ
 
 
-def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: float = math.inf) -> FamilyTable:
-    """The table with its interpolation error measured at its midpoints up to ``mu_max`` (module docstring;
-    about the others the table's error is Missing, not measured); collective."""
+def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: float = math.inf,
+            mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> FamilyTable:
+    """The table with its interpolation error measured at its midpoints from ``mu_min`` up to ``mu_max`` and
+    with sigma in ``sigma_range`` (module docstring), kept with the midpoints the table had measured outside
+    that range (so that a table can be measured in parts); about the others the table's error is Missing, not
+    measured; collective."""
     from petsc4py import PETSc
+
+    if table.measured and not np.allclose(table.springs, springs):
+        raise ValueError(f"--springs {list(springs)}: the table's error was measured behind {list(table.springs)}; "
+                         "a part is measured behind the same springs")
 
     def work(case):
         mu, sigma = case
@@ -173,7 +189,7 @@ def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: fl
         row["seconds"] = time.perf_counter() - t0
         return row
 
-    cases = [c for c in midpoints(table) if c[0] <= mu_max]
+    cases = [c for c in midpoints(table) if mu_min <= c[0] <= mu_max and sigma_range[0] <= c[1] <= sigma_range[1]]
     rows = spread(cases, work, lambda c: node_cost(c) * (1 + len(springs)), comm)
     if out is not None:
         out("| mu | sigma | F at Z | jump Z | jump F | event lambda | event F | solver (s) |")
@@ -181,8 +197,71 @@ def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: fl
         for (m, s), r in zip(cases, rows):
             out(f"| {m:.4g} | {s:.3g} | " + " | ".join(f"{r[f]:.2g}" for f in ERROR_FIELDS) +
                 f" | {r['seconds']:.1f} |" + (f" {r['why']}" if "why" in r else ""))
-    return table.with_error([c[0] for c in cases], [c[1] for c in cases], springs,
-                            {f: [r[f] for r in rows] for f in ERROR_FIELDS})
+    # the midpoints measured before and not now: kept, so that the parts of a table's error add up
+    kept = [k for k in range(table.err_mu.size) if not any(
+        math.isclose(table.err_mu[k], m, rel_tol=1e-9) and math.isclose(table.err_sigma[k], s, abs_tol=1e-12)
+        for m, s in cases)]
+    return table.with_error([table.err_mu[k] for k in kept] + [c[0] for c in cases],
+                            [table.err_sigma[k] for k in kept] + [c[1] for c in cases], springs,
+                            {f: [table.errors[f][k] for k in kept] + [r[f] for r in rows] for f in ERROR_FIELDS})
+
+
+def _legs_error(mine, truth, K: float) -> tuple[float, float, float]:
+    """(F at fixed Z, jump Z, jump F) errors of the table curve ``mine`` behind K against the curve ``truth``
+    (a node's own), F compared at 4000 base positions on each leg away from the jumps of either by twice
+    their distance."""
+    a, b = mine.behind(K), truth.behind(K)
+    Z = np.linspace(b.legs.pieces[0].Z_lo, min(a.Z_max, b.Z_max), 4000)
+    eF = eZ = eJ = 0.0
+    for leg in (APPROACH, RETRACT):
+        js, jt = b.legs.jumps[leg], a.legs.jumps[leg]
+        dz = _nearest(js, jt)
+        eZ = max(eZ, dz)
+        if math.isfinite(dz) and js:
+            fs, ft = b.legs.jump_forces(leg), a.legs.jump_forces(leg)
+            for k, z in enumerate(js):
+                j = int(np.argmin([abs(z - y) for y in jt]))
+                eJ = max(eJ, abs(fs[k][0] - ft[j][0]))
+        on = np.ones(Z.size, dtype=bool)
+        w = 2.0 * (dz if math.isfinite(dz) else 0.0) + 1e-9
+        for z in js + jt:
+            on &= np.abs(Z - z) > w
+        if on.any():
+            eF = max(eF, float(np.max(np.abs(a.predict(Z[on], leg) - b.predict(Z[on], leg)))))
+    return eF, eZ, eJ
+
+
+def spacing(table: FamilyTable, keep, springs=SPRINGS, out=print) -> list[tuple[float, float, dict]]:
+    """The pilot of a sigma spacing, on the nodes alone (docs/family.md, "Roughness in the table"): the table of
+    ``table``'s nodes at the sigma ``keep`` against each node it leaves out between them, at every mu node
+    (there the interpolation in mu is exact, so what is measured is the spacing in sigma's; a node is the
+    solver's curve sampled, to 3e-7 in F at fixed Z).  The errors are those of :func:`measure`: the events of a
+    rigid machine, the legs behind ``springs``.  Returns (mu, sigma, errors) for each left-out node."""
+    from ..family.build import select
+
+    keep = [float(x) for x in keep]
+    idx = [int(np.argmin(np.abs(table.sigma - x))) for x in keep]
+    if any(abs(table.sigma[i] - x) > 1e-9 for i, x in zip(idx, keep)) or len(set(idx)) < 2:
+        raise ValueError(f"--keep {keep}: expected two or more of the table's sigma nodes "
+                         f"({', '.join(f'{x:g}' for x in table.sigma)})")
+    coarse = select(table, sigma=sorted(idx))
+    left = [j for j in range(table.sigma.size) if j not in idx and coarse.sigma[0] < table.sigma[j] < coarse.sigma[-1]]
+    rows = []
+    out("| mu | sigma left out | spacing there | F at Z | jump Z | jump F | event lambda | event F |")
+    out("|---|---|---|---|---|---|---|---|")
+    for mu in table.mu:
+        for j in left:
+            sg = float(table.sigma[j])
+            truth, mine = table.curve(float(mu), sg), coarse.curve(float(mu), sg)
+            el, ef = _event_error(_table_events(mine), _table_events(truth))
+            per_K = [_legs_error(mine, truth, K) for K in springs]
+            row = dict(F_at_Z=max(p[0] for p in per_K), jump_Z=max(p[1] for p in per_K),
+                       jump_F=max(p[2] for p in per_K), event_lam=el, event_F=ef)
+            k = int(np.searchsorted(coarse.sigma, sg))
+            out(f"| {mu:.4g} | {sg:g} | {coarse.sigma[k] - coarse.sigma[k - 1]:g} | " +
+                " | ".join(f"{row[f]:.2g}" for f in ERROR_FIELDS) + " |")
+            rows.append((float(mu), sg, row))
+    return rows
 
 
 def speed(table: FamilyTable, repeats: int = 20, out=print) -> None:
@@ -230,10 +309,21 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("table")
     m.add_argument("--springs", nargs="+", type=float, default=list(SPRINGS))
     m.add_argument("--mu-max", type=float, default=math.inf, help="measure the midpoints up to this mu alone")
+    m.add_argument("--mu-min", type=float, default=0.0,
+                   help="measure the midpoints from this mu alone (those measured before kept)")
+    m.add_argument("--sigma-range", nargs=2, type=float, default=(0.0, math.inf),
+                   help="measure the midpoints with sigma in this range alone")
+    sp = sub.add_parser("spacing")
+    sp.add_argument("table")
+    sp.add_argument("--keep", nargs="+", type=float, required=True, help="the sigma nodes the coarser table keeps")
+    sp.add_argument("--springs", nargs="+", type=float, default=list(SPRINGS))
+    j = sub.add_parser("join")
+    j.add_argument("--out", required=True)
+    j.add_argument("parts", nargs="+", help="tables on the same tau nodes and the same mu (or the same sigma)")
     s = sub.add_parser("speed")
     s.add_argument("table")
     s.add_argument("--repeats", type=int, default=20)
-    for q in (b, m, s):
+    for q in (b, m, s, sp, j):
         q.error = p.error                                 # type: ignore[method-assign]
     return p
 
@@ -248,6 +338,27 @@ def main(argv=None) -> int:
             return 2
         speed(table, args.repeats)
         return 0
+    if args.command in ("spacing", "join"):
+        from ..family.build import join
+        try:
+            if args.command == "join":
+                out_dir = os.path.dirname(os.path.abspath(args.out))
+                if not os.path.isdir(out_dir):
+                    raise ValueError(f"--out {args.out}: no folder {out_dir}")
+                table = join([FamilyTable.load(f) for f in args.parts])
+            else:
+                if not all(K > 0 and math.isfinite(K) for K in args.springs):
+                    raise ValueError(f"--springs {args.springs}: expected stiffnesses > 0")
+                spacing(FamilyTable.load(args.table), args.keep, tuple(args.springs))
+                return 0
+        except ValueError as e:
+            say(f"benchmarks.family: {e}")
+            return 2
+        table.save(args.out)
+        print(f"written {args.out} ({os.path.getsize(args.out) / 1e6:.2f} MB): mu {table.mu.size} nodes "
+              f"[{table.mu[0]:g}, {table.mu[-1]:g}], sigma {table.sigma.size} [{table.sigma[0]:g}, "
+              f"{table.sigma[-1]:g}], its error not measured (measure it)")
+        return 0
     from petsc4py import PETSc
 
     rank = PETSc.COMM_WORLD.getRank()
@@ -260,7 +371,8 @@ def main(argv=None) -> int:
         except ValueError as e:
             say(f"benchmarks.family: {e}")
             return 2
-        return _measured(table, args.springs, args.table, tell, rank, time.perf_counter(), args.mu_max)
+        return _measured(table, args.springs, args.table, tell, rank, time.perf_counter(), args.mu_max, args.mu_min,
+                         tuple(args.sigma_range))
     try:
         lo, hi = args.mu
         grid = TableGrid(mu=log_nodes(lo, hi, args.per_decade) if hi > lo else (lo,), sigma=tuple(args.sigma),
@@ -293,12 +405,17 @@ def main(argv=None) -> int:
     return _measured(table, args.springs, args.out, tell, rank, t1)
 
 
-def _measured(table: FamilyTable, springs, out: str, tell, rank: int, t1: float, mu_max: float = math.inf) -> int:
-    """The table's error measured (at the midpoints up to ``mu_max``) and the table written with it to ``out``;
-    3 where a midpoint's is infinite."""
+def _measured(table: FamilyTable, springs, out: str, tell, rank: int, t1: float, mu_max: float = math.inf,
+              mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> int:
+    """The table's error measured (at the midpoints from ``mu_min`` up to ``mu_max``) and the table written with it
+    to ``out``; 3 where a midpoint's is infinite."""
     from petsc4py import PETSc
 
-    table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max)
+    try:
+        table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max, mu_min, sigma_range)
+    except ValueError as e:
+        say(f"benchmarks.family: {e}")
+        return 2
     t2 = time.perf_counter()
     tell(f"error: {t2 - t1:.1f} s wall at {table.err_mu.size} midpoints; largest {table.worst()}")
     bad = not all(np.all(np.isfinite(v)) for v in table.errors.values())

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -23,7 +23,8 @@ from ..model.pressure import pressure_law
 from .coordinate import NotMonotone, Sampled, sample, width
 from .table import FamilyTable
 
-__all__ = ["TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points", "F_MAX", "ROUGHNESS"]
+__all__ = ["select", "join", "TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points",
+           "F_MAX", "ROUGHNESS"]
 
 #: The load the table's curves end at: the library's default stop (-cont_F_max 2).
 F_MAX = 2.0
@@ -149,3 +150,49 @@ def log_nodes(lo: float, hi: float, per_decade: float) -> tuple:
     """Nodes from ``lo`` to ``hi`` uniform in ln mu, ``per_decade`` intervals a decade (at least one)."""
     n = max(int(math.ceil(per_decade * math.log10(hi / lo) - 1e-9)), 1)
     return tuple(float(x) for x in np.geomspace(lo, hi, n + 1))
+
+
+def select(table: FamilyTable, mu=None, sigma=None) -> FamilyTable:
+    """The table of ``table``'s nodes at the indices ``mu`` and ``sigma`` (None: all), its error not measured
+    (its cells are others)."""
+    i = np.arange(table.mu.size) if mu is None else np.asarray(mu, int)
+    j = np.arange(table.sigma.size) if sigma is None else np.asarray(sigma, int)
+    ix = np.ix_(i, j)
+    seconds = None if table.seconds is None else table.seconds[ix]
+    return replace(table, mu=table.mu[i], sigma=table.sigma[j], lam=table.lam[ix], F=table.F[ix],
+                   s_lo=table.s_lo[ix], s_hi=table.s_hi[ix], s0=table.s0[ix], delta=table.delta[ix],
+                   seconds=seconds, springs=np.zeros(0), err_mu=np.zeros(0), err_sigma=np.zeros(0), errors={})
+
+
+def join(tables: list) -> FamilyTable:
+    """One table of the nodes of ``tables`` built in parts: on the same tau nodes, F_max and roughness rule, and
+    either the same mu nodes (joined along sigma) or the same sigma nodes (along mu); a node two parts hold
+    is taken from the first.  ValueError, one line, for parts that do not fit together.  The joined table's
+    error is not measured (its cells are new)."""
+    first = tables[0]
+    for t in tables[1:]:
+        if t.tau.shape != first.tau.shape or not np.allclose(t.tau, first.tau) or t.F_max != first.F_max or \
+                t.roughness != first.roughness:
+            raise ValueError("the parts differ in their tau nodes, F_max or roughness rule: they are no one table")
+    same_mu = all(t.mu.shape == first.mu.shape and np.allclose(t.mu, first.mu, rtol=1e-12) for t in tables)
+    same_sigma = all(t.sigma.shape == first.sigma.shape and np.allclose(t.sigma, first.sigma) for t in tables)
+    if not (same_mu or same_sigma):
+        raise ValueError("the parts share neither their mu nor their sigma nodes: they are joined along one axis")
+    axis = 1 if same_mu else 0
+    nodes = np.concatenate([t.sigma if axis else t.mu for t in tables])
+    values, where = np.unique(np.round(nodes, 12), return_index=True)
+    # each node's (part, index) in the joined order, the first part's where two hold it
+    owner = [(int(np.searchsorted(np.cumsum([(t.sigma if axis else t.mu).size for t in tables]), w, "right")), w)
+             for w in where]
+    offs = np.r_[0, np.cumsum([(t.sigma if axis else t.mu).size for t in tables])]
+
+    def stack(name):
+        parts = [np.take(getattr(tables[p], name), [w - offs[p]], axis=axis) for p, w in owner]
+        return np.concatenate(parts, axis=axis)
+
+    secs = [t.seconds if t.seconds is not None else np.full(t.s_lo.shape, np.nan) for t in tables]
+    seconds = np.concatenate([np.take(secs[p], [w - offs[p]], axis=axis) for p, w in owner], axis=axis)
+    return replace(first, mu=first.mu if axis else nodes[where], sigma=nodes[where] if axis else first.sigma,
+                   lam=stack("lam"), F=stack("F"), s_lo=stack("s_lo"), s_hi=stack("s_hi"), s0=stack("s0"),
+                   delta=stack("delta"), seconds=seconds, springs=np.zeros(0), err_mu=np.zeros(0),
+                   err_sigma=np.zeros(0), errors={})

@@ -33,7 +33,8 @@ from ..tracing.measured import Measured, Missing
 from ..version import __version__
 from .legs import APPROACH, RETRACT, Legs, spring_legs
 
-__all__ = ["save_npz", "load_npz", "FORMAT", "FORMAT_VERSION", "SHIPPED", "shipped_path", "shipped", "OutOfRange", "TableError",
+__all__ = ["save_npz", "load_npz", "FORMAT", "FORMAT_VERSION", "SHIPPED", "shipped_path", "shipped", "default_table",
+           "OutOfRange", "TableError",
            "FamilyTable", "FamilyCurve", "SpringCurve", "TableEvent", "lagrange"]
 
 FORMAT = "petsc-adhesion curve family"
@@ -47,8 +48,10 @@ ERROR_FIELDS = ("F_at_Z", "jump_Z", "jump_F", "event_lam", "event_F")
 
 
 #: The tables the package ships (petsc_adhesion/family/data/NAME.npz), by name: "smooth", sigma = 0 over mu 1e-3
-#: to 1e3 (docs/family.md says how it was built and its measured error); the first is the fits' default.
-SHIPPED = ("smooth",)
+#: to 1e3; "rough", sigma 0 to 3 over the part of that mu range built so far (docs/family.md says how each was
+#: built, its range and its measured error).  The first is the default of a fit without roughness
+#: (:func:`default_table`).
+SHIPPED = ("smooth", "rough")
 
 
 def shipped_path(name: str = SHIPPED[0]) -> str:
@@ -62,6 +65,21 @@ def shipped_path(name: str = SHIPPED[0]) -> str:
 def shipped(name: str = SHIPPED[0]) -> FamilyTable:
     """The shipped table ``name``, read once per process (a FamilyTable is immutable)."""
     return FamilyTable.load(shipped_path(name))
+
+
+def default_table(sigma: float, fitted: bool, mu_range: tuple[float, float]) -> str:
+    """The shipped table a fit's "default" is: "rough" where the fit has a roughness (``fitted``, or held at
+    ``sigma`` > 0) and the rough table's range holds the fit's, its sigma and the whole ``mu_range`` the fit may
+    reach (a search bounded at a table's mu short of the model's would end at the table's bound, not the
+    data's: while the rough table is built over part of the mu range alone it is taken by its name,
+    ``-fit_table rough``); "smooth" otherwise (SHIPPED[0]; a roughness it does not hold then goes through the
+    solver, said by the fit)."""
+    if (fitted or sigma > 0) and os.path.exists(shipped_path("rough")):
+        t = shipped("rough")
+        lo, hi = mu_range
+        if t.sigma[0] <= sigma <= t.sigma[-1] and t.mu[0] <= lo * (1 + 1e-9) and t.mu[-1] >= hi * (1 - 1e-9):
+            return "rough"
+    return SHIPPED[0]
 
 
 class OutOfRange(ValueError):
@@ -152,7 +170,7 @@ class FamilyTable:
     def error(self, mu: float, sigma: float) -> TableError | Missing:
         """The interpolation error stated about (mu, sigma): SAFETY times the largest measured at the midpoints of
         the cells about it (its cell and their neighbours, in ln mu and sigma); Missing where the table was not
-        measured."""
+        measured, or not at its own cell's centre."""
         self.check(mu, sigma)
         if not self.measured:
             return Missing("the table's interpolation error was not measured (built without its midpoints)")
@@ -164,9 +182,14 @@ class FamilyTable:
         em = np.log(self.err_mu)
         near = (em >= lo_m - 1e-12) & (em <= hi_m + 1e-12) & (self.err_sigma >= lo_s - 1e-12) & \
             (self.err_sigma <= hi_s + 1e-12)
-        if not near.any():
+        # its own cell's centre measured, too: a table measured in parts may hold its neighbours' alone
+        s0, s1 = self.sigma[j - 1], self.sigma[min(j, self.sigma.size - 1)]
+        own = near & (em >= nodes[i - 1] - 1e-12) & (em <= nodes[min(i, nodes.size - 1)] + 1e-12) & \
+            (self.err_sigma >= s0 - 1e-12) & (self.err_sigma <= s1 + 1e-12)
+        if not own.any():
             return Missing(f"the table's interpolation error was not measured about mu = {mu:.4g}, sigma = "
-                           f"{sigma:.4g} (its build measured the midpoints up to mu = {self.err_mu.max():.4g})")
+                           f"{sigma:.4g} (its cell's centre was not; it was measured at {self.err_mu.size} cell "
+                           f"centres, mu {self.err_mu.min():.4g} to {self.err_mu.max():.4g})")
         return TableError(**{f: SAFETY * float(np.max(self.errors[f][near])) for f in ERROR_FIELDS},
                           points=int(near.sum()))
 

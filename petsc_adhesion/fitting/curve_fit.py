@@ -61,7 +61,7 @@ from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
 from .data import MeasuredCurve
 from .branches import BRANCHES
-from .forward import APPROACH, RETRACT, ForwardCurve, open_table, table_covers, table_legs
+from .forward import APPROACH, RETRACT, ForwardCurve, table_choice, table_covers, table_legs
 from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
                      domain_reasons, features, refuse_a_line, refuse_empty)
 from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, verdicts
@@ -362,11 +362,6 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     from ..tracing.trace import GridChoice, SolverChoice
 
     t0 = time.perf_counter()
-    try:
-        family = open_table(table)
-    except ValueError as e:
-        raise CurveFitError(f"the table: {e}") from None
-    label = "none" if family is None else table if isinstance(table, str) else "given"
     choice = choice or FitChoice()
     template = model or Model()
     grid, solver = grid or GridChoice(), solver or SolverChoice()
@@ -403,6 +398,10 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     sigma0 = 0.0 if bodies.rms is None else bodies.rms / eps
     if choice.roughness and bodies.rms is None:
         sigma0 = 0.3
+    try:                       # "default": the rough table where the fit has a roughness its range holds
+        family, label = table_choice(table, sigma0, choice.roughness, MU_BOUNDS)
+    except ValueError as e:
+        raise CurveFitError(f"the table: {e}") from None
     pb = _Problem(data, bodies, spring, template, grid, solver, comm,
                   None if choice.modulus or modulus is None else float(modulus),
                   choice.roughness, sigma0, noise, feat, float(data.F.max()), choice=choice, progress=progress)

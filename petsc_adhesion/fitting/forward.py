@@ -19,11 +19,11 @@ from __future__ import annotations
 import math
 
 from ..family.legs import APPROACH, RETRACT, Legs, Piece
-from ..family.table import SHIPPED, FamilyTable, shipped
+from ..family.table import SHIPPED, FamilyTable, default_table, shipped
 from ..tracing.legs import turn_of
 
 __all__ = ["Piece", "ForwardCurve", "APPROACH", "RETRACT", "curve_stop_reason", "curve_jumps", "pull_off_values",
-           "open_table", "table_covers", "table_legs"]
+           "open_table", "table_choice", "table_covers", "table_legs", "SIGMA_SEARCH"]
 
 
 # -- what fitting/ reads of a traced Curve: these functions alone ---------------------------------------------
@@ -55,6 +55,10 @@ class ForwardCurve(Legs):
 
 
 # -- the curve family table as a fit's forward model ----------------------------------------------------------
+#: The sigma a fitted roughness is searched over: outcome.py's SIGMA_MAX (not imported: outcome imports this module).
+SIGMA_SEARCH = 3.0
+
+
 def open_table(spec) -> FamilyTable | None:
     """The table a fit searches on: ``spec`` "default" (the package's, :data:`~petsc_adhesion.family.table.SHIPPED`),
     a shipped table's name, a file, a FamilyTable, or "none"/None (the solver alone).  ValueError, one line, for a
@@ -70,6 +74,19 @@ def open_table(spec) -> FamilyTable | None:
     return FamilyTable.load(spec)
 
 
+def table_choice(spec, sigma: float, fitted: bool, mu_range: tuple) -> tuple[FamilyTable | None, str]:
+    """(the table a fit searches on, its label in the fit's notes): ``spec`` as :func:`open_table` takes it, but
+    "default" is the rough table where the fit has a roughness (``fitted``, or held at ``sigma`` > 0) and the
+    rough table's range holds the fit's (:func:`~petsc_adhesion.family.table.default_table`: its sigma and all of
+    ``mu_range``, the mu the search may reach), labelled "default rough"; the smooth one otherwise, "default".
+    ValueError, one line, for a file that is no table."""
+    if spec == "default":
+        name = default_table(sigma, fitted, mu_range)
+        return open_table(name), "default" if name == SHIPPED[0] else f"default {name}"
+    family = open_table(spec)
+    return family, "none" if family is None else spec if isinstance(spec, str) else "given"
+
+
 def table_covers(table: FamilyTable, model, rmax: float, fit_sigma: bool, sigma: float) -> str | None:
     """Why ``table`` does not hold the model a fit asks for (None where it does): the table's roughness rule,
     its domain (the end ``rmax`` of the fit's, against the default grid's that the table's nodes were traced
@@ -81,6 +98,8 @@ def table_covers(table: FamilyTable, model, rmax: float, fit_sigma: bool, sigma:
     rule = table.roughness.split()[0]
     if fit_sigma and hi <= lo:
         return f"the roughness is fitted and the table holds sigma = {lo:g} alone"
+    if fit_sigma and (lo > 0 or hi < SIGMA_SEARCH):  # the search's sigma would leave the table mid-fit
+        return f"the roughness is fitted over [0, {SIGMA_SEARCH:g}] and the table holds sigma in [{lo:g}, {hi:g}]"
     if not (lo - 1e-12 <= sigma <= hi + 1e-12):
         return f"sigma = {sigma:.4g} is outside the table's [{lo:g}, {hi:g}]"
     if sigma > 0 or fit_sigma:

@@ -268,8 +268,9 @@ TABLE = {o.name: o for o in [
     Option("fit_max_evals", "int", 40, "fit: the cap on the least squares' evaluations of -fit_curve; reached, "
            "the fit ends with a WARNING and exit status 3", 1, 10**6),
     Option("fit_table", "string", "default", "fit: the curve family table -fit_curve searches on where it holds the "
-           "model (a smooth sphere, mu 1e-3 to 1e3; then one solver curve at its optimum): default (the package's), "
-           "a table file, or none (the solver's curves throughout)"),
+           "model (then one solver curve at its optimum): default (the package's: the rough table where the fit has a "
+           "roughness and its range holds the fit, else the smooth sphere's, mu 1e-3 to 1e3), smooth or rough (a "
+           "shipped table by name), a table file, or none (the solver's curves throughout)"),
     Option("fit_outside_domain", "choice", "refuse", "fit: a -fit_curve outside the model's domain (a deep "
            "indentation, mu beyond its range, a contact steeper than the lever, tethers): refuse before fitting "
            "(exit 3, nothing written) or fit and warn (exit 3)", choices=("refuse", "warn")),
