@@ -334,7 +334,7 @@ def workshop_header(path: str) -> dict | None:
         return None
     if not lines[0].strip().startswith("Force-Distance Curve"):
         return None
-    head = {}
+    head: dict = {}
     for line in lines[1:]:
         if line.count(",") >= 3:            # the columns' names, as afmformats finds them
             head["columns"] = [c.strip() for c in line.strip().split(",")]

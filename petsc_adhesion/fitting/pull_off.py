@@ -451,13 +451,14 @@ def _tried(g, x: float, back: float) -> tuple:
     """(x, g(x)) for the secant, or, where the curve at x fails (:class:`PullOffCurveError`: one solver failure
     at one w, a fold pair it could not resolve, says nothing of the root), for a point moved half of the way
     back towards ``back`` and again, RETRIES times; the first failure's error if all fail."""
-    first = None
+    first: PullOffCurveError | None = None
     for _ in range(RETRIES + 1):
         try:
             return x, g(x)
         except PullOffCurveError as why:
             first = first or why
             x = back + 0.5 * (x - back)
+    assert first is not None, "the loop ran at least once"
     raise first
 
 

@@ -113,7 +113,7 @@ def instrument_of(path: str) -> str:
 def place_folder(files: list, name: str, shape: tuple | None) -> Layout | None:
     """The map of a folder's ``files`` (see the module); None where their instrument places nothing (the
     caller lays them in a row or on ``shape``).  LayoutError (one line) for a folder that is no one map."""
-    kinds = {}
+    kinds: dict[str, list] = {}
     for f in files:
         kinds.setdefault(instrument_of(f), []).append(f)
     if len(kinds) > 1:
@@ -151,7 +151,7 @@ def ibw_note(path: str) -> dict:
         text = f.read(note)
     if len(text) < note:
         raise ValueError("its note is cut short")
-    out = {}
+    out: dict[str, str] = {}
     for line in text.decode("latin-1").split("\r"):
         if ":" in line:
             key, value = line.split(":", 1)
@@ -168,18 +168,21 @@ def _real(note: dict, key: str) -> float | None:
 
 
 def _asylum(files: list, name: str, shape: tuple | None) -> Layout | None:
-    named = [(_ASYLUM_NAME.match(os.path.basename(f)), f) for f in files]
-    if not any(m for m, _ in named):
+    matched = [(_ASYLUM_NAME.match(os.path.basename(f)), f) for f in files]
+    if not any(m for m, _ in matched):
         return None
-    unnamed = [f for m, f in named if not m]
+    unnamed = [f for m, f in matched if not m]
     if unnamed:
         raise LayoutError(f"{name}: '{os.path.basename(unnamed[0])}' is no curve of an Asylum map (its name has "
                           f"no LineNNNNPointNNNN) beside {len(files) - len(unnamed)} that are")
+    named = [(m, f) for m, f in matched if m is not None]
     bases = sorted({m["base"] for m, _ in named})
     if len(bases) > 1:
         raise LayoutError(f"{name}: the curves of two Asylum maps ('{bases[0]}' and '{bases[1]}' before "
                           f"LineNNNNPointNNNN); give each its own folder")
-    notes, grid, first = {}, None, None
+    notes: dict[str, dict] = {}
+    grid: tuple | None = None
+    first = ""
     for m, f in named:
         try:
             note = ibw_note(f)
@@ -206,7 +209,7 @@ def _asylum(files: list, name: str, shape: tuple | None) -> Layout | None:
         raise LayoutError(f"{name}: its curves' notes state a grid of {nx} x {ny} (FMapScanPoints, "
                           f"FMapScanLines); -fit_map_shape {shape[0]},{shape[1]} disagrees: leave it out")
     down = _real(note, "FMapScanDown") == 1
-    cells = {}
+    cells: dict[tuple[int, int], str] = {}
     for m, f in named:
         point, line = int(m["point"]), int(m["line"])
         if point >= nx or line >= ny:
@@ -221,7 +224,8 @@ def _asylum(files: list, name: str, shape: tuple | None) -> Layout | None:
     size = (sx, sy) if sx and sy and sx > 0 and sy > 0 else None
     origin = None
     if size is not None and cx is not None and cy is not None and angle == 0:   # a turned grid: its own frame
-        origin = (cx - sx / 2 + sx / nx / 2, cy - sy / 2 + sy / ny / 2)
+        w, h = size
+        origin = (cx - w / 2 + w / nx / 2, cy - h / 2 + h / ny / 2)
     # where a curve is missing, its name as the map's others are written (their digits and folder)
     f0 = named[0][1]
     m0 = named[0][0]
@@ -285,7 +289,7 @@ def _workshop(files: list, name: str, shape: tuple | None) -> Layout | None:
     if shape is not None and tuple(shape) != (nx, ny):
         raise LayoutError(f"{name}: its curves' positions make a grid of {nx} x {ny}; -fit_map_shape "
                           f"{shape[0]},{shape[1]} disagrees: leave it out")
-    cells = {}
+    cells: dict[tuple, str] = {}
     for f, i, j in zip(files, ix, iy):
         if (i, j) in cells:
             raise LayoutError(f"{name}: '{os.path.basename(cells[i, j])}' and '{os.path.basename(f)}' state the "
