@@ -24,7 +24,7 @@ import numpy as np
 
 from .peer_rough import DLAM, L, MU, N_MAIN, digest, run_mu, surface, write_atomic
 
-__all__ = ["FOOTPRINT", "OUR_F_MAX", "BISTABLE", "run_key", "gaussian_key", "our_curve", "ours_for",
+__all__ = ["FOOTPRINT", "OUR_F_MAX", "BISTABLE", "pull_off_runs", "run_key", "gaussian_key", "our_curve", "ours_for",
            "gaussian_laws", "bistable", "tables", "figure", "main"]
 
 #: The footprint whose pixel heights make the local law: the sphere's contact up to F = 0 lies inside it.
@@ -36,6 +36,17 @@ OUR_F_MAX = 0.05
 def _event(c, kind):
     ev = c.events_of(kind)
     return None if not ev else float(ev[0].lam.value)
+
+
+def pull_off_runs(peer: dict) -> list:
+    """The peer's pull-offs on N_MAIN pixels, one per (mu, sigma, seed): the full curve's, or where there is
+    none the retraction alone (``kind`` 'retract': at mu = 3 the approach to F = 0 would carry the contact to
+    the square's edge, and its cost is that of four retractions)."""
+    full = [r for r in peer["runs"] if r["n"] == N_MAIN]
+    have = {(run_mu(r), r["sigma"], r["seed"]) for r in full}
+    alone = [dict(r, kind="retract") for r in peer.get("retract_runs", [])
+             if r["n"] == N_MAIN and (run_mu(r), r["sigma"], r["seed"]) not in have]
+    return [dict(r, kind="runs") for r in full] + alone
 
 
 def run_key(run: dict) -> str:
@@ -134,9 +145,10 @@ def ours_main(argv) -> int:
                     ours[kind][key] = old[kind][key] if key in old[kind] else ours_for(run, tmp)
                     print(kind, key, {k: round(v["pull_off"]["F"], 5) for k, v in ours[kind][key].items()},
                           flush=True)
-            main = [r for r in peer["runs"] if r["sigma"] > 0 and r["n"] == N_MAIN]
+            main = [r for r in pull_off_runs(peer) if r["sigma"] > 0]
             for mu, sigma in sorted({(run_mu(r), r["sigma"]) for r in main}):
-                tops = [r["top"] for r in main if (run_mu(r), r["sigma"]) == (mu, sigma)]
+                tops = [ours[r["kind"]][run_key(r)]["measured"]["top"] for r in main
+                        if (run_mu(r), r["sigma"]) == (mu, sigma)]
                 key = gaussian_key(sigma, mu)
                 kept = old["gaussian"].get(key)
                 want = {f"truncated:{round(t / sigma, 2)}" for t in tops} | {"hermite"}
@@ -190,36 +202,39 @@ def _mus(runs) -> list:
 def tables(peer: dict, ours: dict) -> str:
     """The comparison, one row per (mu, rms): the explicit runs' mean and seed-to-seed spread, each mean field;
     the folds surface by surface; the grid (the retractions alone on two grids)."""
-    main = [r for r in peer["runs"] if r["n"] == N_MAIN and r["sigma"] > 0]
-    smooth = {run_mu(r): r for r in peer["runs"] if r["n"] == N_MAIN and r["sigma"] == 0}
+    every_po = pull_off_runs(peer)
+    main = [r for r in every_po if r["sigma"] > 0]
+    smooth = {run_mu(r): r for r in every_po if r["sigma"] == 0}
     lines = ["Pull-off F (load / (2 pi R gamma)) at each Tabor parameter mu: the explicit runs' mean +- their "
              "seed-to-seed standard deviation (over the seeds of the third column), the mean field of each "
              "surface's own pixel heights (mean +- spread over the seeds): all of the square's and the "
              "footprint's (r < 2.5), the paper's Gaussian rule (16 points) at the same rms, the Gaussian cut at "
              "each surface's own top; the ratio of the explicit pull-off to the mean field of the square's "
              "heights (mean over the seeds of each seed's ratio); sigma 0: the smooth sphere, the explicit "
-             "run against our curve.", "",
+             "run against our curve.  'retraction': the explicit pull-off of the retraction alone from a state in "
+             "contact (the grid's table below), no full curve.", "",
              "| mu | sigma (rms / epsilon) | seeds | explicit (ContactMechanics) | mean field, the square's heights | "
              "mean field, the footprint's heights | Gaussian rule, 16 points | Gaussian cut at the own top | "
              "highest height / rms | explicit / mean field |", "|---|---|---|---|---|---|---|---|---|---|"]
     for mu in _mus(main + list(smooth.values())):
         if mu in smooth:
             r = smooth[mu]
-            o = ours["runs"][run_key(r)]["smooth"]["pull_off"]
-            lines.append(f"| {mu:g} | 0 | - | {r['pull_off']['F']:.4f} | {o['F']:.4f} (smooth) | - | - | - | - | "
+            o = ours[r["kind"]][run_key(r)]["smooth"]["pull_off"]
+            lines.append(f"| {mu:g} | 0 | {'retraction' if r['kind'] == 'retract' else '-'} | {r['pull_off']['F']:.4f} | {o['F']:.4f} (smooth) | - | - | - | - | "
                          f"{r['pull_off']['F'] / o['F']:.3f} |")
         for sigma in sorted({r["sigma"] for r in main if run_mu(r) == mu}):
             rs = [r for r in main if (run_mu(r), r["sigma"]) == (mu, sigma)]
-            keys = [run_key(r) for r in rs]
+            mine = [ours[r["kind"]][run_key(r)] for r in rs]
             g = ours["gaussian"][gaussian_key(sigma, mu)]
             trunc = [v["pull_off"]["F"] for k, v in g.items() if k.startswith("truncated")]
-            ratio = [r["pull_off"]["F"] / ours["runs"][k]["measured"]["pull_off"]["F"] for r, k in zip(rs, keys)]
-            lines.append(f"| {mu:g} | {sigma:g} | {', '.join(str(r['seed']) for r in rs)} | "
+            ratio = [r["pull_off"]["F"] / o["measured"]["pull_off"]["F"] for r, o in zip(rs, mine)]
+            seeds = ", ".join(str(r["seed"]) + (" (retraction)" if r["kind"] == "retract" else "") for r in rs)
+            lines.append(f"| {mu:g} | {sigma:g} | {seeds} | "
                          f"{_ms(_stats([r['pull_off']['F'] for r in rs]))} | "
-                         f"{_ms(_stats([ours['runs'][k]['measured']['pull_off']['F'] for k in keys]))} | "
-                         f"{_ms(_stats([ours['runs'][k]['footprint']['pull_off']['F'] for k in keys]))} | "
+                         f"{_ms(_stats([o['measured']['pull_off']['F'] for o in mine]))} | "
+                         f"{_ms(_stats([o['footprint']['pull_off']['F'] for o in mine]))} | "
                          f"{g['hermite']['pull_off']['F']:.4f} | {_ms(_stats(trunc))} | "
-                         f"{_ms(_stats([r['top'] / sigma for r in rs]), 2)} | {_ms(_stats(ratio), 2)} |")
+                         f"{_ms(_stats([o['measured']['top'] / sigma for o in mine]), 2)} | {_ms(_stats(ratio), 2)} |")
     lines += ["", "Snap-on and snap-off (lambda, approach / epsilon) and the hysteresis (the energy of the "
               "displacement-controlled cycle, 2 pi R gamma epsilon), surface by surface.  The explicit ones: the "
               f"lattice's bistable range (where approach and retraction differ by more than {BISTABLE:g} in load; "
@@ -229,7 +244,7 @@ def tables(peer: dict, ours: dict) -> str:
               "| mu | sigma | seed | snap-on, explicit | snap-on, mean field | snap-off, explicit | "
               "snap-off, mean field | hysteresis, explicit | hysteresis, mean field |",
               "|---|---|---|---|---|---|---|---|---|"]
-    for r in sorted(main + list(smooth.values()), key=lambda r: (run_mu(r), r["sigma"], r["seed"])):
+    for r in sorted((r for r in every_po if r["kind"] == "runs"), key=lambda r: (run_mu(r), r["sigma"], r["seed"])):
         o = ours["runs"][run_key(r)]
         m = o["smooth" if r["sigma"] == 0 else "measured"]
         b = bistable(r)
@@ -268,9 +283,10 @@ def tables(peer: dict, ours: dict) -> str:
     for mu in _mus(every):
         runs = [r for r in every if run_mu(r) == mu]
         curves = [r for r in runs if "approach" in r]
+        each = "" if not curves else (f", {min(r['cpu_time_s'] for r in curves):.0f} to "
+                                      f"{max(r['cpu_time_s'] for r in curves):.0f} s each")
         lines.append(f"CPU time at mu = {mu:g}: the explicit runs {sum(r['cpu_time_s'] for r in runs) / 60:.1f} min "
-                     f"({len(curves)} curves, {min(r['cpu_time_s'] for r in curves):.0f} to "
-                     f"{max(r['cpu_time_s'] for r in curves):.0f} s each, and {len(runs) - len(curves)} retractions;"
+                     f"({len(curves)} curves{each}, and {len(runs) - len(curves)} retractions;"
                      f" {sum(r['solves'] for r in runs)} minimisations).")
     lines += ["", f"Ours: {ocpu:.0f} s ({sum(len(o) for o in mine)} curves); ContactMechanics "
               f"{ver['ContactMechanics']}, Adhesion {ver['Adhesion']}, muGrid {ver['muGrid']}, one core each, "
@@ -280,8 +296,8 @@ def tables(peer: dict, ours: dict) -> str:
 
 
 def _ours_of(ours: dict, runs, sigma: float, law: str) -> list:
-    """Our curves under ``law`` for the peer runs at ``sigma``."""
-    return [ours["runs"][run_key(r)][law] for r in runs if r["sigma"] == sigma]
+    """Our curves under ``law`` for the peer runs (of :func:`pull_off_runs`) at ``sigma``."""
+    return [ours[r["kind"]][run_key(r)][law] for r in runs if r["sigma"] == sigma]
 
 
 def _curve_panel(ax, r, ours):
@@ -314,7 +330,8 @@ def figure(peer: dict, ours: dict, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     main = [r for r in peer["runs"] if r["n"] == N_MAIN]
-    mus = _mus(main)
+    po = pull_off_runs(peer)
+    mus = _mus(po)
     first = [min((r for r in main if run_mu(r) == MU and r["sigma"] == s), key=lambda r: r["seed"])
              for s in sorted({r["sigma"] for r in main if run_mu(r) == MU})]
     # at each other mu the curve of the rms whose explicit and mean-field pull-offs differ most (the first seed)
@@ -332,7 +349,7 @@ def figure(peer: dict, ours: dict, path: str) -> None:
         ax_.set_visible(False)
     for i, mu in enumerate(mus):
         col = f"C{i}"
-        at = [r for r in main if run_mu(r) == mu]
+        at = [r for r in po if run_mu(r) == mu]
         rough = sorted({r["sigma"] for r in at if r["sigma"] > 0})
         ex = [_stats([r["pull_off"]["F"] for r in at if r["sigma"] == s]) for s in rough]
         ax.errorbar(rough, [-e[0] for e in ex], yerr=[np.nan if e[1] is None else e[1] for e in ex], fmt="o",
@@ -344,7 +361,7 @@ def figure(peer: dict, ours: dict, path: str) -> None:
         sm = [r for r in at if r["sigma"] == 0]
         if sm:
             ax.axhline(-sm[0]["pull_off"]["F"], color=col, lw=0.6, ls="--")
-        ratio = [_stats([r["pull_off"]["F"] / ours["runs"][run_key(r)]["measured"]["pull_off"]["F"]
+        ratio = [_stats([r["pull_off"]["F"] / ours[r["kind"]][run_key(r)]["measured"]["pull_off"]["F"]
                          for r in at if r["sigma"] == s]) for s in rough]
         axr.errorbar(rough, [q[0] for q in ratio], yerr=[np.nan if q[1] is None else q[1] for q in ratio],
                      fmt="o-", color=col, capsize=3, label=f"mu = {mu:g}")
@@ -352,7 +369,7 @@ def figure(peer: dict, ours: dict, path: str) -> None:
                             (axr, "explicit / mean field (the square's heights)", "pull-off ratio")):
         a_.set_xscale("log")
         a_.set_yscale("log")
-        ticks = sorted({r["sigma"] for r in main if r["sigma"] > 0})
+        ticks = sorted({r["sigma"] for r in po if r["sigma"] > 0})
         a_.set_xticks(ticks, [f"{s:g}" for s in ticks])
         a_.minorticks_off()
         a_.set_xlabel("sigma (rms / epsilon)")

@@ -86,7 +86,7 @@ R_TI = 0.5
 def start_gap(mu: float) -> float:
     """The approach's start before the highest asperity under the sphere: START_GAP up to mu = 1, beyond it
     START_GAP mu^0.8, so that the retraction, which ends there, passes the snap-off of a softer sphere (ours
-    of the smooth sphere at mu = 3 lies at lambda -4.99, the start at -6.0)."""
+    of the smooth sphere at mu = 3 lies at lambda -4.99, the start at -6.3)."""
     return START_GAP * max(1.0, mu) ** 0.8
 
 
