@@ -1,7 +1,8 @@
 """docs/mean_field.md: how far the mean field holds, against explicit rough contacts solved by
 ContactMechanics + Adhesion (the ContactEngineering codes) in an environment of their own.
 
-The same sphere (mu = 1) on a few explicit rough surfaces.  Their side: an FFT elastic half-space (free,
+The same sphere (mu = 0.3, 1, 3: a case's fourth field, MU when it names none) on a few explicit rough
+surfaces.  Their side: an FFT elastic half-space (free,
 non-periodic), the explicit topography of sphere plus roughness, the Lennard-Jones 9-3 surface stress of our
 eq. (5) (their ``Lj82``), energy minimisation in displacement control (stable states only), approach and
 retract on a lattice of lambda.  Our side: the mean field of the same surface, its own pixel heights as the
@@ -22,7 +23,8 @@ against the roughness, with the seed-to-seed spread of the explicit runs as thei
 (``.venv-peer`` is the user's to make, not part of the repository.)  The first command runs this file as a
 script under the peer's interpreter: at module level it imports nothing but the standard library and numpy,
 and the peer's packages inside its functions; our side is :mod:`.mean_field`, which imports this module.  The peer's cases can be
-split over processes (``peer --cases 64:0.3:1,... --out part.json``, ``--retract``) and their files joined
+split over processes (``peer --cases 64:0.3:1,64:0.3:1:3,... --out part.json``, ``--retract
+64:0.3:1:0.5:-3.5:3``) and their files joined
 (``peer_rough.py merge --out docs/data/peer_rough.json part1.json part2.json ...``), as the stored file was.
 
 ``muFFT`` 0.95 (the last on the registry) is left out: installed beside muGrid 1.6 it replaces muGrid's
