@@ -322,6 +322,14 @@ def _curve_panel(ax, r, ours):
     ax.legend(fontsize=7, loc="lower left")
 
 
+def _bar(spreads):
+    """Error bars of the seed spreads; no bar where one seed gives none (and none at all where no rms has
+    two seeds: matplotlib refuses bars that are all missing)."""
+    if all(x is None for x in spreads):
+        return None
+    return [np.nan if x is None else x for x in spreads]
+
+
 def figure(peer: dict, ours: dict, path: str) -> None:
     """F(lambda) of the first seed at each rms at MU, and of one rms at each other mu: the explicit approach
     and retract against the mean field's branch (stable solid, unstable dotted) and the Gaussian rule's; the
@@ -352,7 +360,7 @@ def figure(peer: dict, ours: dict, path: str) -> None:
         at = [r for r in po if run_mu(r) == mu]
         rough = sorted({r["sigma"] for r in at if r["sigma"] > 0})
         ex = [_stats([r["pull_off"]["F"] for r in at if r["sigma"] == s]) for s in rough]
-        ax.errorbar(rough, [-e[0] for e in ex], yerr=[np.nan if e[1] is None else e[1] for e in ex], fmt="o",
+        ax.errorbar(rough, [-e[0] for e in ex], yerr=_bar([e[1] for e in ex]), fmt="o",
                     color=col, capsize=3, label=f"mu = {mu:g}: explicit (mean +- seed spread)")
         ax.plot(rough, [-np.mean([c["pull_off"]["F"] for c in _ours_of(ours, at, s, "measured")]) for s in rough],
                 "-", marker=".", color=col, label=f"mu = {mu:g}: mean field, the square's heights")
@@ -363,7 +371,7 @@ def figure(peer: dict, ours: dict, path: str) -> None:
             ax.axhline(-sm[0]["pull_off"]["F"], color=col, lw=0.6, ls="--")
         ratio = [_stats([r["pull_off"]["F"] / ours[r["kind"]][run_key(r)]["measured"]["pull_off"]["F"]
                          for r in at if r["sigma"] == s]) for s in rough]
-        axr.errorbar(rough, [q[0] for q in ratio], yerr=[np.nan if q[1] is None else q[1] for q in ratio],
+        axr.errorbar(rough, [q[0] for q in ratio], yerr=_bar([q[1] for q in ratio]),
                      fmt="o-", color=col, capsize=3, label=f"mu = {mu:g}")
     for a_, title, ylab in ((ax, "pull-off against roughness (dashed: smooth)", "pull-off -F / (2 pi R gamma)"),
                             (axr, "explicit / mean field (the square's heights)", "pull-off ratio")):
