@@ -1,13 +1,15 @@
 """docs/mean_field.md's table and figure: our side of :mod:`.peer_rough` (the project's environment).
 
-For each explicit rough sphere of the peer's data file (``docs/data/peer_rough.json``) the mean field of the
-same surface: its pixel heights as the measured law (all of the square's, and the footprint's under the
+For each explicit rough sphere of the peer's data file (``docs/data/peer_rough.json``), at its own Tabor
+parameter (a run's ``mu``; the runs stored without one are at MU = 1), the mean field of the same surface: its pixel heights as the measured law (all of the square's, and the footprint's under the
 sphere), the paper's Gaussian rule at its rms and the Gaussian cut at its own highest height; kept in
 ``docs/data/mean_field.json``; then the table ``docs/figures/mean_field.md`` and the figure
 ``docs/figures/mean_field.png``::
 
     OPENBLAS_NUM_THREADS=1 nice -n 10 python -m petsc_adhesion.benchmarks.mean_field
     OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.benchmarks.mean_field --reuse               # table, figure
+
+The first keeps the curves already in ``mean_field.json`` for the same surfaces (``--fresh``: all again).
 
 Each surface is drawn again from its seed (:func:`.peer_rough.surface`) and must be the peer's (its digest).
 """
