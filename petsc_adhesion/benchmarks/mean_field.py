@@ -1,13 +1,15 @@
 """docs/mean_field.md's table and figure: our side of :mod:`.peer_rough` (the project's environment).
 
-For each explicit rough sphere of the peer's data file (``docs/data/peer_rough.json``) the mean field of the
-same surface: its pixel heights as the measured law (all of the square's, and the footprint's under the
+For each explicit rough sphere of the peer's data file (``docs/data/peer_rough.json``), at its own Tabor
+parameter (a run's ``mu``; the runs stored without one are at MU = 1), the mean field of the same surface: its pixel heights as the measured law (all of the square's, and the footprint's under the
 sphere), the paper's Gaussian rule at its rms and the Gaussian cut at its own highest height; kept in
 ``docs/data/mean_field.json``; then the table ``docs/figures/mean_field.md`` and the figure
 ``docs/figures/mean_field.png``::
 
     OPENBLAS_NUM_THREADS=1 nice -n 10 python -m petsc_adhesion.benchmarks.mean_field
     OPENBLAS_NUM_THREADS=1 python -m petsc_adhesion.benchmarks.mean_field --reuse               # table, figure
+
+The first keeps the curves already in ``mean_field.json`` for the same surfaces (``--fresh``: all again).
 
 Each surface is drawn again from its seed (:func:`.peer_rough.surface`) and must be the peer's (its digest).
 """
@@ -22,10 +24,10 @@ import time
 
 import numpy as np
 
-from .peer_rough import DLAM, L, MU, N_MAIN, REFINED, digest, surface, write_atomic
+from .peer_rough import DLAM, L, MU, N_MAIN, digest, run_mu, surface, write_atomic
 
-__all__ = ["FOOTPRINT", "OUR_F_MAX", "BISTABLE", "our_curve", "ours_for", "gaussian_laws", "bistable", "tables",
-           "figure", "main"]
+__all__ = ["FOOTPRINT", "OUR_F_MAX", "BISTABLE", "pull_off_runs", "run_key", "gaussian_key", "our_curve", "ours_for",
+           "gaussian_laws", "bistable", "tables", "figure", "main"]
 
 #: The footprint whose pixel heights make the local law: the sphere's contact up to F = 0 lies inside it.
 FOOTPRINT = 2.5
@@ -36,6 +38,29 @@ OUR_F_MAX = 0.05
 def _event(c, kind):
     ev = c.events_of(kind)
     return None if not ev else float(ev[0].lam.value)
+
+
+def pull_off_runs(peer: dict) -> list:
+    """The peer's pull-offs on N_MAIN pixels, one per (mu, sigma, seed): the full curve's, or where there is
+    none the retraction alone (``kind`` 'retract': at mu = 3 the approach to F = 0 would carry the contact to
+    the square's edge, and its cost is that of four retractions)."""
+    full = [r for r in peer["runs"] if r["n"] == N_MAIN]
+    have = {(run_mu(r), r["sigma"], r["seed"]) for r in full}
+    alone = [dict(r, kind="retract") for r in peer.get("retract_runs", [])
+             if r["n"] == N_MAIN and (run_mu(r), r["sigma"], r["seed"]) not in have]
+    return [dict(r, kind="runs") for r in full] + alone
+
+
+def run_key(run: dict) -> str:
+    """A peer run's key in our file: n:sigma:seed at MU (the keys stored before the mu was a case's), and
+    n:sigma:seed:mu at any other mu."""
+    mu = run_mu(run)
+    return f"{run['n']}:{run['sigma']}:{run['seed']}" + ("" if mu == MU else f":{mu:g}")
+
+
+def gaussian_key(sigma: float, mu: float) -> str:
+    """The Gaussian laws' key in our file: the rms at MU (as stored before), sigma:mu at any other mu."""
+    return str(sigma) + ("" if mu == MU else f":{mu:g}")
 
 
 def our_curve(mu: float = MU, sigma: float | None = None, **options) -> dict:
@@ -58,30 +83,30 @@ def ours_for(run: dict, tmp: str) -> dict:
     """The mean field of one peer surface: its pixel heights as the measured law (all of the square's, and
     the footprint's), the paper's Gaussian rule at its rms, the truncated Gaussian cut at its own top.  The
     surface is drawn again from its seed and must be the peer's (their digests)."""
-    n, sigma, seed = run["n"], run["sigma"], run["seed"]
+    n, sigma, seed, mu = run["n"], run["sigma"], run["seed"], run_mu(run)
     z = surface(n, sigma, seed)
     if digest(z) != run["digest"]:
         raise RuntimeError(f"the surface n {n} sigma {sigma} seed {seed} is not the peer's (digest)")
     if sigma == 0.0:
-        return dict(smooth=our_curve(sigma=0.0))
+        return dict(smooth=our_curve(mu, sigma=0.0))
     x = -L + (np.arange(n) + 0.5) * (2.0 * L / n)
     X, Y = np.meshgrid(x, x, indexing="ij")
     out = {}
     for name, heights in (("measured", z.ravel()), ("footprint", z[np.hypot(X, Y) < FOOTPRINT])):
         path = os.path.join(tmp, f"{name}.npy")
         np.save(path, heights)            # 1-D: read as they are (a 2-D map would be levelled by its plane)
-        out[name] = our_curve(adh_roughness="measured", adh_roughness_file=path)
+        out[name] = our_curve(mu, adh_roughness="measured", adh_roughness_file=path)
         out[name]["top"] = float(heights.max())
     return out
 
 
-def gaussian_laws(sigma: float, tops) -> dict:
+def gaussian_laws(sigma: float, tops, mu: float = MU) -> dict:
     """The paper's Gaussian rule (16-point Hermite) at rms sigma, and the truncated Gaussian cut at each
     surface's own highest height (K = top / sigma, two decimals; sigma that of the uncut Gaussian)."""
-    out = {"hermite": our_curve(sigma=sigma)}
+    out = {"hermite": our_curve(mu, sigma=sigma)}
     for top in tops:
         K = round(top / sigma, 2)
-        out[f"truncated:{K}"] = our_curve(sigma=sigma, adh_roughness="truncated_gaussian", adh_roughness_cutoff=K)
+        out[f"truncated:{K}"] = our_curve(mu, sigma=sigma, adh_roughness="truncated_gaussian", adh_roughness_cutoff=K)
     return out
 
 
@@ -94,6 +119,9 @@ def ours_main(argv) -> int:
     p.add_argument("--figure", default=os.path.join("docs", "figures", "mean_field.png"))
     p.add_argument("--table", default=os.path.join("docs", "figures", "mean_field.md"))
     p.add_argument("--reuse", action="store_true", help="the table and figure from --ours as it is")
+    p.add_argument("--fresh", action="store_true",
+                   help="every curve again (without it, the curves already in --ours for the same peer "
+                        "surfaces are kept and only the missing ones computed)")
     a = p.parse_args(argv)
     for path in [a.data] + ([a.ours] if a.reuse else []):
         if not os.path.exists(path):
@@ -106,19 +134,28 @@ def ours_main(argv) -> int:
         with open(a.ours) as f:
             ours = json.load(f)
     else:
-        ours = {"runs": {}, "gaussian": {}}
+        old = {"runs": {}, "gaussian": {}, "retract": {}}
+        if os.path.exists(a.ours) and not a.fresh:
+            with open(a.ours) as f:
+                old.update(json.load(f))
+        ours = {"runs": {}, "gaussian": {}, "retract": {}}
         with tempfile.TemporaryDirectory() as tmp:
-            for run in peer["runs"]:
-                key = f"{run['n']}:{run['sigma']}:{run['seed']}"
-                ours["runs"][key] = ours_for(run, tmp)
-                print(key, {k: round(v["pull_off"]["F"], 5) for k, v in ours["runs"][key].items()}, flush=True)
-            ours["retract"] = {}
-            for run in peer.get("retract_runs", []):
-                key = f"{run['n']}:{run['sigma']}:{run['seed']}"
-                ours["retract"][key] = ours_for(run, tmp)
-            for sigma in sorted({r["sigma"] for r in peer["runs"] if r["sigma"] > 0 and r["n"] == N_MAIN}):
-                tops = [r["top"] for r in peer["runs"] if r["sigma"] == sigma and r["n"] == N_MAIN]
-                ours["gaussian"][str(sigma)] = gaussian_laws(sigma, tops)
+            for kind, runs in (("runs", peer["runs"]), ("retract", peer.get("retract_runs", []))):
+                for run in runs:
+                    key = run_key(run)
+                    # a kept curve is of the same surface: the heights' digest is checked when it is made
+                    ours[kind][key] = old[kind][key] if key in old[kind] else ours_for(run, tmp)
+                    print(kind, key, {k: round(v["pull_off"]["F"], 5) for k, v in ours[kind][key].items()},
+                          flush=True)
+            main = [r for r in pull_off_runs(peer) if r["sigma"] > 0]
+            for mu, sigma in sorted({(run_mu(r), r["sigma"]) for r in main}):
+                tops = [ours[r["kind"]][run_key(r)]["measured"]["top"] for r in main
+                        if (run_mu(r), r["sigma"]) == (mu, sigma)]
+                key = gaussian_key(sigma, mu)
+                kept = old["gaussian"].get(key)
+                want = {f"truncated:{round(t / sigma, 2)}" for t in tops} | {"hermite"}
+                ours["gaussian"][key] = kept if kept is not None and set(kept) == want \
+                    else gaussian_laws(sigma, tops, mu)
         write_atomic(a.ours, ours)
     table = tables(peer, ours)
     d = os.path.dirname(os.path.abspath(a.table))
@@ -160,71 +197,100 @@ def bistable(run: dict):
     return (min(lams), max(lams)) if lams else None
 
 
+def _mus(runs) -> list:
+    return sorted({run_mu(r) for r in runs})
+
+
 def tables(peer: dict, ours: dict) -> str:
-    """The comparison, one row per rms: the explicit runs' mean and seed-to-seed spread, each mean field."""
-    main = [r for r in peer["runs"] if r["n"] == N_MAIN and r["sigma"] > 0]
-    lines = ["Pull-off F (load / (2 pi R gamma)) at mu = 1: the explicit runs' mean +- their seed-to-seed "
-             "standard deviation (over the seeds of the second column), the mean field of each surface's own "
-             "pixel heights (mean +- spread over the seeds): all of the square's and the footprint's "
-             "(r < 2.5), the paper's Gaussian rule (16 points) at the same rms, the Gaussian cut at each "
-             "surface's own top.", "",
-             "| sigma (rms / epsilon) | seeds | explicit (ContactMechanics) | mean field, the square's heights | "
+    """The comparison, one row per (mu, rms): the explicit runs' mean and seed-to-seed spread, each mean field;
+    the folds surface by surface; the grid (the retractions alone on two grids)."""
+    every_po = pull_off_runs(peer)
+    main = [r for r in every_po if r["sigma"] > 0]
+    smooth = {run_mu(r): r for r in every_po if r["sigma"] == 0}
+    lines = ["Pull-off F (load / (2 pi R gamma)) at each Tabor parameter mu: the explicit runs' mean +- their "
+             "seed-to-seed standard deviation (over the seeds of the third column), the mean field of each "
+             "surface's own pixel heights (mean +- spread over the seeds): all of the square's and the "
+             "footprint's (r < 2.5), the paper's Gaussian rule (16 points) at the same rms, the Gaussian cut at "
+             "each surface's own top; the ratio of the explicit pull-off to the mean field of the square's "
+             "heights (mean over the seeds of each seed's ratio); sigma 0: the smooth sphere, the explicit "
+             "run against our curve.  'retraction': the explicit pull-off of the retraction alone from a state in "
+             "contact (the grid's table below), no full curve.", "",
+             "| mu | sigma (rms / epsilon) | seeds | explicit (ContactMechanics) | mean field, the square's heights | "
              "mean field, the footprint's heights | Gaussian rule, 16 points | Gaussian cut at the own top | "
-             "highest height / rms |", "|---|---|---|---|---|---|---|---|"]
-    for sigma in sorted({r["sigma"] for r in main}):
-        rs = [r for r in main if r["sigma"] == sigma]
-        keys = [f"{r['n']}:{r['sigma']}:{r['seed']}" for r in rs]
-        g = ours["gaussian"][str(sigma)]
-        trunc = [v["pull_off"]["F"] for k, v in g.items() if k.startswith("truncated")]
-        lines.append(f"| {sigma:g} | {', '.join(str(r['seed']) for r in rs)} | "
-                     f"{_ms(_stats([r['pull_off']['F'] for r in rs]))} | "
-                     f"{_ms(_stats([ours['runs'][k]['measured']['pull_off']['F'] for k in keys]))} | "
-                     f"{_ms(_stats([ours['runs'][k]['footprint']['pull_off']['F'] for k in keys]))} | "
-                     f"{g['hermite']['pull_off']['F']:.4f} | {_ms(_stats(trunc))} | "
-                     f"{_ms(_stats([r['top'] / sigma for r in rs]), 2)} |")
+             "highest height / rms | explicit / mean field |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for mu in _mus(main + list(smooth.values())):
+        if mu in smooth:
+            r = smooth[mu]
+            o = ours[r["kind"]][run_key(r)]["smooth"]["pull_off"]
+            lines.append(f"| {mu:g} | 0 | {'retraction' if r['kind'] == 'retract' else '-'} | {r['pull_off']['F']:.4f} | {o['F']:.4f} (smooth) | - | - | - | - | "
+                         f"{r['pull_off']['F'] / o['F']:.3f} |")
+        for sigma in sorted({r["sigma"] for r in main if run_mu(r) == mu}):
+            rs = [r for r in main if (run_mu(r), r["sigma"]) == (mu, sigma)]
+            mine = [ours[r["kind"]][run_key(r)] for r in rs]
+            g = ours["gaussian"][gaussian_key(sigma, mu)]
+            trunc = [v["pull_off"]["F"] for k, v in g.items() if k.startswith("truncated")]
+            ratio = [r["pull_off"]["F"] / o["measured"]["pull_off"]["F"] for r, o in zip(rs, mine)]
+            seeds = ", ".join(str(r["seed"]) + (" (retraction)" if r["kind"] == "retract" else "") for r in rs)
+            lines.append(f"| {mu:g} | {sigma:g} | {seeds} | "
+                         f"{_ms(_stats([r['pull_off']['F'] for r in rs]))} | "
+                         f"{_ms(_stats([o['measured']['pull_off']['F'] for o in mine]))} | "
+                         f"{_ms(_stats([o['footprint']['pull_off']['F'] for o in mine]))} | "
+                         f"{g['hermite']['pull_off']['F']:.4f} | {_ms(_stats(trunc))} | "
+                         f"{_ms(_stats([o['measured']['top'] / sigma for o in mine]), 2)} | {_ms(_stats(ratio), 2)} |")
     lines += ["", "Snap-on and snap-off (lambda, approach / epsilon) and the hysteresis (the energy of the "
               "displacement-controlled cycle, 2 pi R gamma epsilon), surface by surface.  The explicit ones: the "
               f"lattice's bistable range (where approach and retraction differ by more than {BISTABLE:g} in load; "
               "on one branch they agree to 2e-4): the snap-on lies within DLAM = 0.05 above it, the snap-off "
               "within 0.05 below; 'none': no bistable state, the curve reversible.  The mean field's: its folds "
-              "in lambda (of the square's heights).", "",
-              "| sigma | seed | snap-on, explicit | snap-on, mean field | snap-off, explicit | snap-off, mean field | "
-              "hysteresis, explicit | hysteresis, mean field |", "|---|---|---|---|---|---|---|---|"]
-    for r in sorted(main, key=lambda r: (r["sigma"], r["seed"])):
-        m = ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"]["measured"]
+              "in lambda (of the square's heights; of the smooth sphere at sigma 0).", "",
+              "| mu | sigma | seed | snap-on, explicit | snap-on, mean field | snap-off, explicit | "
+              "snap-off, mean field | hysteresis, explicit | hysteresis, mean field |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for r in sorted((r for r in every_po if r["kind"] == "runs"), key=lambda r: (run_mu(r), r["sigma"], r["seed"])):
+        o = ours["runs"][run_key(r)]
+        m = o["smooth" if r["sigma"] == 0 else "measured"]
         b = bistable(r)
         on = "none" if b is None else f"{b[1]:.2f} to {b[1] + DLAM:.2f}"
         off = "none" if b is None else f"{b[0] - DLAM:.2f} to {b[0]:.2f}"
 
         def fold(x):
             return "none" if x is None else f"{x:.4f}"
-        lines.append(f"| {r['sigma']:g} | {r['seed']} | {on} | {fold(m['snap_on'])} | {off} | {fold(m['snap_off'])} | "
-                     f"{r['hysteresis']:.4f} | {m['hysteresis']:.4f} |")
-    lines += ["", "The grid: the same continuous surfaces on 64 and 128 pixels a side (pixel 0.156 and "
-              "0.078 sqrt(R epsilon)), the explicit retraction alone about the pull-off (from a state in contact), "
-              "the full curve's pull-off on the same grid, and the mean field of each grid's pixel heights.", "",
-              "| surface | pixels | explicit pull-off F (retraction) | its lambda | the full curve's | "
-              "mean field (the square's heights) | CPU (s) |", "|---|---|---|---|---|---|---|"]
-    for sigma, seed, _, _ in REFINED:
-        full = {r["n"]: r for r in peer["runs"] if (r["sigma"], r["seed"]) == (sigma, seed)}
-        for r in sorted((r for r in peer.get("retract_runs", []) if (r["sigma"], r["seed"]) == (sigma, seed)),
-                        key=lambda r: r["n"]):
-            o = ours["retract"][f"{r['n']}:{r['sigma']}:{r['seed']}"]
-            mf = o["smooth" if sigma == 0.0 else "measured"]["pull_off"]
-            name = "smooth" if sigma == 0.0 else f"sigma {sigma:g}, seed {seed}"
-            f = full.get(r["n"])
-            lines.append(f"| {name} | {r['n']} | {r['pull_off']['F']:.5f}"
-                         + (" (at the range's end)" if r["pull_off"]["at_end"] else "")
-                         + f" | {r['pull_off']['lam']:.3f} | " + (f"{f['pull_off']['F']:.5f}" if f else "-")
-                         + f" | {mf['F']:.5f} +- {mf['err']:.0e} | {r['cpu_time_s']:.0f} |")
-    cpu = sum(r["cpu_time_s"] for r in peer["runs"] + peer.get("retract_runs", []))
+        hm = "-" if m["hysteresis"] is None else f"{m['hysteresis']:.4f}"
+        lines.append(f"| {run_mu(r):g} | {r['sigma']:g} | {r['seed'] if r['sigma'] > 0 else '-'} | {on} | "
+                     f"{fold(m['snap_on'])} | {off} | {fold(m['snap_off'])} | {r['hysteresis']:.4f} | {hm} |")
+    lines += ["", "The grid: the same continuous surfaces on two grids (64 pixels a side: pixel 0.156 "
+              "sqrt(R epsilon); 128: 0.078), the explicit retraction alone about the pull-off (from a state in "
+              "contact), the full curve's pull-off on the same grid, and the mean field of each grid's pixel "
+              "heights (our curve of the smooth sphere at sigma 0).", "",
+              "| mu | surface | pixels | explicit pull-off F (retraction) | its lambda | the full curve's | "
+              "mean field (the square's heights) | explicit / ours - 1 | CPU (s) |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    full = {case: r for r in peer["runs"] for case in [(run_mu(r), r["sigma"], r["seed"], r["n"])]}
+    for r in sorted(peer.get("retract_runs", []), key=lambda r: (run_mu(r), r["sigma"], r["seed"], r["n"])):
+        mu, sigma, seed = run_mu(r), r["sigma"], r["seed"]
+        o = ours["retract"][run_key(r)]
+        mf = o["smooth" if sigma == 0.0 else "measured"]["pull_off"]
+        name = "smooth" if sigma == 0.0 else f"sigma {sigma:g}, seed {seed}"
+        f = full.get((mu, sigma, seed, r["n"]))
+        lines.append(f"| {mu:g} | {name} | {r['n']} | {r['pull_off']['F']:.5f}"
+                     + (" (at the range's end)" if r["pull_off"]["at_end"] else "")
+                     + f" | {r['pull_off']['lam']:.3f} | " + (f"{f['pull_off']['F']:.5f}" if f else "-")
+                     + f" | {mf['F']:.5f} +- {mf['err']:.0e} | {r['pull_off']['F'] / mf['F'] - 1:+.4f} | "
+                       f"{r['cpu_time_s']:.0f} |")
+    every = peer["runs"] + peer.get("retract_runs", [])
     mine = list(ours["runs"].values()) + list(ours.get("retract", {}).values()) + list(ours["gaussian"].values())
     ocpu = sum(v["cpu_time_s"] for o in mine for v in o.values())
     ver = peer["runs"][0]["versions"]
-    every = peer["runs"] + peer.get("retract_runs", [])
-    lines += ["", f"CPU time: the explicit runs {cpu / 60:.1f} min ({len(peer['runs'])} curves and "
-              f"{len(every) - len(peer['runs'])} retractions, {sum(r['solves'] for r in every)} minimisations), "
-              f"ours {ocpu:.0f} s ({sum(len(o) for o in mine)} curves); ContactMechanics "
+    lines += [""]
+    for mu in _mus(every):
+        runs = [r for r in every if run_mu(r) == mu]
+        curves = [r for r in runs if "approach" in r]
+        each = "" if not curves else (f", {min(r['cpu_time_s'] for r in curves):.0f} to "
+                                      f"{max(r['cpu_time_s'] for r in curves):.0f} s each")
+        lines.append(f"CPU time at mu = {mu:g}: the explicit runs {sum(r['cpu_time_s'] for r in runs) / 60:.1f} min "
+                     f"({len(curves)} curves{each}, and {len(runs) - len(curves)} retractions;"
+                     f" {sum(r['solves'] for r in runs)} minimisations).")
+    lines += ["", f"Ours: {ocpu:.0f} s ({sum(len(o) for o in mine)} curves); ContactMechanics "
               f"{ver['ContactMechanics']}, Adhesion {ver['Adhesion']}, muGrid {ver['muGrid']}, one core each, "
               f"the machine shared (load average "
               f"{min(r['loadavg'][0] for r in every):.0f} to {max(r['loadavg'][0] for r in every):.0f})."]
@@ -232,63 +298,99 @@ def tables(peer: dict, ours: dict) -> str:
 
 
 def _ours_of(ours: dict, runs, sigma: float, law: str) -> list:
-    """Our curves under ``law`` for the peer runs at ``sigma``."""
-    return [ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"][law] for r in runs if r["sigma"] == sigma]
+    """Our curves under ``law`` for the peer runs (of :func:`pull_off_runs`) at ``sigma``."""
+    return [ours[r["kind"]][run_key(r)][law] for r in runs if r["sigma"] == sigma]
+
+
+def _curve_panel(ax, r, ours):
+    """One explicit curve (approach, retraction) against the mean field of its heights and the Gaussian rule."""
+    sigma, mu = r["sigma"], run_mu(r)
+    o = ours["runs"][run_key(r)]
+    ax.plot(r["approach"]["lam"], r["approach"]["F"], "o", ms=2.5, color="C0", label="explicit, approach")
+    ax.plot(r["retract"]["lam"], r["retract"]["F"], "s", ms=2.5, mfc="none", color="C3", label="explicit, retract")
+    curves = [("mean field (own heights)", o["smooth" if sigma == 0 else "measured"]["branch"], "k")]
+    if sigma > 0:
+        curves.append(("Gaussian rule, 16 points", ours["gaussian"][gaussian_key(sigma, mu)]["hermite"]["branch"],
+                       "C2"))
+    for label, b, col in curves:
+        lam, F, st = (np.array(b[k]) for k in ("lam", "F", "stable"))
+        ax.plot(lam, np.where(st, F, np.nan), "-", color=col, lw=1.2, label=label)
+        ax.plot(lam, np.where(st, np.nan, F), ":", color=col, lw=1.0)
+    ax.set_xlim(min(r["approach"]["lam"]), max(r["approach"]["lam"]) + 0.1)
+    ax.set_ylim(min(min(r["retract"]["F"]), o[next(iter(o))]["pull_off"]["F"]) * 1.15 - 0.02, 0.05)
+    ax.set_title(("smooth" if sigma == 0 else f"sigma = {sigma:g}, seed {r['seed']}") + f", mu = {mu:g}")
+    ax.set_xlabel("lambda (approach / epsilon)")
+    ax.set_ylabel("F / (2 pi R gamma)")
+    ax.legend(fontsize=7, loc="lower left")
+
+
+def _bar(spreads):
+    """Error bars of the seed spreads; no bar where one seed gives none (and none at all where no rms has
+    two seeds: matplotlib refuses bars that are all missing)."""
+    if all(x is None for x in spreads):
+        return None
+    return [np.nan if x is None else x for x in spreads]
 
 
 def figure(peer: dict, ours: dict, path: str) -> None:
-    """F(lambda) of the first seed at each rms: the explicit approach and retract against the mean field's
-    branch (stable solid, unstable dotted) and the Gaussian rule's; and the pull-off against sigma."""
+    """F(lambda) of the first seed at each rms at MU, and of one rms at each other mu: the explicit approach
+    and retract against the mean field's branch (stable solid, unstable dotted) and the Gaussian rule's; the
+    pull-off against sigma at each mu; the ratio explicit / mean field against sigma, one line per mu."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     main = [r for r in peer["runs"] if r["n"] == N_MAIN]
-    sigmas = sorted({r["sigma"] for r in main})
-    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5))
-    for ax, sigma in zip(axes.flat, sigmas):
-        r = min((r for r in main if r["sigma"] == sigma), key=lambda r: r["seed"])
-        o = ours["runs"][f"{r['n']}:{r['sigma']}:{r['seed']}"]
-        ax.plot(r["approach"]["lam"], r["approach"]["F"], "o", ms=2.5, color="C0", label="explicit, approach")
-        ax.plot(r["retract"]["lam"], r["retract"]["F"], "s", ms=2.5, mfc="none", color="C3",
-                label="explicit, retract")
-        curves = [("mean field (own heights)", o["smooth" if sigma == 0 else "measured"]["branch"], "k")]
-        if sigma > 0:
-            curves.append(("Gaussian rule, 16 points", ours["gaussian"][str(sigma)]["hermite"]["branch"], "C2"))
-        for label, b, col in curves:
-            lam, F, st = (np.array(b[k]) for k in ("lam", "F", "stable"))
-            ax.plot(lam, np.where(st, F, np.nan), "-", color=col, lw=1.2, label=label)
-            ax.plot(lam, np.where(st, np.nan, F), ":", color=col, lw=1.0)
-        lo = min(r["approach"]["lam"])
-        ax.set_xlim(lo, max(r["approach"]["lam"]) + 0.1)
-        ax.set_ylim(min(min(r["retract"]["F"]), o[next(iter(o))]["pull_off"]["F"]) * 1.15 - 0.02, 0.05)
-        ax.set_title(("smooth" if sigma == 0 else f"sigma = {sigma:g}, seed {r['seed']}") + ", mu = 1")
-        ax.set_xlabel("lambda (approach / epsilon)")
-        ax.set_ylabel("F / (2 pi R gamma)")
-        ax.legend(fontsize=7, loc="lower left")
-    ax = axes.flat[-1]
-    rough = [s for s in sigmas if s > 0]
-    ex = [_stats([r["pull_off"]["F"] for r in main if r["sigma"] == s]) for s in rough]
-    ax.errorbar(rough, [-e[0] for e in ex], yerr=[np.nan if e[1] is None else e[1] for e in ex], fmt="o",
-                color="C3", capsize=3,
-                label="explicit (mean +- seed spread)")
-    for label, get, fmt in (
-            ("mean field, the square's heights", lambda s: _ours_of(ours, main, s, "measured"), "k-"),
-            ("mean field, the footprint's heights", lambda s: _ours_of(ours, main, s, "footprint"), "k--"),
-            ("Gaussian rule, 16 points", lambda s: [ours["gaussian"][str(s)]["hermite"]], "C2-"),
-            ("Gaussian cut at the own top", lambda s: [v for k, v in ours["gaussian"][str(s)].items()
-                                                       if k.startswith("truncated")], "C1-")):
-        ax.plot(rough, [-np.mean([c["pull_off"]["F"] for c in get(s)]) for s in rough], fmt, marker=".", label=label)
-    sm = [r for r in main if r["sigma"] == 0]
-    if sm:
-        ax.axhline(-sm[0]["pull_off"]["F"], color="0.6", lw=0.8, label="smooth sphere")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xticks(rough, [f"{s:g}" for s in rough])
-    ax.minorticks_off()
-    ax.set_xlabel("sigma (rms / epsilon)")
-    ax.set_ylabel("pull-off -F / (2 pi R gamma)")
-    ax.set_title("pull-off against roughness, mu = 1")
-    ax.legend(fontsize=7)
+    po = pull_off_runs(peer)
+    mus = _mus(po)
+    first = [min((r for r in main if run_mu(r) == MU and r["sigma"] == s), key=lambda r: r["seed"])
+             for s in sorted({r["sigma"] for r in main if run_mu(r) == MU})]
+    # at each other mu the curve of the rms whose explicit and mean-field pull-offs differ most (the first seed)
+    for mu in mus:
+        rs = [r for r in main if run_mu(r) == mu and r["sigma"] > 0]
+        if mu != MU and rs:
+            first.append(max(sorted(rs, key=lambda r: (r["seed"], r["sigma"])),
+                             key=lambda r: r["pull_off"]["F"] / ours["runs"][run_key(r)]["measured"]["pull_off"]["F"]))
+    rows = int(np.ceil((len(first) + 2) / 3))
+    fig, axes = plt.subplots(rows, 3, figsize=(13, 3.75 * rows))
+    for ax, r in zip(axes.flat, first):
+        _curve_panel(ax, r, ours)
+    ax, axr = axes.flat[len(first)], axes.flat[len(first) + 1]
+    for ax_ in axes.flat[len(first) + 2:]:
+        ax_.set_visible(False)
+    for i, mu in enumerate(mus):
+        col = f"C{i}"
+        at = [r for r in po if run_mu(r) == mu]
+        rough = sorted({r["sigma"] for r in at if r["sigma"] > 0})
+        ex = [_stats([r["pull_off"]["F"] for r in at if r["sigma"] == s]) for s in rough]
+        ax.errorbar(rough, [-e[0] for e in ex], yerr=_bar([e[1] for e in ex]), fmt="o",
+                    color=col, capsize=3, label=f"mu = {mu:g}: explicit (mean +- seed spread)")
+        ax.plot(rough, [-np.mean([c["pull_off"]["F"] for c in _ours_of(ours, at, s, "measured")]) for s in rough],
+                "-", marker=".", color=col, label=f"mu = {mu:g}: mean field, the square's heights")
+        ax.plot(rough, [-ours["gaussian"][gaussian_key(s, mu)]["hermite"]["pull_off"]["F"] for s in rough],
+                ":", color=col, label=f"mu = {mu:g}: Gaussian rule, 16 points")
+        sm = [r for r in at if r["sigma"] == 0]
+        if sm:
+            ax.axhline(-sm[0]["pull_off"]["F"], color=col, lw=0.6, ls="--")
+        ratio = [_stats([r["pull_off"]["F"] / ours[r["kind"]][run_key(r)]["measured"]["pull_off"]["F"]
+                         for r in at if r["sigma"] == s]) for s in rough]
+        axr.errorbar(rough, [q[0] for q in ratio], yerr=_bar([q[1] for q in ratio]),
+                     fmt="o-", color=col, capsize=3, label=f"mu = {mu:g}")
+    for a_, title, ylab in ((ax, "pull-off against roughness (dashed: smooth)", "pull-off -F / (2 pi R gamma)"),
+                            (axr, "explicit / mean field (the square's heights)", "pull-off ratio")):
+        a_.set_xscale("log")
+        a_.set_yscale("log")
+        ticks = sorted({r["sigma"] for r in po if r["sigma"] > 0})
+        a_.set_xticks(ticks, [f"{s:g}" for s in ticks])
+        a_.minorticks_off()
+        a_.grid(True, which="major", color="0.9", lw=0.5)
+        a_.set_xlabel("sigma (rms / epsilon)")
+        a_.set_ylabel(ylab)
+        a_.set_title(title)
+        a_.legend(fontsize=6)
+    axr.axhline(1.0, color="0.6", lw=0.8)
+    from matplotlib.ticker import LogLocator, ScalarFormatter
+    axr.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    axr.yaxis.set_major_formatter(ScalarFormatter())
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)

@@ -1,7 +1,8 @@
 """docs/mean_field.md: how far the mean field holds, against explicit rough contacts solved by
 ContactMechanics + Adhesion (the ContactEngineering codes) in an environment of their own.
 
-The same sphere (mu = 1) on a few explicit rough surfaces.  Their side: an FFT elastic half-space (free,
+The same sphere (mu = 0.3, 1, 3: a case's fourth field, MU when it names none) on a few explicit rough
+surfaces.  Their side: an FFT elastic half-space (free,
 non-periodic), the explicit topography of sphere plus roughness, the Lennard-Jones 9-3 surface stress of our
 eq. (5) (their ``Lj82``), energy minimisation in displacement control (stable states only), approach and
 retract on a lattice of lambda.  Our side: the mean field of the same surface, its own pixel heights as the
@@ -22,7 +23,8 @@ against the roughness, with the seed-to-seed spread of the explicit runs as thei
 (``.venv-peer`` is the user's to make, not part of the repository.)  The first command runs this file as a
 script under the peer's interpreter: at module level it imports nothing but the standard library and numpy,
 and the peer's packages inside its functions; our side is :mod:`.mean_field`, which imports this module.  The peer's cases can be
-split over processes (``peer --cases 64:0.3:1,... --out part.json``, ``--retract``) and their files joined
+split over processes (``peer --cases 64:0.3:1,64:0.3:1:3,... --out part.json``, ``--retract
+64:0.3:1:0.5:-3.5:3``) and their files joined
 (``peer_rough.py merge --out docs/data/peer_rough.json part1.json part2.json ...``), as the stored file was.
 
 ``muFFT`` 0.95 (the last on the registry) is left out: installed beside muGrid 1.6 it replaces muGrid's
@@ -56,7 +58,8 @@ import time
 
 import numpy as np
 
-#: Tabor parameter of every run.
+#: Tabor parameter of a run that names none: the first set of runs (the stored file's runs without a "mu" are
+#: at this one).  A case's own mu is its fourth field (``--cases n:sigma:seed:mu``).
 MU = 1.0
 #: Half width of the square [-L, L]^2 (sqrt(R epsilon)); the contact (radius below 2.5 up to F = 0 at mu = 1)
 #: lies well inside, the traction beyond is the rigid far field.
@@ -80,6 +83,13 @@ DLAM, DLAM_FINE, F_STOP, START_GAP = 0.05, 0.01, 0.0, 2.6
 JUMP_DF = 0.05
 #: The linear core of the law below this gap (a line search guard, as peers.py; states are checked above it).
 R_TI = 0.5
+
+
+def start_gap(mu: float) -> float:
+    """The approach's start before the highest asperity under the sphere: START_GAP up to mu = 1, beyond it
+    START_GAP mu^0.8, so that the retraction, which ends there, passes the snap-off of a softer sphere (ours
+    of the smooth sphere at mu = 3 lies at lambda -4.99, the start at -6.3)."""
+    return START_GAP * max(1.0, mu) ** 0.8
 
 
 def surface(n: int, sigma: float, seed: int, half_width: float = L) -> np.ndarray:
@@ -137,19 +147,19 @@ def far_field_load(lam: float, F_raw: float, mu: float = MU, half_width: float =
 class PeerSystem:
     """One explicit rough sphere in ContactMechanics + Adhesion and its minimiser (peer's environment)."""
 
-    def __init__(self, n: int, sigma: float, seed: int, gtol_rel: float = 1e-4):
+    def __init__(self, n: int, sigma: float, seed: int, gtol_rel: float = 1e-4, mu: float = MU):
         from Adhesion.Interactions import Lj82
         from Adhesion.System import SmoothContactSystem
         from ContactMechanics import FreeFFTElasticHalfSpace
         from SurfaceTopography import Topography
-        self.n, self.sigma, self.seed = n, sigma, seed
+        self.n, self.sigma, self.seed, self.mu = n, sigma, seed, mu
         self.h = 2.0 * L / n
         x = -L + (np.arange(n) + 0.5) * self.h
         X, Y = np.meshgrid(x, x, indexing="ij")
         self.z = surface(n, sigma, seed)
         self.r = np.hypot(X, Y)
         topography = Topography(-(X ** 2 + Y ** 2) / 2.0 + self.z, physical_sizes=(2 * L, 2 * L))
-        substrate = FreeFFTElasticHalfSpace((n, n), MU ** -1.5, physical_sizes=(2 * L, 2 * L))
+        substrate = FreeFFTElasticHalfSpace((n, n), mu ** -1.5, physical_sizes=(2 * L, 2 * L))
         self.interaction = Lj82(1.0, 1.0).linearize_core(r_ti=R_TI)
         self.system = SmoothContactSystem(substrate, self.interaction, topography)
         # the settings of the package's own adhesive-sphere example (peers.py): stop on the gradient, the
@@ -171,7 +181,7 @@ class PeerSystem:
         if gap.min() <= R_TI:
             raise RuntimeError(f"the state at lambda = {lam} reaches the linear core (smallest gap {gap.min()})")
         F_raw = float(self.system.compute_normal_force()) / (2.0 * np.pi)
-        F_tail = far_field_load(lam, F_raw)
+        F_tail = far_field_load(lam, F_raw, self.mu)
         contact = gap < 1.5
         return dict(lam=float(lam), F=F_raw + F_tail, F_tail=F_tail, min_gap=float(gap.min()),
                     contact_pixels=int(contact.sum())), self.system.disp.copy()
@@ -200,16 +210,16 @@ def largest_jump(states):
     return dict(lam_from=a["lam"], lam_to=b["lam"], F_from=a["F"], F_to=b["F"], count=int((dF > JUMP_DF).sum()))
 
 
-def peer_curve(n: int, sigma: float, seed: int, log=print) -> dict:
+def peer_curve(n: int, sigma: float, seed: int, log=print, mu: float = MU) -> dict:
     """Approach from START_GAP before the highest asperity under the sphere (r < 2.5) until F >= F_STOP on a
     lattice of DLAM, retract on the same lattice to the start, the pull-off refined on DLAM_FINE about the
     lattice's most tensile state (warm-started down the retract leg from the state one step before it)."""
     t0, c0 = time.perf_counter(), time.process_time()
-    system = PeerSystem(n, sigma, seed)
+    system = PeerSystem(n, sigma, seed, mu=mu)
     top = float(system.z[system.r < 2.5].max())
-    k0 = int(np.floor((-START_GAP - top) / DLAM))
+    k0 = int(np.floor((-start_gap(mu) - top) / DLAM))
     lattice = DLAM * np.arange(k0, k0 + 100000)
-    log(f"n {n} sigma {sigma} seed {seed}: the highest asperity under the sphere {top:.3f}, "
+    log(f"mu {mu} n {n} sigma {sigma} seed {seed}: the highest asperity under the sphere {top:.3f}, "
         f"start {lattice[0]:.2f}")
     approach, disps = march(system, None, lattice, stop=lambda s: s["F"] >= F_STOP)
     back = [s["lam"] for s in approach[-2::-1]]
@@ -223,7 +233,7 @@ def peer_curve(n: int, sigma: float, seed: int, log=print) -> dict:
         lams = retract[i - 1]["lam"] - DLAM_FINE * np.arange(1, int(round(2 * DLAM / DLAM_FINE)))
         fine, _ = march(system, rdisps[i - 1], lams)
     best = min(retract + fine, key=lambda s: s["F"])
-    out = dict(n=n, sigma=sigma, seed=seed, digest=digest(system.z), top_under_sphere=top,
+    out = dict(n=n, sigma=sigma, seed=seed, mu=mu, digest=digest(system.z), top_under_sphere=top,
                top=float(system.z.max()), pixel=system.h,
                approach={k: [s[k] for s in approach] for k in approach[0]},
                retract={k: [s[k] for s in retract] for k in retract[0]},
@@ -239,13 +249,13 @@ def peer_curve(n: int, sigma: float, seed: int, log=print) -> dict:
     return out
 
 
-def peer_retract(n: int, sigma: float, seed: int, lam_hi: float, lam_lo: float, log=print) -> dict:
+def peer_retract(n: int, sigma: float, seed: int, lam_hi: float, lam_lo: float, log=print, mu: float = MU) -> dict:
     """The grid's refinement at a fifth of a curve's cost: the retraction alone, from a state in contact at
     lam_hi (a cold start, where the contact branch is the only state) down the lattice to lam_lo, the
     pull-off refined as :func:`peer_curve` does.  Run on both grids, its pull-off on the coarse one is the
     full curve's (the same branch), and the two grids' difference is the pixel's error."""
     t0, c0 = time.perf_counter(), time.process_time()
-    system = PeerSystem(n, sigma, seed)
+    system = PeerSystem(n, sigma, seed, mu=mu)
     lams = DLAM * np.arange(int(round(lam_hi / DLAM)), int(round(lam_lo / DLAM)) - 1, -1)
     retract, disps = march(system, None, lams)
     i = int(np.argmin([s["F"] for s in retract]))
@@ -254,13 +264,14 @@ def peer_retract(n: int, sigma: float, seed: int, lam_hi: float, lam_lo: float, 
         fine, _ = march(system, disps[i - 1],
                         retract[i - 1]["lam"] - DLAM_FINE * np.arange(1, int(round(2 * DLAM / DLAM_FINE))))
     best = min(retract + fine, key=lambda s: s["F"])
-    out = dict(n=n, sigma=sigma, seed=seed, digest=digest(system.z), pixel=system.h, lam_hi=lam_hi, lam_lo=lam_lo,
+    out = dict(n=n, sigma=sigma, seed=seed, mu=mu, digest=digest(system.z), pixel=system.h, lam_hi=lam_hi,
+               lam_lo=lam_lo,
                retract={k: [s[k] for s in retract] for k in retract[0]},
                pull_off=dict(F=best["F"], lam=best["lam"], F_lattice=retract[i]["F"], lam_lattice=retract[i]["lam"],
                              at_end=i in (0, len(retract) - 1)),
                solves=system.solves, iterations=system.iterations,
                wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0)
-    log(f"n {n} sigma {sigma} seed {seed} retract from {lam_hi}: pull-off F {best['F']:.5f} at lambda "
+    log(f"mu {mu} n {n} sigma {sigma} seed {seed} retract from {lam_hi}: pull-off F {best['F']:.5f} at lambda "
         f"{best['lam']:.3f}; {system.solves} solves, {out['cpu_time_s']:.1f} s CPU")
     return out
 
@@ -302,55 +313,88 @@ def _versions() -> dict:
     return out
 
 
+def run_mu(run: dict) -> float:
+    """A run's Tabor parameter: its own, or MU for the runs stored before the mu was a case's (they have none)."""
+    return float(run.get("mu", MU))
+
+
+def case_key(run: dict) -> tuple:
+    """What names a run: (n, sigma, seed, mu); a later run of the same case replaces it."""
+    return run["n"], run["sigma"], run["seed"], run_mu(run)
+
+
+def _order(run: dict) -> tuple:
+    return run_mu(run), run["sigma"], run["seed"], run["n"]
+
+
+def _parse(option: str, text: str, fields: int):
+    """``--cases``/``--retract``'s comma-separated cases of ``fields`` numbers and an optional mu > 0, or a
+    one-line refusal naming the option (ValueError)."""
+    accepts = {3: "n:sigma:seed[:mu]", 5: "n:sigma:seed:lam_hi:lam_lo[:mu]"}[fields]
+    out = []
+    for c in text.split(","):
+        f = c.split(":")
+        try:
+            if len(f) not in (fields, fields + 1):
+                raise ValueError
+            vals = [int(f[0]), float(f[1]), int(f[2])] + [float(x) for x in f[3:fields]]
+            mu = float(f[fields]) if len(f) > fields else MU
+            if not (vals[0] > 2 * M_HI and vals[1] >= 0.0 and np.isfinite(mu) and mu > 0.0):
+                raise ValueError
+        except ValueError:
+            raise ValueError(f"peer_rough.py: {option} accepts comma-separated {accepts} (n > {2 * M_HI}, "
+                             f"sigma >= 0, mu > 0), not {c!r}") from None
+        out.append(tuple(vals) + (mu,))
+    return out
+
+
 def peer_main(argv) -> int:
     """Their side: the curves asked for, each merged into the JSON file as it finishes."""
     p = argparse.ArgumentParser(prog="peer_rough.py peer")
     p.add_argument("--out", required=True)
     p.add_argument("--cases", default=None,
-                   help="n:sigma:seed,...: these curves (with neither option: every curve at N_MAIN, "
-                        "then the refinement)")
+                   help="n:sigma:seed[:mu],...: these curves (mu: MU unless given; with neither option: every "
+                        "curve at N_MAIN and MU, then the refinement)")
     p.add_argument("--retract", default=None,
-                   help="n:sigma:seed:lam_hi:lam_lo,...: the retraction alone (the grid's refinement)")
+                   help="n:sigma:seed:lam_hi:lam_lo[:mu],...: the retraction alone (the grid's refinement)")
     a = p.parse_args(argv)
     if a.retract is None and a.cases is None:     # the whole benchmark: the curves, then the refinement
-        peer_main(["--out", a.out, "--cases", ",".join(f"{N_MAIN}:{s}:{k}" for s in (0.0,) + SIGMAS
-                                                       for k in ((0,) if s == 0.0 else SEEDS))])
+        a.cases = ",".join(f"{N_MAIN}:{s}:{k}" for s in (0.0,) + SIGMAS for k in ((0,) if s == 0.0 else SEEDS))
         a.retract = ",".join(f"{n}:{s}:{k}:{hi}:{lo}" for s, k, hi, lo in REFINED for n in (N_MAIN, N_FINE))
-    if a.retract:
-        data = {"retract_runs": []}
-        if os.path.exists(a.out):
-            with open(a.out) as f:
-                data = json.load(f)
-        for c in a.retract.split(","):
-            n, s, k, hi, lo = c.split(":")
-            run = peer_retract(int(n), float(s), int(k), float(hi), float(lo))
-            run.update(versions=_versions(), date=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg=os.getloadavg())
-            data["retract_runs"] = [r for r in data.get("retract_runs", [])
-                                    if (r["n"], r["sigma"], r["seed"]) != (run["n"], run["sigma"], run["seed"])]
-            data["retract_runs"].append(run)
-            write_atomic(a.out, data)
-        return 0
-    cases = [(int(n), float(s), int(k)) for n, s, k in (c.split(":") for c in a.cases.split(","))]
-    data = {"runs": []}
+    try:          # every case checked before the first is run: a bad one runs nothing
+        cases = _parse("--cases", a.cases, 3) if a.cases else []
+        retracts = _parse("--retract", a.retract, 5) if a.retract else []
+    except ValueError as e:
+        print(e, file=sys.stderr)
+        return 2
+    data = {"runs": [], "retract_runs": []}
     if os.path.exists(a.out):
         with open(a.out) as f:
             data = json.load(f)
-    for n, s, k in cases:
-        run = peer_curve(n, s, k)
+    stamp = dict(mu=MU, L=L, modes=[M_LO, M_HI], hurst=HURST, dlam=DLAM, dlam_fine=DLAM_FINE, F_stop=F_STOP,
+                 description="ContactMechanics + Adhesion: an explicit rough sphere (FFT free half-space, Lj82, "
+                             "L-BFGS-B in displacement control); petsc_adhesion/benchmarks/peer_rough.py; "
+                             "a run without its own mu is at the mu here")
+    for n, s, k, mu in cases:
+        run = peer_curve(n, s, k, mu=mu)
         run.update(versions=_versions(), date=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg=os.getloadavg())
-        data["runs"] = [r for r in data.get("runs", []) if (r["n"], r["sigma"], r["seed"]) != (n, s, k)]
-        data["runs"].append(run)
-        data["runs"].sort(key=lambda r: (r["sigma"], r["seed"], r["n"]))
-        data.update(mu=MU, L=L, modes=[M_LO, M_HI], hurst=HURST, dlam=DLAM, dlam_fine=DLAM_FINE, F_stop=F_STOP,
-                    description="ContactMechanics + Adhesion: an explicit rough sphere (FFT free half-space, Lj82, "
-                                "L-BFGS-B in displacement control); petsc_adhesion/benchmarks/peer_rough.py")
+        data["runs"] = sorted([r for r in data.get("runs", []) if case_key(r) != case_key(run)] + [run], key=_order)
+        data.update(stamp)
+        write_atomic(a.out, data)
+    for n, s, k, hi, lo, mu in retracts:
+        run = peer_retract(n, s, k, hi, lo, mu=mu)
+        run.update(versions=_versions(), date=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg=os.getloadavg())
+        data["retract_runs"] = sorted([r for r in data.get("retract_runs", []) if case_key(r) != case_key(run)]
+                                      + [run], key=_order)
+        data.update(stamp)
         write_atomic(a.out, data)
     return 0
 
 
 def merge_main(argv) -> int:
     """``merge --out FILE A.json B.json ...``: the runs of several peer processes (each ran a part of the
-    cases, ``--cases``) in one file; a later file's run replaces an earlier one's of the same case."""
+    cases, ``--cases``) in one file; a later file's run replaces an earlier one's of the same case.  Every
+    run is written with its mu (a part's runs without one are at that part's ``mu``, MU in the first files)."""
     p = argparse.ArgumentParser(prog="peer_rough.py merge")
     p.add_argument("--out", required=True)
     p.add_argument("parts", nargs="+")
@@ -361,11 +405,14 @@ def merge_main(argv) -> int:
     for part in a.parts:
         with open(part) as f:
             d = json.load(f)
-        runs.update({(r["n"], r["sigma"], r["seed"]): r for r in d.pop("runs", [])})
-        retracts.update({(r["n"], r["sigma"], r["seed"]): r for r in d.pop("retract_runs", [])})
+        for kind, into in (("runs", runs), ("retract_runs", retracts)):
+            for r in d.pop(kind, []):
+                r.setdefault("mu", float(d.get("mu", MU)))
+                into[case_key(r)] = r
         data.update(d)
-    data["runs"] = sorted(runs.values(), key=lambda r: (r["sigma"], r["seed"], r["n"]))
-    data["retract_runs"] = sorted(retracts.values(), key=lambda r: (r["sigma"], r["seed"], r["n"]))
+    data["mu"] = MU
+    data["runs"] = sorted(runs.values(), key=_order)
+    data["retract_runs"] = sorted(retracts.values(), key=_order)
     write_atomic(a.out, data)
     return 0
 
