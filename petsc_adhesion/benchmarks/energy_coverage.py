@@ -5,6 +5,7 @@
     python -m petsc_adhesion.benchmarks.energy_coverage -case 1 0 0.05   # one case (mu sigma K|rigid), printed
     python -m petsc_adhesion.benchmarks.energy_coverage -mu 5 -jobs 1    # the cases of mu = 5 only (-sigma S
                                    # too), one at a time (their stored rows replaced, the others kept)
+    python -m petsc_adhesion.benchmarks.energy_coverage -program -mu 3 5 -jobs 1   # their program's part again
 
 For each case (mu, sigma, machine: the rigid machine or a spring of stiffness
 K) the program's energy of one approach-retract cycle and its bar are those of
@@ -543,19 +544,24 @@ def main(argv: list[str]) -> int:
         run = case if argv[0] == "-case" else program_case
         print(json.dumps(run(float(argv[1]), float(argv[2]), K)))
         return 0
+    from .selection import selected
     if argv[:1] == ["-program"]:
-        # each case stored as soon as it is done (cheapest first), the others marked not measured again, so
-        # that a run cut short leaves a table of what it measured
+        # the cases chosen (-mu, -sigma; all without), each stored as soon as it is done (cheapest first), the
+        # others of them marked not measured again, so that a run cut short leaves a table of what it measured
+        chosen, jobs = selected(argv[1:], CASES)
+        if chosen is None:
+            print(f"energy_coverage: {jobs}", file=sys.stderr)
+            return 2
         with open(DATA) as f:
             data = json.load(f)
         if "truth" not in data["made"]:
             data["made"] = {"study_s": data["made"].get("study_s"),
                             "truth": {k: data["made"].get(k) for k in ("commit", "changed")}}
-        rows = [r | {"stale": True} for r in data["rows"]]
+        rows = [r | {"stale": True} if (r["mu"], r["sigma"], r["K"]) in chosen else r for r in data["rows"]]
         where = {(r["mu"], r["sigma"], r["K"]): i for i, r in enumerate(rows)}
-        order = sorted(CASES, key=lambda c: (c[0], c[2] is not None, c[1]))
+        order = sorted(chosen, key=lambda c: (c[0], c[2] is not None, c[1]))
         t = time.perf_counter()
-        with ThreadPoolExecutor(2) as pool:
+        with ThreadPoolExecutor(jobs) as pool:
             for c, p in zip(order, pool.map(_run_program, order)):
                 i = where[c]
                 rows[i] = p if "failed" in p else merged({k: v for k, v in rows[i].items() if k != "stale"}, p)
@@ -564,7 +570,6 @@ def main(argv: list[str]) -> int:
                     json.dump({"made": data["made"], "rows": rows}, f, indent=1)
                 os.replace(DATA + ".part", DATA)
     elif argv[:1] != ["-table"]:
-        from .selection import selected
         cases, jobs = selected(argv, CASES)
         if cases is None:
             print(f"energy_coverage: {jobs}", file=sys.stderr)
