@@ -20,13 +20,7 @@ Where that extrapolation's own bar is not well below the program's bar
 (:data:`RESOLVE`), level 3 is traced too when affordable and levels 1, 2, 3
 are used; else the case is reported as "truth not resolved".
 
-Each case runs in a process of its own (PETSc started there), two at a time.
-The program's bar is split into its three terms (the jumps' c-errors, the
-stretches' F-errors and the quadrature's estimate) by wrapping
-:func:`~petsc_adhesion.tracing.energy.energy_bar` in the case's process; the
-true error is split into the quadrature's (the program's value against the
-same grid's value with the tight tolerance) and the grid's (the rest), and the
-grid's jump part is measured from each jump's c at the levels.
+Each case runs in a process of its own (PETSc started there), two at a time unless ``-jobs`` says.
 """
 from __future__ import annotations
 
@@ -260,34 +254,21 @@ def derived(row: dict) -> dict:
             "covered": bool(err <= bar) if bar is not None and row["resolved"] else None}
 
 
-def _run(c) -> dict:
+def _run(c, flag: str = "-case") -> dict:
+    """One case in a process of its own: whole (``-case``) or the program's part (``-program-case``)."""
     mu, sigma, K = c
     t = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.energy_coverage", "-case", f"{mu:g}",
+    proc = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.energy_coverage", flag, f"{mu:g}",
                            f"{sigma:g}", "rigid" if K is None else f"{K:g}"],
                           capture_output=True, text=True, cwd=paths.ROOT)
     if proc.returncode:
         return {"mu": mu, "sigma": sigma, "K": K, "failed": proc.stderr.strip().splitlines()[-1:],
                 "time": {"process_s": time.perf_counter() - t}}
     row = json.loads(proc.stdout.strip().splitlines()[-1])
-    row["time"]["process_s"] = time.perf_counter() - t
-    print(f"mu = {mu:g}, sigma = {sigma:g}, {_machine(row)}: {row['time']['process_s']:.0f} s", file=sys.stderr,
-          flush=True)
-    return row
-
-
-def _run_program(c) -> dict:
-    mu, sigma, K = c
-    t = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.energy_coverage", "-program-case",
-                           f"{mu:g}", f"{sigma:g}", "rigid" if K is None else f"{K:g}"],
-                          capture_output=True, text=True, cwd=paths.ROOT)
-    if proc.returncode:
-        return {"mu": mu, "sigma": sigma, "K": K, "failed": proc.stderr.strip().splitlines()[-1:],
-                "time": {"process_s": time.perf_counter() - t}}
-    row = json.loads(proc.stdout.strip().splitlines()[-1])
-    print(f"mu = {mu:g}, sigma = {sigma:g}, {_machine(row)}: {time.perf_counter() - t:.0f} s (program)",
-          file=sys.stderr, flush=True)
+    if flag == "-case":
+        row["time"]["process_s"] = time.perf_counter() - t
+    print(f"mu = {mu:g}, sigma = {sigma:g}, {_machine(row)}: {time.perf_counter() - t:.0f} s"
+          + ("" if flag == "-case" else " (program)"), file=sys.stderr, flush=True)
     return row
 
 
@@ -423,7 +404,7 @@ def _again(rows: list) -> str:
 def _offsets(diag: list) -> str:
     """Where the bar's other level k is one the truth traced whole too: the loop put point by point on level k
     (the program's E_k) against the whole level-k trace's energy, beside E_0 - E_k, per case."""
-    out = []
+    out, sizes = [], []
     for d in diag:
         r = d["row"]
         lv = {int(k): v for k, v in r["bar_levels"].items()}
@@ -431,9 +412,10 @@ def _offsets(diag: list) -> str:
         whole = r["levels"].get(str(k))
         if whole is None or whole.get("energy") is None:
             continue
+        sizes.append(abs(ek - whole["energy"]))
         out.append(f"{_where(r)}: {ek - whole['energy']:+.1e} against E_0 - E_{k} = {lv[0] - ek:+.1e} "
                    f"(bar / |error| {r['ratio']:.3g})")
-    return "; ".join(out) or "none"
+    return "; ".join(out) + f" (the largest difference {max(sizes):.1e})" if out else "none"
 
 
 def section(rows: list, made: dict | None = None) -> str:
@@ -522,17 +504,24 @@ than 5 times the error: {loose}.  In {blurred} cases the error is below the trut
 bar / |error| is uncertain; bar / (|error| + truth's bar), a lower bound of the ratio wherever the
 truth's bar holds, is {safe}.
 
-Why the widest are wide, measured where the bar's level is one the truth traced whole too (level 1,
-at mu = 3 and 5): the loop put point by point on the level-1 grids of the program's segments, against the
-whole curve traced on level 1 (its own segments, grids centred where it moved them): {offsets}.  At
-sigma = 0 (mu = 3 and 5) the two level-1 energies differ by -1.4e-4 to -2.3e-4, one sign in every
-case and about as much as E_0 and E_1 do: the bar there measures that offset, not the grid's h^2
-change, and where it is widest (mu = 3, K = 0.05 aside) the level-0 error is 3 to 10 times smaller
-than E_0 - E_1.  The offset's cause is not
-yet isolated (the level's grids are placed by the level-0 curve's segments, the whole trace's by its
-own); tightening these bars needs it found and the program's part measured again.  At mu = 2 (the level -1) the coarse level's error is 30 times the level-0
-error where the bar is widest (mu = 2, sigma = 0.2, rigid: E_-1 - E_0 = 1.4e-5, the error 4.3e-7),
-not 4 times: a level not yet in the asymptotic range, which two levels cannot show.
+Why the widest were wide, measured where the bar's level is one the truth traced whole too (level 1,
+at mu = 3 and 5): the bar's loop on level 1 against the whole curve traced on level 1 (its own segments,
+grids centred where it moved them), beside E_0 - E_1: {offsets}.  Before commit 076a832 the two
+level-1 energies differed by -1.4e-4 to -2.3e-4 at sigma = 0 (one sign in every case, about as much as
+E_0 - E_1; bar / |error| 90th percentile 29, the widest 40.8): the bar measured that offset.  Its cause:
+where the trace passes from one segment's grid to the next, it carries the last point over by a
+zero-length arclength correction, which slides along the curve by the tangential part of the
+interpolation's error, and the quadrature does no work over that step (the two ends are one state), so
+the slide's work is left out (mu = 5, sigma = 0, rigid: 7.3e-5 and 9.8e-5 at the loop's two handovers on
+level 0, 1.9e-5 and 2.5e-5 on level 1, falling like h^2: part of each level's grid error).  The level's
+loop carried both ends of every handover from level 0 and so kept level 0's slides, not its own.  A
+defect, not another valid discretization: the level's loop is meant to be that level's curve under the
+same quadrature, and level 0's slides do not shrink with the level.  Now a segment's first point is
+carried on the level from the previous segment's last point there, as the trace carried it.
+
+At mu = 2 (the level -1) the coarse level's error is 30 times the level-0 error where the bar was
+widest before (mu = 2, sigma = 0.2, rigid: E_-1 - E_0 = 1.4e-5, the error 4.3e-7), not 4 times: a level
+not yet in the asymptotic range, which two levels cannot show.
 """
 
 
@@ -562,7 +551,7 @@ def main(argv: list[str]) -> int:
         order = sorted(chosen, key=lambda c: (c[0], c[2] is not None, c[1]))
         t = time.perf_counter()
         with ThreadPoolExecutor(jobs) as pool:
-            for c, p in zip(order, pool.map(_run_program, order)):
+            for c, p in zip(order, pool.map(lambda c: _run(c, "-program-case"), order)):
                 i = where[c]
                 rows[i] = p if "failed" in p else merged({k: v for k, v in rows[i].items() if k != "stale"}, p)
                 data["made"] |= {"program_s": time.perf_counter() - t, **paths.source()}
