@@ -345,6 +345,12 @@ def table(rows: list, made: dict | None = None) -> str:
     lines.append("\nNo bar (an energy with hysteresis reported without one): "
                  + ("; ".join(barless) if barless else "none") + ".")
     lines.append("\nTruth not resolved: " + ("; ".join(unresolved) if unresolved else "none") + ".")
+    # where the truth's own bar is known, it may still decide: |error| + its bar within the bar, or beyond it
+    judged = [r for r in rows if "failed" not in r and not r["resolved"] and r["truth"] is not None and r["bar"]]
+    for verdict, test in (("covered", lambda r: r["error"] + r["truth_bar"] <= r["bar"]),
+                          ("missed", lambda r: r["error"] - r["truth_bar"] > r["bar"])) if judged else ():
+        lines.append(f"Of these, {verdict} even with the truth's bar: "
+                     + ("; ".join(_where(r) for r in judged if test(r)) or "none") + ".")
     if failed:
         lines.append("\nFailed: " + "; ".join(failed) + ".")
     if stale:
