@@ -293,7 +293,7 @@ def table(rows: list, made: dict | None = None) -> str:
     """The per-case table, the summary line and the cost, from the study's rows (those not measured again
     since the bar changed, ``stale``, named apart)."""
     stale = [r for r in rows if r.get("stale")]
-    rows = [r for r in rows if not r.get("stale")]
+    rows = [r for r in rows if not r.get("stale") or "failed" in r]        # a failed case stays under Failed
     lines = ["| mu | sigma | machine | loops | energy (program) | bar | truth | truth's bar | levels | \\|error\\| | "
              "bar / \\|error\\| | covered | bar's levels (old bound / \\|error\\|) | curve (s) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -399,7 +399,7 @@ def _again(rows: list) -> str:
     by: dict = {}
     for r in (r for r in rows if r.get("source")):
         by.setdefault((r["source"].get("commit") or "?")[:7], set()).add(r["mu"])
-    return "".join(f"; the cases of mu = {', '.join(f'{m:g}' for m in sorted(mus))}, program and truth, at commit {c}"
+    return "".join(f"; the truths of mu = {', '.join(f'{m:g}' for m in sorted(mus))} traced again at commit {c}"
                    for c, mus in sorted(by.items()))
 
 
