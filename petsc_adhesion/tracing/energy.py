@@ -25,7 +25,11 @@ smooth through the folds, where lambdadot = 0), by 3-point Gauss-Legendre,
 exact for that interpolant; behind a spring, F dZ = F dlambda + d(F^2) / (2K)
 exactly.  The
 step between two grids (a point carried to the next segment's grid) adds
-nothing: its two ends are one state on two discretizations.
+nothing: its two ends are one state on two discretizations, up to the carry's
+slide along the curve (the tangential part of the interpolation's error, which
+falls like h^2: at mu = 5, sigma = 0 the work it leaves out is 7.3e-5 on the
+default grids, 1.9e-5 on grids twice as fine), part of the grid's error that the
+levels of the bar measure, each level carrying its own handovers.
 
 The error bar comes from the loops on the nested levels of the events' error
 bars (:func:`~petsc_adhesion.tracing.error_bars.energy_levels`): the borders'
@@ -339,7 +343,7 @@ def border_integral(result: Loop, points: dict, weight: float) -> float:
     total = 0.0
     for i, j, k in result.pieces:
         for n in range(i, j):
-            if nodes[n].seg != nodes[n + 1].seg:            # between two grids: one state, no work
+            if nodes[n].seg != nodes[n + 1].seg:            # between two grids: one state, no work (but its slide)
                 continue
             chain = [points[n, -1]] + [points[n, m] for m in range(len(inner.get(n, ())))] + [points[n + 1, -1]]
             total += k * sum(_integral(a, b, weight) for a, b in zip(chain, chain[1:]))
