@@ -38,7 +38,7 @@ import numpy as np
 
 from ..brent import root
 
-__all__ = ["width", "NotMonotone", "Sampled", "coordinate", "sample", "stretch", "unstretch"]
+__all__ = ["width", "NotMonotone", "Sampled", "coordinate", "rising", "sample", "stretch", "unstretch"]
 
 
 
@@ -53,6 +53,22 @@ def coordinate(H0: np.ndarray, a: np.ndarray) -> np.ndarray:
     """s = a^2 / 2 - H(0) at each point (module docstring)."""
     return 0.5 * np.asarray(a, dtype=float) ** 2 - np.asarray(H0, dtype=float)
 
+
+
+def rising(s: np.ndarray) -> tuple[np.ndarray, float]:
+    """(the indices of the points of ``s`` that rise along the curve, the largest fall of a point left out, as a
+    share of s's range).  A point of another grid at the state just before (a regrid), a hair before or behind
+    the last kept one, is left out; a fall larger than a hair says the coordinate is not monotone there."""
+    span = float(s.max() - s.min()) if s.size else 0.0
+    gaps = np.diff(s)
+    least = 1e-3 * float(np.median(gaps[gaps > 0])) if (gaps > 0).any() else 0.0
+    kept, fall = [0], 0.0
+    for i in range(1, s.size):
+        if s[i] > s[kept[-1]] + least:
+            kept.append(i)
+        else:
+            fall = max(fall, float(s[kept[-1]] - s[i]))
+    return np.asarray(kept, dtype=int), (fall / span if span > 0 else 0.0)
 
 def stretch(s, s0: float, s_lo: float, s_hi: float, delta: float):
     """tau of s (module docstring): -1 at s_lo, 0 at s0, 1 at s_hi."""
@@ -100,18 +116,10 @@ def sample(lam, F, H0, a, level: float, F_max: float, tau: np.ndarray, mu: float
         own = ~np.asarray(regrid, dtype=bool)
         lam, F, H0, a = lam[own], F[own], H0[own], a[own]
     s = coordinate(H0, a)
-    span = float(s.max() - s.min())
-    gaps = np.diff(s)
-    least = 1e-3 * float(np.median(gaps[gaps > 0])) if (gaps > 0).any() else 0.0
-    kept, fall = [0], 0.0
-    for i in range(1, s.size):
-        # a point of another grid at the state just before (a regrid), a hair before or behind it: left out
-        if s[i] > s[kept[-1]] + least:
-            kept.append(i)
-        else:
-            fall = max(fall, float(s[kept[-1]] - s[i]))
-    if fall > 1e-4 * span:
-        raise NotMonotone(f"s = a^2/2 - H(0) falls by {fall:.3g} along the curve ({fall / span:.2g} of its range)")
+    kept, fall = rising(s)
+    if fall > 1e-4:
+        span = float(s.max() - s.min())
+        raise NotMonotone(f"s = a^2/2 - H(0) falls by {fall * span:.3g} along the curve ({fall:.2g} of its range)")
     s, lam, F = s[kept], lam[kept], F[kept]
     over = np.flatnonzero(F >= F_max)
     if not over.size or over[0] == 0:

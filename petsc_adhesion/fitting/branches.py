@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..family.coordinate import coordinate, stretch, width
+from ..family.coordinate import coordinate, rising, stretch, width
 from ..family.legs import Legs
 from ..family.table import FamilyCurve
 from ..tracing.measured import Missing
@@ -86,16 +86,8 @@ class SolverBranch:
         lam, F = np.asarray(b.lam, float)[own], np.asarray(b.F, float)[own]
         if s.size < 4:
             return None
-        span = float(s.max() - s.min())
-        gaps = np.diff(s)
-        least = 1e-3 * float(np.median(gaps[gaps > 0])) if (gaps > 0).any() else 0.0
-        kept, fall = [0], 0.0
-        for i in range(1, s.size):
-            if s[i] > s[kept[-1]] + least:
-                kept.append(i)
-            else:
-                fall = max(fall, float(s[kept[-1]] - s[i]))
-        if fall > 1e-4 * span or len(kept) < 4:
+        kept, fall = rising(s)
+        if fall > 1e-4 or len(kept) < 4:
             return None
         s, lam, F = s[kept], lam[kept], F[kept]
         m = curve.model
