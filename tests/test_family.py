@@ -2,6 +2,7 @@
 nodes reproducing the solver's sampled curves to round-off, its off-node curves within the error it measured,
 its legs behind a spring against fitting/forward.py's on the same curve, its refusals and its file."""
 import math
+import re
 
 import numpy as np
 import pytest
@@ -195,6 +196,70 @@ def test_a_file_of_another_version_or_no_table_is_one_line(table, tmp_path):
     (tmp_path / "x.npz").write_text("no table")
     with pytest.raises(ValueError, match="not a curve family table"):
         FamilyTable.load(str(tmp_path / "x.npz"))
+
+
+def _damaged(src, tmp_path):
+    """(name, path, what the refusal says) of copies of the table file ``src``, each damaged one way."""
+    raw = open(src, "rb").read()
+    with np.load(src) as z:
+        good = dict(z)
+
+    def changed(name, **arrays):
+        d = {k: v for k, v in {**good, **arrays}.items() if v is not None}
+        np.savez(str(tmp_path / name), **d)
+        return str(tmp_path / name)
+
+    def written(name, data):
+        (tmp_path / name).write_bytes(data)
+        return str(tmp_path / name)
+
+    middle = bytearray(raw)
+    middle[len(raw) // 3:len(raw) // 3 + 200] = bytes(200)
+    return [
+        ("text", written("text.npz", b"no table"), r"\(not an \.npz archive\)$"),
+        ("empty", written("empty.npz", b""), r"\(not an \.npz archive\)$"),
+        ("truncated", written("half.npz", raw[:len(raw) // 2]), r"\(a truncated or corrupted \.npz archive: "),
+        ("corrupted", written("mid.npz", bytes(middle)), r"\(a truncated or corrupted \.npz archive: "),
+        ("no file", str(tmp_path / "absent.npz"), r"No such file or directory"),
+        ("kind", changed("kind.npz", format=np.array("petsc-adhesion something else")), r"\(no format '"),
+        ("version", changed("v.npz", format_version=np.array(7)),
+         r"of format version 7; this program reads version 1 \(rebuild it\)$"),
+        ("no version", changed("nov.npz", format_version=None), r"without an integer format version; this program "),
+        ("text version", changed("sv.npz", format_version=np.array("1")), r"without an integer format version"),
+        ("no mu", changed("nomu.npz", mu=None), r"without the array mu \(rebuild it\)$"),
+        ("no roughness, sigma", changed("nors.npz", roughness=None, sigma=None),
+         r"without the arrays sigma, roughness \(rebuild it\)$"),
+    ]
+
+
+@pytest.mark.parametrize("which", ["family", "pull-off"])
+def test_every_damaged_table_file_is_one_line_naming_it(which, tmp_path):
+    """Both tables' files read through family/table.py's load_npz: a file that is no table of this program's
+    format and version, or lacks an array, or is no .npz, truncated or corrupted, is a ValueError of one line
+    that begins with the file and says which; the file undamaged reads back the same values."""
+    from petsc_adhesion.family.pull_off import DEFAULT_PATH, PullOffTable
+    from petsc_adhesion.family.table import shipped_path
+
+    cls, src, kind = (FamilyTable, shipped_path("smooth"), "curve family table") if which == "family" else \
+        (PullOffTable, DEFAULT_PATH, "pull-off table")
+    seen = set()
+    for name, path, says in _damaged(src, tmp_path):
+        with pytest.raises(ValueError) as e:
+            cls.load(path)
+        msg = str(e.value)
+        assert "\n" not in msg and msg.startswith(f"{path}: ") and kind in msg, (name, msg)
+        assert re.search(says, msg), (name, msg)
+        seen.add(msg)
+    assert len(seen) == 11                  # each damage said in its own words
+    a, b = cls.load(src), cls.load(changed_copy(src, tmp_path))
+    assert np.array_equal(a.mu, b.mu) and np.array_equal(a.F, b.F) and a.roughness == b.roughness
+
+
+def changed_copy(src, tmp_path):
+    """``src`` read and written again with numpy (uncompressed): the same arrays in another archive."""
+    with np.load(src) as z:
+        np.savez(str(tmp_path / "again.npz"), **dict(z))
+    return str(tmp_path / "again.npz")
 
 
 def test_a_failed_save_leaves_the_earlier_file(table, tmp_path, monkeypatch):

@@ -11,7 +11,7 @@ import pytest
 from conftest import ROOT, run_cli
 from test_hostile import listing, one_line
 
-from petsc_adhesion.family.table import shipped
+from petsc_adhesion.family.table import shipped, shipped_path
 from petsc_adhesion.fitting import table_search
 from petsc_adhesion.fitting.curve_fit import CurveFitError, TableStep, fit_curve
 from petsc_adhesion.fitting.forward import table_covers
@@ -105,16 +105,19 @@ def test_what_the_table_does_not_hold_goes_through_the_solver():
 def test_a_table_that_is_none_is_refused(tmp_path):
     """-fit_table: a file that is no table, in one line naming the option, exit 2, nothing written; in the
     library a CurveFitError; and -fit_table with a pull-off is refused as every option of -fit_curve."""
-    bad = tmp_path / "bad.npz"
+    bad, half = tmp_path / "bad.npz", tmp_path / "half.npz"
     bad.write_bytes(b"not a table")
+    raw = open(shipped_path("smooth"), "rb").read()
+    half.write_bytes(raw[:len(raw) // 2])           # a table cut short (a copy interrupted)
     out = tmp_path / "out"
     out.mkdir()
-    p = run_cli("-fit_curve", GOLDEN_CURVE, *TIP_ARGS, "-phys_spring", "1", "-fit_table", bad,
-                "-summary", out / "f.json")
-    msg = one_line(p)
-    assert msg.startswith("-fit_table: ") and "not a curve family table" in msg and \
-        msg.endswith("expected a table file, default or none"), msg
-    assert listing(out) == []
+    for given, why in ((bad, "(not an .npz archive)"), (half, "(a truncated or corrupted .npz archive: ")):
+        p = run_cli("-fit_curve", GOLDEN_CURVE, *TIP_ARGS, "-phys_spring", "1", "-fit_table", given,
+                    "-summary", out / "f.json")
+        msg = one_line(p)
+        assert msg.startswith(f"-fit_table: {given}: not a curve family table {why}") and \
+            msg.endswith("expected a table file, default or none"), msg
+        assert listing(out) == []
     p = run_cli("-fit_pull_off", "12e-9", *TIP_ARGS, "-phys_young1", "150e9", "-phys_poisson1", "0.27",
                 "-fit_table", "none", "-summary", out / "f.json")
     assert one_line(p) == "-fit_table: only with -fit_curve"

@@ -222,14 +222,13 @@ class PullOffTable:
     @classmethod
     def load(cls, path: str) -> PullOffTable:
         """The table in ``path``; ValueError, one line, for a file that is no pull-off table of this version."""
-        d = load_npz(path, "pull-off table")
-        if str(d.get("format", "")) != FORMAT:
-            raise ValueError(f"{path}: not a pull-off table (no format '{FORMAT}')")
-        if int(d["format_version"]) != FORMAT_VERSION:
-            raise ValueError(f"{path}: a pull-off table of format version {int(d['format_version'])}; this program "
-                             f"reads version {FORMAT_VERSION} (rebuild it)")
-        return cls(**{k: d[k] for k in cls._ARRAYS}, roughness=str(d["roughness"]), F_stop=float(d["F_stop"]),
-                   version=str(d["program_version"]))
+        d = load_npz(path, "pull-off table", FORMAT, FORMAT_VERSION,
+                     (*cls._ARRAYS, "roughness", "F_stop", "program_version"))
+        try:
+            return cls(**{k: d[k] for k in cls._ARRAYS}, roughness=str(d["roughness"]), F_stop=float(d["F_stop"]),
+                       version=str(d["program_version"]))
+        except (ValueError, TypeError) as e:      # the arrays there, but not a table's (the constructor's checks)
+            raise ValueError(f"{path}: {e}") from None
 
     @classmethod
     def default(cls) -> PullOffTable:

@@ -25,6 +25,8 @@ from __future__ import annotations
 import functools
 import math
 import os
+import zipfile
+import zlib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -222,6 +224,10 @@ class FamilyTable:
         return FamilyCurve(float(mu), float(sigma), self.tau, lam, F, self.F_max, self.error(mu, sigma))
 
     # -- the file ----------------------------------------------------------------------
+    #: The arrays a table's file holds beside its format and version.
+    _ARRAYS = ("mu", "sigma", "tau", "lam", "F", "s_lo", "s_hi", "s0", "delta", "F_max", "roughness",
+               "program_version", "seconds", "springs", "err_mu", "err_sigma", *(f"err_{f}" for f in ERROR_FIELDS))
+
     def save(self, path: str) -> None:
         """Write the table to ``path`` (.npz), all or nothing: a temporary file beside it, renamed over it."""
         arrays = dict(format=np.array(FORMAT), format_version=np.array(FORMAT_VERSION),
@@ -236,12 +242,7 @@ class FamilyTable:
     @classmethod
     def load(cls, path: str) -> FamilyTable:
         """The table in ``path``; ValueError, one line, for a file that is no table of this format version."""
-        d = load_npz(path, "curve family table")
-        if str(d.get("format", "")) != FORMAT:
-            raise ValueError(f"{path}: not a curve family table (no format '{FORMAT}')")
-        if int(d["format_version"]) != FORMAT_VERSION:
-            raise ValueError(f"{path}: a curve family table of format version {int(d['format_version'])}; this "
-                             f"program reads version {FORMAT_VERSION} (rebuild it)")
+        d = load_npz(path, "curve family table", FORMAT, FORMAT_VERSION, cls._ARRAYS)
         errors = {f: d[f"err_{f}"] for f in ERROR_FIELDS} if d["err_mu"].size else {}
         return cls(mu=d["mu"], sigma=d["sigma"], tau=d["tau"], lam=d["lam"], F=d["F"], s_lo=d["s_lo"],
                    s_hi=d["s_hi"], s0=d["s0"], delta=d["delta"], F_max=float(d["F_max"]),
@@ -370,11 +371,38 @@ def save_npz(path: str, arrays: dict) -> None:
             os.remove(tmp)
 
 
-def load_npz(path: str, what: str) -> dict:
-    """Every array of the .npz ``path``; ValueError, one line naming ``what`` it should be, for a file numpy cannot
-    read as one (no pickles: a table is data)."""
+def load_npz(path: str, kind: str, fmt: str, version: int, names: tuple[str, ...]) -> dict:
+    """The arrays of the .npz ``path`` that holds a ``kind`` (a table's name in a message) written as format ``fmt``
+    of ``version`` with at least the arrays ``names``; ValueError, one line beginning with ``path``, for a file that
+    is none: not an .npz archive (numpy would read any other file as a pickle, and a table is data: no pickles),
+    truncated or corrupted, of another format or version, or missing one of the arrays (both tables' loaders)."""
+    d = None
     try:
-        with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
-    except (OSError, ValueError, EOFError) as e:
-        raise ValueError(f"{path}: not a {what} ({str(e).splitlines()[0] if str(e) else type(e).__name__})") from None
+        # np.load reads a file that is neither .npz nor .npy as a pickle: the zip's own signature decides first.
+        with open(path, "rb") as fh:
+            zipped = fh.read(4) in (b"PK\x03\x04", b"PK\x05\x06")
+        if zipped:
+            with np.load(path, allow_pickle=False) as z:
+                d = {k: z[k] for k in z.files}
+        why = "not an .npz archive"
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as e:
+        # Truncated: BadZipFile; a member corrupted: zlib.error or a CRC's BadZipFile; unreadable: OSError.
+        why = str(e).splitlines()[0] if str(e) else type(e).__name__
+        if isinstance(e, (zipfile.BadZipFile, zlib.error, EOFError)):
+            why = f"a truncated or corrupted .npz archive: {why}"
+    if d is None:
+        raise ValueError(f"{path}: not a {kind} ({why})")
+    if str(d.get("format", "")) != fmt:
+        raise ValueError(f"{path}: not a {kind} (no format '{fmt}')")
+    got = d.get("format_version")
+    if got is None or got.shape != () or got.dtype.kind not in "iu":
+        raise ValueError(f"{path}: a {kind} without an integer format version; this program reads version "
+                         f"{version} (rebuild it)")
+    if int(got) != version:
+        raise ValueError(f"{path}: a {kind} of format version {int(got)}; this program reads version {version} "
+                         f"(rebuild it)")
+    missing = [k for k in names if k not in d]
+    if missing:
+        raise ValueError(f"{path}: a {kind} without the array{'s' if len(missing) > 1 else ''} "
+                         f"{', '.join(missing)} (rebuild it)")
+    return d
