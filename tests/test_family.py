@@ -296,6 +296,8 @@ def test_an_unmeasured_table_says_its_error_is_missing():
     (["build", "--out", "no/such/t.npz"], "--out no/such/t.npz: no folder"),
     (["build", "--out", "t.npz", "--n-tau", "x"], "argument --n-tau: invalid int value: 'x'"),
     (["speed", "t.npz"], "t.npz: not a curve family table"),
+    ([], "benchmarks.family: the following arguments are required: command"),
+    (["measure"], "benchmarks.family: the following arguments are required: table"),
 ])
 def test_the_builder_s_bad_input_is_one_line_and_writes_nothing(tmp_path, args, says):
     """The builder refuses what it cannot build before any trace: one line, exit 2, no file."""

@@ -238,3 +238,24 @@ def test_a_built_tables_nodes_resume_a_larger_build(tmp_path):
                                                           for m in TABLE.mu for s in TABLE.sigma])
     for name in ("F", "F_err", "F_grid", "lam", "lam_err", "seconds"):
         assert np.array_equal(getattr(again, name), getattr(TABLE, name)), name
+
+
+@pytest.mark.parametrize("args, says", [
+    ([], "benchmarks.pull_off: the following arguments are required: command"),
+    (["build", "--mu", "x"], "benchmarks.pull_off: argument --mu: invalid float value: 'x'"),
+    (["seed", "--out"], "benchmarks.pull_off: argument --out: expected one argument"),
+    (["report", "no/such.npz"], "benchmarks.pull_off: no/such.npz: not a pull-off table ("),
+])
+def test_the_builder_s_bad_input_is_one_line_and_writes_nothing(tmp_path, args, says):
+    """The pull-off table's builder refuses bad arguments, its subcommands' among them, in one line naming
+    itself, exit 2, no file."""
+    import subprocess
+    import sys
+
+    from conftest import _env
+
+    p = subprocess.run([sys.executable, "-m", "petsc_adhesion.benchmarks.pull_off", *args], cwd=tmp_path,
+                       capture_output=True, text=True, env=_env(), timeout=300)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.count("\n") == 1 and p.stderr.startswith(f"petsc-adhesion: {says}"), p.stderr
+    assert list(tmp_path.iterdir()) == []

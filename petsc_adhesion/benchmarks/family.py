@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import say
 from ..family.build import F_MAX, TableGrid, build, log_nodes, node_cost, regrid_points, spread, trace_node
 from ..family.table import APPROACH, ERROR_FIELDS, RETRACT, FamilyTable, OutOfRange
+from ._args import OneLineParser
 
 #: The springs the error is measured behind (units 2 pi R w / epsilon): very soft and soft (jumps far out, the
 #: rigid sphere's law), middling.  K = 10 (stiff: the legs follow the curve's folds) is left out: on a 20 nm tip
@@ -290,12 +291,7 @@ def speed(table: FamilyTable, repeats: int = 20, out=print) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    class OneLine(argparse.ArgumentParser):
-        def error(self, message):
-            say(f"benchmarks.family: {message}")
-            sys.exit(2)
-
-    p = OneLine(prog="python -m petsc_adhesion.benchmarks.family")
+    p = OneLineParser(prog="python -m petsc_adhesion.benchmarks.family", label="benchmarks.family")
     sub = p.add_subparsers(dest="command", required=True)
     b = sub.add_parser("build")
     b.add_argument("--out", required=True)
@@ -323,8 +319,6 @@ def _parser() -> argparse.ArgumentParser:
     s = sub.add_parser("speed")
     s.add_argument("table")
     s.add_argument("--repeats", type=int, default=20)
-    for q in (b, m, s, sp, j):
-        q.error = p.error                                 # type: ignore[method-assign]
     return p
 
 

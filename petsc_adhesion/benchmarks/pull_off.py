@@ -35,6 +35,7 @@ import numpy as np
 from ..errors import say
 from ..family.pull_off import DEFAULT_PATH, NodeValue, PullOffTable, trace_pull_off
 from ..tracing.measured import Measured
+from ._args import OneLineParser
 
 #: The sigma nodes: the pull-off falls fastest between 0.1 and 0.4 (from 0.92 to 0.18 of the smooth one at mu =
 #: 0.01), its sharpest bend between 0.15 and 0.2 (the error at that cell's centre was 1e-2 with nodes 0.05 apart:
@@ -223,12 +224,7 @@ def map_cost(tell=print) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    class OneLine(argparse.ArgumentParser):
-        def error(self, message):
-            say(f"benchmarks.pull_off: {message}")
-            sys.exit(2)
-
-    p = OneLine(prog="python -m petsc_adhesion.benchmarks.pull_off")
+    p = OneLineParser(prog="python -m petsc_adhesion.benchmarks.pull_off", label="benchmarks.pull_off")
     sub = p.add_subparsers(dest="command", required=True)
     b = sub.add_parser("build")
     b.add_argument("--out", default=DEFAULT_PATH)
@@ -247,8 +243,6 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--mu", nargs="+", type=float, default=[0.1, 1.0, 10.0, 300.0])
     f.add_argument("--sigma", nargs="+", type=float, default=[0.0, 0.3])
     f.add_argument("--map-only", action="store_true")
-    for q in (b, a, d, r, f):
-        q.error = p.error                                 # type: ignore[method-assign]
     return p
 
 
