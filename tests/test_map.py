@@ -56,6 +56,12 @@ def folder(tmp_path_factory):
     return d
 
 
+def _text(path, text):
+    """``path`` with ``text`` written in it."""
+    path.write_text(text)
+    return path
+
+
 def _rows(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
@@ -168,7 +174,7 @@ def test_an_asylum_folder_gives_its_grid_and_positions(tmp_path, lines):
     its pixel on the grid read; the missing pixel an entry whose curve is read as missing, with why.  Given,
     the same shape is taken; another, refused."""
     from petsc_adhesion.fitting.data import CurveFileError
-    from petsc_adhesion.maps.source import MapSourceError, open_map
+    from petsc_adhesion.maps.source import ShapeError, open_map
 
     placed = _asylum_map(tmp_path, 3, 2, skip={(2, 1)}, lines=lines)
     m = open_map(str(tmp_path))
@@ -187,7 +193,8 @@ def test_an_asylum_folder_gives_its_grid_and_positions(tmp_path, lines):
         assert abs(m.grid.origin[0] + e.ix * px - e.x) < 1e-12 and abs(m.grid.origin[1] + e.iy * py - e.y) < 1e-12
         assert m.curve(e).spring == pytest.approx(1.1841)
     assert open_map(str(tmp_path), (3, 2)).grid.shape == (3, 2)
-    with pytest.raises(MapSourceError, match=r"grid of 3 x 2 \(FMapScanPoints, FMapScanLines\); -fit_map_shape 6,1"):
+    with pytest.raises(ShapeError, match=r"its Asylum curves state a grid of 3 x 2 \(their notes' FMapScanPoints, "
+                                         r"FMapScanLines\); the shape 6 x 1 disagrees: leave it out$"):
         open_map(str(tmp_path), (6, 1))
 
 
@@ -252,8 +259,9 @@ def test_the_instruments_refusals_at_the_command_line_write_nothing(tmp_path):
         (mixed / "ws.csv").write_bytes(z.read(z.namelist()[0]))
     assert "more than one instrument" in _refused(run_cli("-fit_map", mixed, *tip), "fit_map")
     (mixed / "ws.csv").unlink()
-    assert "-fit_map_shape 1,2 disagrees" in _refused(run_cli("-fit_map", mixed, *tip, "-fit_map_shape", "1,2"),
-                                                      "fit_map")
+    assert "'mixed': its Asylum curves state a grid of 2 x 1 (their notes' FMapScanPoints, FMapScanLines); the " \
+        "shape 1 x 2 disagrees: leave it out" in _refused(run_cli("-fit_map", mixed, *tip, "-fit_map_shape", "1,2"),
+                                                          "fit_map_shape")
     assert out.read_bytes() == b"an earlier result" and not os.path.exists(str(out) + ".journal")
 
 
@@ -267,7 +275,7 @@ def test_an_afm_workshop_folder_gives_the_grid_afmformats_gives(tmp_path):
     import afmformats
 
     from petsc_adhesion.fitting.data import CurveFileError
-    from petsc_adhesion.maps.source import MapSourceError, open_map
+    from petsc_adhesion.maps.source import MapSourceError, ShapeError, open_map
 
     with zipfile.ZipFile(WORKSHOP) as z:
         z.extractall(tmp_path)
@@ -289,7 +297,8 @@ def test_an_afm_workshop_folder_gives_the_grid_afmformats_gives(tmp_path):
     assert len(m) == 16 and len(m.files) == 15 and m.entries[6].x is None
     with pytest.raises(CurveFileError, match=r"missing: the AFM Workshop map's grid of 4 x 4 has pixel \(2, 1\)"):
         m.curve(m.entries[6])
-    with pytest.raises(MapSourceError, match="positions make a grid of 4 x 4; -fit_map_shape 2,8 disagrees"):
+    with pytest.raises(ShapeError, match=r"its AFM Workshop curves state a grid of 4 x 4 \(their positions X, um "
+                                         r"and Y, um\); the shape 2 x 8 disagrees: leave it out$"):
         open_map(str(tmp_path), (2, 8))
     # a curve in volts: its force the file's T-B (V) times the sensitivity and the spring constant given
     first = sorted(tmp_path.iterdir())[0]
@@ -465,9 +474,10 @@ def test_a_killed_map_resumes_to_the_same_files(folder, whole, tmp_path):
 
 # -- bad input ---------------------------------------------------------------------------------------------------
 def _refused(p, option):
+    """The one line of a refusal (exit 2) that names ``option`` first, as the option at fault."""
     assert p.returncode == 2, (p.returncode, p.stderr)
     lines = p.stderr.strip().splitlines()
-    assert len(lines) == 1 and f"-{option}" in lines[0], p.stderr
+    assert len(lines) == 1 and lines[0].startswith(f"petsc-adhesion: error: -{option}: "), p.stderr
     return lines[0]
 
 
@@ -478,14 +488,23 @@ def test_refusals_write_nothing_and_keep_an_earlier_result(folder, tmp_path):
     base = ("-fit_map", folder, *TIP, "-out", out)
     _refused(run_cli("-fit_map", folder, *TIP), "out")                                 # nowhere to write
     _refused(run_cli("-fit_map", tmp_path / "nonesuch", *TIP, "-out", out), "fit_map")
-    _refused(run_cli(*base, "-fit_map_shape", "1,1"), "fit_map")                       # 4 curves, 1 pixel
+    assert "4 curves do not fit the shape 1 x 1: expected nx, ny with nx ny at least 4" in \
+        _refused(run_cli(*base, "-fit_map_shape", "1,1"), "fit_map_shape")
     _refused(run_cli(*base, "-fit_map_shape", "2.5,3"), "fit_map_shape")
     _refused(run_cli(*base, "-fit_curve", folder / "c0.csv"), "fit_curve")
     _refused(run_cli(*base, "-summary", tmp_path / "s.json"), "summary")
     _refused(run_cli(*base, "-fit_curve_index", 2), "fit_curve_index")
     _refused(run_cli("-fit_curve", folder / "c0.csv", *TIP, "-fit_map_shape", "2,3"), "fit_map_shape")
-    _refused(run_cli("-fit_map", QI, "-phys_radius", R, "-phys_epsilon", EPS, "-out", out, "-fit_map_shape",
-                     "2,2"), "fit_map")                                               # a map file has its grid
+    assert "a map file states its own grid; a shape is for a folder or a list: leave it out" in \
+        _refused(run_cli("-fit_map", QI, "-phys_radius", R, "-phys_epsilon", EPS, "-out", out, "-fit_map_shape",
+                         "2,2"), "fit_map_shape")
+    placed = tmp_path / "placed.list"           # a list whose lines place the pixels: no shape to give
+    placed.write_text(f"{folder / 'c0.csv'} 0 0\n{folder / 'c1.csv'} 1 0\n")
+    assert "its lines place the pixels; a shape is for a list without them: leave it out" in \
+        _refused(run_cli("-fit_map", placed, *TIP, "-out", out, "-fit_map_shape", "2,1"), "fit_map_shape")
+    assert "two lines name the same pixel" in \
+        _refused(run_cli("-fit_map", _text(tmp_path / "twice.list", f"{folder / 'c0.csv'} 0 0\n"
+                                            f"{folder / 'c1.csv'} 0 0\n"), *TIP, "-out", out), "fit_map")
     _refused(run_cli("-fit_map", os.path.join(DATA, "NOTICE"), *TIP, "-out", out), "fit_map")     # no map
     os.mkfifo(tmp_path / "fifo")
     assert "is a FIFO" in _refused(run_cli("-fit_map", tmp_path / "fifo", *TIP, "-out", out), "fit_map")
@@ -510,9 +529,37 @@ def test_volts_without_a_sensitivity_and_a_journal_of_another_map(folder, tmp_pa
     with open(journal, "w") as f:
         f.write('{"journal": "petsc-adhesion map journal", "format": 1, "fingerprint": "another"}\n')
     before = open(journal).read()
-    line = _refused(run_cli("-fit_map", folder, *TIP, "-out", out), "fit_map")
-    assert "journal of another map" in line
+    line = _refused(run_cli("-fit_map", folder, *TIP, "-out", out), "out")
+    assert line.endswith(": -out: the journal beside it, 'v.h5.journal' is the journal of another map (other "
+                         "source or options); remove it to fit this one from the start"), line
     assert out.read_bytes() == b"earlier" and open(journal).read() == before
+    # without -out the journal stands beside -csv; one that is no journal at all is named as such
+    table = tmp_path / "v.csv"
+    _text(tmp_path / "v.csv.journal", "not a journal\n")
+    line = _refused(run_cli("-fit_map", folder, *TIP, "-csv", table), "csv")
+    assert line.endswith("the journal beside it, 'v.csv.journal' is not a map's journal; move it away"), line
+    assert not table.exists() and open(str(table) + ".journal").read() == "not a journal\n"
+
+
+def test_a_sensitivity_for_curves_in_newtons_is_refused_as_given(tmp_path):
+    """AFM Workshop's map with its columns in nN (a force, no sensitivity stated) given -fit_invols: one line that
+    names -fit_invols as given and to be removed (not 'required'), exit 2, nothing written; so for -fit_curve on
+    one of its curves."""
+    import zipfile
+
+    ws = tmp_path / "ws"
+    ws.mkdir()
+    with zipfile.ZipFile(WORKSHOP) as z:
+        for name in z.namelist():
+            (ws / name).write_text(z.read(name).decode().replace("T-B(V)", "Force(nN)"))
+    table = tmp_path / "ws.csv"
+    tip = ("-phys_radius", R, "-phys_epsilon", EPS, "-fit_invols", 1e-8, "-phys_spring", 20)
+    says = "gives a force, not a deflection in volts, and states no sensitivity (m/V) for the one given to " \
+        "replace; remove it"
+    assert _refused(run_cli("-fit_map", ws, *tip, "-csv", table), "fit_invols").endswith(says)
+    first = sorted(ws.iterdir())[0]
+    assert _refused(run_cli("-fit_curve", first, *tip, "-summary", tmp_path / "f.json"), "fit_invols").endswith(says)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ws"]
 
 
 def test_a_list_with_a_missing_file_and_a_curve_without_retract_flags_them(folder, tmp_path):

@@ -93,6 +93,14 @@ def _refuse_others(opts: AppOptions, what: str) -> None:
             raise InputError(f"-{name}: not with {what}: {why}; remove it")
 
 
+def instrument_error(e: NeedsInstrument, run: str) -> InputError:
+    """The refusal of a file's missing calibration, naming its option (-fit_invols, -phys_spring): required with
+    ``run`` (-fit_curve, -fit_map) where not given, or to be removed where given and the file cannot take it."""
+    if e.given:
+        return InputError(f"-{e.option}: {printable(str(e))}; remove it")
+    return InputError(f"-{e.option}: required with {run}: {printable(str(e))}")
+
+
 def _moduli(opts: AppOptions, need: bool, what: str) -> float | None:
     """E* of eq. (2) from -phys_young1, -phys_poisson1 (and -phys_young2, -phys_poisson2), or None: checked
     here, given to the fit in the Bodies."""
@@ -204,7 +212,7 @@ def read(opts: AppOptions, comm, argv: list[str]) -> FitRequest:
             data = read_curve(path, opts.int("fit_curve_index"), spring=opts.real("phys_spring"),
                               invols=opts.real("fit_invols"))
         except NeedsInstrument as e:
-            raise InputError(f"-{e.option}: required with -fit_curve: {printable(str(e))}") from None
+            raise instrument_error(e, "-fit_curve") from None
         except CurveFileError as e:
             raise InputError(f"-fit_curve: {printable(str(e))}") from None
         invols = opts.real("fit_invols")

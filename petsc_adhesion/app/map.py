@@ -34,12 +34,12 @@ from ..io.resultset import PLOT_FORMATS, check_targets, plot_format, written
 from ..io.summary import program_record
 from ..maps.fit import MapProgress, fit_map
 from ..maps.result import Pixel
-from ..maps.source import MapEntry, MapSource, MapSourceError, open_map
+from ..maps.source import MapEntry, MapSource, MapSourceError, ShapeError, open_map
 from ..model.parameters import Model
 from ..model.physical import Bodies
 from ..tracing.curve import Program
 from ..tracing.trace import GridChoice
-from .fit import _curve_choice, _moduli, _refuse_others, _template
+from .fit import _curve_choice, _moduli, _refuse_others, _template, instrument_error
 from .options.checks import check_misspelled, check_petsc_values
 from .options.plausible import PLAUSIBLE, implausible
 from .options.reading import AppOptions, read_grid, read_model_spread, read_solver
@@ -142,8 +142,11 @@ def read(opts: AppOptions, comm, argv: list[str]) -> MapRequest:
     path = opts.string("fit_map")
     if not os.path.isdir(path):
         check_input("fit_map", path, MAP_BYTES)     # a FIFO, a device, a link to nothing: named, never opened
+    shape = _shape(opts)
     try:
-        source = open_map(path, _shape(opts))
+        source = open_map(path, shape)
+    except ShapeError as e:         # the source is read, the shape given is what it cannot take
+        raise InputError(f"-fit_map_shape: {printable(str(e))}") from None
     except MapSourceError as e:
         raise InputError(f"-fit_map: {printable(str(e))}") from None
     k, invols = opts.real("phys_spring"), opts.real("fit_invols")
@@ -164,7 +167,7 @@ def _first_curve(source: MapSource, k: float | None, invols: float | None) -> No
         try:
             data = source.curve(entry, k, invols)
         except NeedsInstrument as e:
-            raise InputError(f"-{e.option}: required with -fit_map: {printable(str(e))}") from None
+            raise instrument_error(e, "-fit_map") from None
         except CurveFileError:
             continue
         if invols is not None and data.sensitivity != invols:
@@ -176,20 +179,22 @@ def _first_curve(source: MapSource, k: float | None, invols: float | None) -> No
 
 
 def _resumed(req: MapRequest) -> dict:
-    """The pixels of an earlier run's journal, by curve index; InputError for a journal not this map's."""
+    """The pixels of an earlier run's journal, by curve index; InputError for a journal not this map's, naming
+    the output it stands beside (-out, or -csv without one): that option placed it, the source is not at fault."""
+    beside = f"-{'out' if 'out' in req.targets else 'csv'}: the journal beside it"
     try:
         records = Journal(req.journal, req.fingerprint).read()
     except JournalError as e:
-        raise InputError(f"-fit_map: the journal {printable(str(e))}") from None
+        raise InputError(f"{beside}, {printable(str(e))}") from None
     except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"-fit_map: the journal '{printable(req.journal)}' cannot be read ({type(e).__name__})") \
-            from None
+        raise InputError(f"{beside}, '{printable(req.journal)}', cannot be read ({type(e).__name__}); move it "
+                         f"away") from None
     known = {e.index: e for e in req.source.entries}
     done = {}
     for rec in records:
         entry, fields = pixel_fields(rec)
         if known.get(entry["index"]) != MapEntry(**entry):
-            raise InputError(f"-fit_map: the journal '{printable(req.journal)}' names a curve the map does not hold "
+            raise InputError(f"{beside}, '{printable(req.journal)}', names a curve the map does not hold "
                              f"({entry['index']}); remove it")
         done[entry["index"]] = Pixel(MapEntry(**entry), **fields)
     return done

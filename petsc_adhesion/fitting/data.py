@@ -84,11 +84,12 @@ class CurveFileError(ValueError):
 
 class NeedsInstrument(CurveFileError):
     """A file whose deflection needs what it does not state: ``option`` names the input (``fit_invols``: the
-    sensitivity in m/V; ``phys_spring``: the spring constant in N/m); the message is one line."""
+    sensitivity in m/V; ``phys_spring``: the spring constant in N/m); or, ``given``, a file that cannot take
+    that input where it was given (a sensitivity for a force); the message is one line."""
 
-    def __init__(self, message: str, option: str):
+    def __init__(self, message: str, option: str, given: bool = False):
         super().__init__(message)
-        self.option = option
+        self.option, self.given = option, given
 
 
 class _TextCurveError(CurveFileError):
@@ -442,8 +443,8 @@ def afm_curve(d, path: str, index: int, count: int, spring_given: float | None =
         F = np.asarray(d["force"], dtype=float)
     if invols is not None:
         if sens is None:
-            raise NeedsInstrument(f"{_name(path)}: states no sensitivity (m/V) for the one given to replace; its "
-                                  f"deflection is already in metres", "fit_invols")
+            raise NeedsInstrument(f"{_name(path)}: gives a force, not a deflection in volts, and states no "
+                                  f"sensitivity (m/V) for the one given to replace", "fit_invols", given=True)
         F, sens = F * (invols / sens), invols       # the deflection is the voltage times the sensitivity
     return _curve(np.asarray(d[zcol], dtype=float), F, path, source, spring, sens,
                   {**meta, "z_column": zcol, "curves_in_file": count, "index": index})

@@ -21,8 +21,9 @@ AFM Workshop
     curve is flagged.  Curves of ``Mode: Single`` place nothing (a row, or ``-fit_map_shape``).
 
 A folder holds one instrument's curves of one map: two instruments, two maps' names or notes of two grids
-are refused in one line, as is a ``-fit_map_shape`` that disagrees with the grid the files state.  Every
-pixel of the grid is an entry; one without its file is read as missing and flagged with that reason.
+are refused in one line (a grid shape given that disagrees with the one the files state is refused by
+maps/source.py).  Every pixel of the grid is an entry; one without its file is read as missing and flagged with
+that reason.
 """
 from __future__ import annotations
 
@@ -73,13 +74,15 @@ class Placed:
 @dataclass(frozen=True)
 class Layout:
     """A folder's map: the ``instrument``, the grid's ``shape`` (nx, ny), ``size`` and ``origin`` (m, None
-    where not stated) and its ``pixels`` (in the order measured)."""
+    where not stated), its ``pixels`` (in the order measured) and what in the files gave the shape
+    (``shape_from``, for a refusal of another shape)."""
 
     instrument: str
     shape: tuple
     size: tuple | None
     origin: tuple | None
     pixels: tuple
+    shape_from: str = ""
 
 
 def list_folder(path: str) -> list:
@@ -110,9 +113,9 @@ def instrument_of(path: str) -> str:
     return "text"
 
 
-def place_folder(files: list, name: str, shape: tuple | None) -> Layout | None:
+def place_folder(files: list, name: str) -> Layout | None:
     """The map of a folder's ``files`` (see the module); None where their instrument places nothing (the
-    caller lays them in a row or on ``shape``).  LayoutError (one line) for a folder that is no one map."""
+    caller lays them in a row or on a shape given).  LayoutError (one line) for a folder that is no one map."""
     kinds: dict[str, list] = {}
     for f in files:
         kinds.setdefault(instrument_of(f), []).append(f)
@@ -124,9 +127,9 @@ def place_folder(files: list, name: str, shape: tuple | None) -> Layout | None:
     if kind == "Asylum ARDF":
         raise LayoutError(f"{name}: holds {ARDF_REFUSAL}")
     if kind == "Asylum":
-        return _asylum(files, name, shape)
+        return _asylum(files, name)
     if kind == "AFM Workshop":
-        return _workshop(files, name, shape)
+        return _workshop(files, name)
     return None
 
 
@@ -167,7 +170,7 @@ def _real(note: dict, key: str) -> float | None:
     return v if math.isfinite(v) else None
 
 
-def _asylum(files: list, name: str, shape: tuple | None) -> Layout | None:
+def _asylum(files: list, name: str) -> Layout | None:
     matched = [(_ASYLUM_NAME.match(os.path.basename(f)), f) for f in files]
     if not any(m for m, _ in matched):
         return None
@@ -205,9 +208,6 @@ def _asylum(files: list, name: str, shape: tuple | None) -> Layout | None:
         raise LayoutError(f"{name}: the note of '{os.path.basename(first)}' states no map's grid (FMapScanPoints "
                           f"{note.get('FMapScanPoints')}, FMapScanLines {note.get('FMapScanLines')})")
     nx, ny = int(nx), int(ny)
-    if shape is not None and tuple(shape) != (nx, ny):
-        raise LayoutError(f"{name}: its curves' notes state a grid of {nx} x {ny} (FMapScanPoints, "
-                          f"FMapScanLines); -fit_map_shape {shape[0]},{shape[1]} disagrees: leave it out")
     down = _real(note, "FMapScanDown") == 1
     cells: dict[tuple[int, int], str] = {}
     for m, f in named:
@@ -245,7 +245,7 @@ def _asylum(files: list, name: str, shape: tuple | None) -> Layout | None:
                 continue
             n = notes.get(f, {})
             pixels.append(Placed(f, point, iy, _real(n, "XLVDT"), _real(n, "YLVDT")))
-    return Layout("Asylum", (nx, ny), size, origin, tuple(pixels))
+    return Layout("Asylum", (nx, ny), size, origin, tuple(pixels), "their notes' FMapScanPoints, FMapScanLines")
 
 
 # -- AFM Workshop -----------------------------------------------------------------------------------------------
@@ -264,7 +264,7 @@ def _axis(values: list, what: str, name: str) -> tuple[float, float, int, list]:
     return distinct[0], step, max(index) + 1, index
 
 
-def _workshop(files: list, name: str, shape: tuple | None) -> Layout | None:
+def _workshop(files: list, name: str) -> Layout | None:
     heads = [(f, workshop_header(f) or {}) for f in files]
     modes = {h.get("Mode", "").lower() for _, h in heads}
     if "mapping" not in modes:
@@ -286,9 +286,6 @@ def _workshop(files: list, name: str, shape: tuple | None) -> Layout | None:
     if nx * ny > _SPARSE * len(files):     # positions a hair apart make a spacing of a hair: no scan's grid
         raise LayoutError(f"{name}: the curves' positions make a grid of {nx} x {ny} pixels for {len(files)} "
                           f"curves (spacings of {dx * 1e6:.3g} and {dy * 1e6:.3g} um): positions on no scan's grid")
-    if shape is not None and tuple(shape) != (nx, ny):
-        raise LayoutError(f"{name}: its curves' positions make a grid of {nx} x {ny}; -fit_map_shape "
-                          f"{shape[0]},{shape[1]} disagrees: leave it out")
     cells: dict[tuple, str] = {}
     for f, i, j in zip(files, ix, iy):
         if (i, j) in cells:
@@ -306,4 +303,5 @@ def _workshop(files: list, name: str, shape: tuple | None) -> Layout | None:
             else:
                 pixels.append(Placed(f, i, j, *at[f]))
     size = (nx * dx, ny * dy) if nx > 1 and ny > 1 else None
-    return Layout("AFM Workshop", (nx, ny), size, (x0, y0) if size else None, tuple(pixels))
+    return Layout("AFM Workshop", (nx, ny), size, (x0, y0) if size else None, tuple(pixels),
+                  "their positions X, um and Y, um")

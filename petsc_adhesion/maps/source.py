@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from ..fitting.data import AFM_EXTENSIONS, CurveFileError, MeasuredCurve, afm_curve, load_afm, read_curve
 from .folders import ARDF_REFUSAL, Layout, LayoutError, list_folder, place_folder
 
-__all__ = ["MapSourceError", "MapEntry", "Grid", "MapSource", "open_map", "curves_map", "READ_ERRORS"]
+__all__ = ["MapSourceError", "ShapeError", "MapEntry", "Grid", "MapSource", "open_map", "curves_map", "READ_ERRORS"]
 
 #: What afmformats' readers raise on a damaged curve inside a map whose index it read (its data are read
 #: when first asked for): the curve is flagged, the map goes on.
@@ -37,6 +37,11 @@ READ_ERRORS = (CurveFileError, KeyError, ValueError, IndexError, TypeError, OSEr
 
 class MapSourceError(ValueError):
     """A map source that cannot be read at all: one line, naming the source."""
+
+
+class ShapeError(MapSourceError):
+    """A grid shape given that the source cannot take (too few pixels for its curves, or a source that places
+    its curves itself): the shape is at fault, not the source (the command line names -fit_map_shape)."""
 
 
 @dataclass(frozen=True)
@@ -141,23 +146,29 @@ def _row_grid(n: int, shape: tuple | None, name: str) -> tuple[Grid, list]:
         return Grid((n, 1)), [(i, 0) for i in range(n)]
     nx, ny = shape
     if nx * ny < n:
-        raise MapSourceError(f"{name}: {n} curves do not fit a grid of {nx} x {ny}")
+        raise ShapeError(f"{name}: {n} curves do not fit the shape {nx} x {ny}: expected nx, ny with nx ny at "
+                         f"least {n}")
     return Grid((nx, ny)), [(i % nx, i // nx) for i in range(n)]
 
 
 def open_map(path: str, shape: tuple | None = None) -> MapSource:
-    """The map of ``path``: a folder, a map file afmformats reads, or a list file (see the module).
-    MapSourceError (one line) for a source that is no map."""
+    """The map of ``path``: a folder, a map file afmformats reads, or a list file (see the module), its curves
+    filling the grid ``shape`` (nx, ny) row by row where they place nothing themselves.  MapSourceError (one
+    line) for a source that is no map; its ShapeError where ``shape`` is at fault."""
     base = os.path.basename(path.rstrip(os.sep)) or path
     if os.path.isdir(path):
         files = list_folder(path)
         if not files:
             raise MapSourceError(f"'{base}': a folder without a curve file")
         try:
-            layout = place_folder(files, f"'{base}'", shape)
+            layout = place_folder(files, f"'{base}'")
         except LayoutError as e:
             raise MapSourceError(str(e)) from None
         if layout is not None:
+            if shape is not None and tuple(shape) != layout.shape:
+                raise ShapeError(f"'{base}': its {layout.instrument} curves state a grid of {layout.shape[0]} x "
+                                 f"{layout.shape[1]} ({layout.shape_from}); the shape {shape[0]} x {shape[1]} "
+                                 f"disagrees: leave it out")
             return _placed(path, layout)
         grid, cells = _row_grid(len(files), shape, f"'{base}'")
         entries = tuple(MapEntry(i, ix, iy, label=os.path.basename(f)) for i, (f, (ix, iy)) in
@@ -171,7 +182,8 @@ def open_map(path: str, shape: tuple | None = None) -> MapSource:
         raise MapSourceError(f"'{base}': not a map: expected a folder of curves, a list file of paths (.list, "
                              f".lst) or a map file afmformats reads ({', '.join(AFM_EXTENSIONS[:4])}, ...)")
     if shape is not None:
-        raise MapSourceError(f"'{base}': a map file states its own grid; a shape is for a folder or a list")
+        raise ShapeError(f"'{base}': a map file states its own grid; a shape is for a folder or a list: leave it "
+                         f"out")
     try:
         curves = load_afm(path)
     except CurveFileError as e:
@@ -225,7 +237,8 @@ def _open_list(path: str, shape: tuple | None) -> MapSource:
             cells.append((ix, iy))
     if cells:
         if shape is not None:
-            raise MapSourceError(f"'{base}': its lines place the pixels; a shape is for a list without them")
+            raise ShapeError(f"'{base}': its lines place the pixels; a shape is for a list without them: leave "
+                             f"it out")
         if len(set(cells)) < len(cells):
             raise MapSourceError(f"'{base}': two lines name the same pixel")
         grid = Grid((max(c[0] for c in cells) + 1, max(c[1] for c in cells) + 1))
