@@ -312,13 +312,51 @@ def test_an_afm_workshop_folder_gives_the_grid_afmformats_gives(tmp_path):
         open_map(str(tmp_path))
 
 
+def test_an_afm_workshop_zip_in_volts_is_read_with_its_calibration(tmp_path):
+    """AFM Workshop's zipped map in volts read by open_map: each curve's force the member's T-B (V) columns
+    times the sensitivity and the spring constant given (to round-off, against the member's numbers read
+    here); a copy whose headers state a calibration (Light Lever Gain 50 mV/nm, so 2e-8 m/V; Force Constant
+    0.5 nN/nm) is read with it and needs neither; without either where it states none, NeedsInstrument
+    naming the option."""
+    import zipfile
+
+    from petsc_adhesion.fitting.data import NeedsInstrument
+    from petsc_adhesion.maps.source import open_map
+
+    with zipfile.ZipFile(WORKSHOP) as z:
+        members = {n: z.read(n).decode() for n in sorted(z.namelist())}
+    volts = [np.loadtxt(text.splitlines()[11:], delimiter=",") for text in members.values()]
+
+    def force(c, v, factor):
+        assert c.F == pytest.approx(np.r_[v[:, 1], v[:, 3]] * factor, rel=1e-13, abs=0)
+
+    m = open_map(WORKSHOP, spring=20.0, invols=1e-8)
+    assert m.kind == "afm" and len(m) == 16 and m.grid.shape == (4, 4)
+    for e, v in zip(m.entries, volts):
+        c = m.curve(e, 20.0, 1e-8)
+        force(c, v, 1e-8 * 20.0)
+        assert (c.spring, c.sensitivity) == (20.0, 1e-8)
+    for given, option in (({}, "fit_invols"), ({"invols": 1e-8}, "phys_spring")):
+        with pytest.raises(NeedsInstrument) as e:
+            open_map(WORKSHOP, **given)
+        assert e.value.option == option and not e.value.given and "\n" not in str(e.value)
+    stated = tmp_path / "stated.zip"
+    with zipfile.ZipFile(stated, "w") as z:
+        for name, text in members.items():
+            z.writestr(name, text.replace("Y, um:", "Light Lever Gain, mV/nm:\t50\nForce Constant, nN/nm:\t0.5\nY, um:"))
+    m = open_map(str(stated))
+    for e, v in zip(m.entries, volts):
+        force(m.curve(e), v, 2e-8 * 0.5)
+
+
 def test_the_real_asylum_and_afm_workshop_maps_fitted_flag_each_pixel(tmp_path):
     """The Asylum map of 2 x 2 made of the MFP-3D curve (one pixel's file missing) and AFM Workshop's map
     (4 x 4) through -fit_map with a 20 nm tip assumed: each curve that is read indents the tip beyond R/4
     (the MFP-3D curve by 14.5 nm, 0.72 R, as -fit_curve says of it, docs/fitting.md): 'outside' with that
     reason and no w; the missing pixel 'unreadable', missing; exit status 3.  AFM Workshop's curves are in
     volts: without -fit_invols the map is refused in one line naming it, nothing written; with afmformats'
-    own test calibration (10 nm/V, 20 N/m) every pixel is read, at its position, and outside."""
+    own test calibration (10 nm/V, 20 N/m) every pixel is read, at its position, and outside; the zip given
+    as it is, the same pixels with the same numbers (afmformats' map reader calibrated by the options)."""
     import zipfile
 
     asylum = tmp_path / "asylum"
@@ -346,6 +384,25 @@ def test_the_real_asylum_and_afm_workshop_maps_fitted_flag_each_pixel(tmp_path):
     assert len(rows) == 16 and {r["status"] for r in rows} == {"outside"}
     assert all("indentation reaches" in r["reasons"] and r["gamma_J_m2"] == "" for r in rows)
     assert float(rows[5]["x_m"]) == pytest.approx(7.333333333333333e-6, abs=1e-12)
+    # the zip itself, through afmformats' map reader calibrated as the folder: refused without -fit_invols and
+    # then without -phys_spring (one line each naming it, nothing written); with both, every pixel the folder's
+    zipped = tmp_path / "zipped.csv"
+    assert "'fmt-afm-workshop-fd_mapping_16_2018-08-01_13.07.zip': its deflection is in volts (AFM Workshop's " \
+        "T-B(V)) and it states no sensitivity: give it in m/V" in \
+        _refused(run_cli("-fit_map", WORKSHOP, "-phys_radius", R, "-phys_epsilon", EPS, "-csv", zipped), "fit_invols")
+    assert "states no spring constant: give it in N/m" in \
+        _refused(run_cli("-fit_map", WORKSHOP, "-phys_radius", R, "-phys_epsilon", EPS, "-fit_invols", 1e-8, "-csv",
+                         zipped), "phys_spring")
+    assert not zipped.exists()
+    p = run_cli("-fit_map", WORKSHOP, "-phys_radius", R, "-phys_epsilon", EPS, "-fit_invols", 1e-8, "-phys_spring",
+                20, "-csv", zipped)
+    assert p.returncode == 3, p.stderr
+    by_pixel = {(r["ix"], r["iy"]): r for r in rows}
+    for r in _rows(zipped):
+        f = by_pixel[r["ix"], r["iy"]]
+        assert r["status"] == "outside" and r["reasons"] == f["reasons"], (r, f)
+        for q in ("x_m", "y_m", "pull_off_N", "jump_in_N", "energy_J"):
+            assert float(r[q]) == pytest.approx(float(f[q]), rel=1e-12, abs=1e-18), (q, r, f)
 
 
 # -- what a curve shows by itself -----------------------------------------------------------------------------

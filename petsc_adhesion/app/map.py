@@ -142,14 +142,15 @@ def read(opts: AppOptions, comm, argv: list[str]) -> MapRequest:
     path = opts.string("fit_map")
     if not os.path.isdir(path):
         check_input("fit_map", path, MAP_BYTES)     # a FIFO, a device, a link to nothing: named, never opened
-    shape = _shape(opts)
+    shape, k, invols = _shape(opts), opts.real("phys_spring"), opts.real("fit_invols")
     try:
-        source = open_map(path, shape)
+        source = open_map(path, shape, k, invols)
+    except NeedsInstrument as e:    # a map file read only calibrated (AFM Workshop's zip in volts)
+        raise instrument_error(e, "-fit_map") from None
     except ShapeError as e:         # the source is read, the shape given is what it cannot take
         raise InputError(f"-fit_map_shape: {printable(str(e))}") from None
     except MapSourceError as e:
         raise InputError(f"-fit_map: {printable(str(e))}") from None
-    k, invols = opts.real("phys_spring"), opts.real("fit_invols")
     _first_curve(source, k, invols)
     targets_in = {"fit_map": [path, *source.files]}
     req = MapRequest(source, model, grid, solver, bodies, None if k is None else Spring(k, "-phys_spring"), choice,

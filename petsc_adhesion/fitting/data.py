@@ -26,8 +26,10 @@ an AFM file afmformats reads
     ``invols`` given replaces the file's (its force rescaled by their ratio: the
     deflection is the measured voltage times it); a file that states no spring
     constant takes ``spring`` for its deflection column.  An AFM Workshop curve in
-    volts (``T-B(V)``) whose header states no calibration is read with ``invols``
-    and ``spring`` (afmformats' ``meta_override``), :class:`NeedsInstrument` without.
+    volts (``T-B(V)``) whose header states no calibration, alone (``.csv``) or in
+    the zip of a map (its first curve's header read for the map's), is read with
+    ``invols`` and ``spring`` (afmformats' ``meta_override``), :class:`NeedsInstrument`
+    without.
 
 Approach and retract are split where the displacement turns: at its extreme
 farthest from the first sample.  Either sign convention of the displacement is
@@ -43,6 +45,8 @@ import logging
 import os
 import re
 import warnings
+import zipfile
+import zlib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -327,12 +331,22 @@ def _read_text(path: str, spring: float | None = None, invols: float | None = No
 def workshop_header(path: str) -> dict | None:
     """The header of an AFM Workshop curve (``.csv``: a first line ``Force-Distance Curve``, then ``key:
     value`` lines, then the columns' names): its keys and values as written (``Mode``, ``Point``, ``X, um``,
-    ``Y, um``, ...) and ``columns``; None for a file that is not one (or cannot be read)."""
+    ``Y, um``, ...) and ``columns``; of a ``.zip`` (AFM Workshop's zipped map), its first curve's, by name as
+    afmformats orders them; None for a file that is not one (or cannot be read)."""
     try:
-        with open(path, encoding="utf-8", errors="replace") as f:
-            lines = [f.readline() for _ in range(64)]       # the header is about a dozen lines
-    except OSError:
-        return None
+        if str(path).lower().endswith(".zip"):
+            with zipfile.ZipFile(path) as z:
+                names = sorted(z.namelist())
+                if not names:
+                    return None
+                with z.open(names[0]) as raw:
+                    text = io.TextIOWrapper(raw, encoding="utf-8", errors="replace")
+                    lines = [text.readline() for _ in range(64)]
+        else:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                lines = [f.readline() for _ in range(64)]       # the header is about a dozen lines
+    except (OSError, EOFError, RuntimeError, NotImplementedError, zipfile.BadZipFile, zlib.error):
+        return None     # (an encrypted member is RuntimeError, an unknown compression NotImplementedError)
     if not lines[0].strip().startswith("Force-Distance Curve"):
         return None
     head: dict = {}
@@ -348,9 +362,10 @@ def workshop_header(path: str) -> dict | None:
 
 def _workshop_override(path: str, spring_given: float | None, invols: float | None) -> dict | None:
     """What afmformats needs to read an AFM Workshop file whose deflection is in volts (``T-B(V)``, the
-    photodiode's top-bottom signal): the sensitivity and the spring constant, the caller's where the header
-    states none (AFM Workshop writes 1 for a value not set, and afmformats takes 1 as none)."""
-    head = workshop_header(path) if str(path).lower().endswith(".csv") else None
+    photodiode's top-bottom signal), a curve or a zipped map: the sensitivity and the spring constant, the
+    caller's where the header states none (AFM Workshop writes 1 for a value not set, and afmformats takes 1
+    as none; without them its reader stops with its own 'Please specify ...')."""
+    head = workshop_header(path) if str(path).lower().endswith((".csv", ".zip")) else None
     if head is None or not any("T-B(V)" in c for c in head["columns"]):
         return None
     stated = {k: head.get(k, "1") for k in ("Light Lever Gain, mV/nm", "Force Constant, nN/nm")}
@@ -374,18 +389,20 @@ def _float(text: str) -> float | None:
 
 def _read_afm(path: str, index: int, spring_given: float | None = None,
               invols: float | None = None) -> MeasuredCurve:
-    curves = load_afm(path, _workshop_override(path, spring_given, invols))
+    curves = load_afm(path, spring_given, invols)
     if not 0 <= index < len(curves):
         raise CurveFileError(f"{_name(path)}: holds {len(curves)} curve{'s' * (len(curves) != 1)}; index {index} "
                              f"asked for")
     return afm_curve(curves[index], path, index, len(curves), spring_given, invols)
 
 
-def load_afm(path: str, override: dict | None = None) -> list:
+def load_afm(path: str, spring_given: float | None = None, invols: float | None = None) -> list:
     """The force-distance curves afmformats reads in ``path`` (its data objects, in the file's order; a force
-    map's curves each once: a map is opened once, not once per curve), with ``override`` the metadata the
-    file lacks (afmformats' ``meta_override``); CurveFileError (one line) for a file it cannot read or one
-    without a curve."""
+    map's curves each once: a map is opened once, not once per curve), an AFM Workshop file in volts
+    calibrated with ``spring_given`` (N/m) and ``invols`` (m/V) where its header states no calibration
+    (NeedsInstrument without them); CurveFileError (one line) for a file it cannot read or one without a
+    curve."""
+    override = _workshop_override(path, spring_given, invols)
     try:
         import afmformats
     except ImportError:

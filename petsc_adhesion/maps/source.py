@@ -25,7 +25,8 @@ import os
 import stat
 from dataclasses import dataclass, field
 
-from ..fitting.data import AFM_EXTENSIONS, CurveFileError, MeasuredCurve, afm_curve, load_afm, read_curve
+from ..fitting.data import AFM_EXTENSIONS, CurveFileError, MeasuredCurve, NeedsInstrument, afm_curve, load_afm, \
+    read_curve
 from .folders import ARDF_REFUSAL, Layout, LayoutError, list_folder, place_folder
 
 __all__ = ["MapSourceError", "ShapeError", "MapEntry", "Grid", "MapSource", "open_map", "curves_map", "READ_ERRORS"]
@@ -151,10 +152,14 @@ def _row_grid(n: int, shape: tuple | None, name: str) -> tuple[Grid, list]:
     return Grid((nx, ny)), [(i % nx, i // nx) for i in range(n)]
 
 
-def open_map(path: str, shape: tuple | None = None) -> MapSource:
+def open_map(path: str, shape: tuple | None = None, spring: float | None = None,
+             invols: float | None = None) -> MapSource:
     """The map of ``path``: a folder, a map file afmformats reads, or a list file (see the module), its curves
-    filling the grid ``shape`` (nx, ny) row by row where they place nothing themselves.  MapSourceError (one
-    line) for a source that is no map; its ShapeError where ``shape`` is at fault."""
+    filling the grid ``shape`` (nx, ny) row by row where they place nothing themselves.  A map file that
+    afmformats reads only calibrated (AFM Workshop's zip in volts, its header stating no calibration) is read
+    with ``spring`` (N/m) and ``invols`` (m/V), NeedsInstrument without them; the curves of any other source
+    take them when read (:meth:`MapSource.curve`).  MapSourceError (one line) for a source that is no map;
+    its ShapeError where ``shape`` is at fault."""
     base = os.path.basename(path.rstrip(os.sep)) or path
     if os.path.isdir(path):
         files = list_folder(path)
@@ -185,7 +190,9 @@ def open_map(path: str, shape: tuple | None = None) -> MapSource:
         raise ShapeError(f"'{base}': a map file states its own grid; a shape is for a folder or a list: leave it "
                          f"out")
     try:
-        curves = load_afm(path)
+        curves = load_afm(path, spring, invols)
+    except NeedsInstrument:
+        raise                       # the caller's calibration is missing, not the source at fault
     except CurveFileError as e:
         raise MapSourceError(str(e)) from None
     entries, grid = _afm_grid(curves, base)
