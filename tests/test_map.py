@@ -321,7 +321,7 @@ def test_an_afm_workshop_zip_in_volts_is_read_with_its_calibration(tmp_path):
     import zipfile
 
     from petsc_adhesion.fitting.data import NeedsInstrument
-    from petsc_adhesion.maps.source import open_map
+    from petsc_adhesion.maps.source import MapSourceError, open_map
 
     with zipfile.ZipFile(WORKSHOP) as z:
         members = {n: z.read(n).decode() for n in sorted(z.namelist())}
@@ -347,6 +347,11 @@ def test_an_afm_workshop_zip_in_volts_is_read_with_its_calibration(tmp_path):
     m = open_map(str(stated))
     for e, v in zip(m.entries, volts):
         force(m.curve(e), v, 2e-8 * 0.5)
+    cut = tmp_path / "cut.zip"             # a zip cut short: its header unread, the source refused, not a crash
+    cut.write_bytes(open(WORKSHOP, "rb").read()[:3000])
+    with pytest.raises(MapSourceError, match=r"^'cut\.zip': not a force-distance curve afmformats reads \(File is "
+                                             r"not a zip file\)$"):
+        open_map(str(cut), spring=20.0, invols=1e-8)
 
 
 def test_the_real_asylum_and_afm_workshop_maps_fitted_flag_each_pixel(tmp_path):
