@@ -168,7 +168,7 @@ class LawOptimum:
         J_P <- J_P + (dr - J_P dt) dt^T / (dt^T dt),     dr the change of r_P,
 
     and c's start at the next t predicted to first order, c - J_c^+ J_t dt.  The first J_P is the fit's J
-    projected (no curve), so a law near the reference costs one curve and its check.  Converged where a step
+    projected (no curve), so a law near the reference costs a curve, its difference and the last step's.  Converged where a step
     with J_P differenced at the point moves each coordinate of t by less than SPREAD_TOL of its bar: there
     J_P^T r_P = J_t^T r_P, the gradient in t, is that small, and in c it is the inner solve's zero; that last
     step is taken too where it lowers |r_P|^2, so what is left is of second order.  One curve is traced per new
@@ -218,13 +218,10 @@ class LawOptimum:
         chi2 = float(r @ r)
         fresh, radius = False, math.inf          # J_P differenced at x; the step's largest size in bars
         for _ in range(SPREAD_STEPS):
-            dt = -np.linalg.lstsq(self.JP, r, rcond=None)[0]
-            size = float(np.max(np.abs(dt) / self.bar))
-            if size > radius:
-                dt *= radius / size
-            target = np.clip(x[t] + dt, self.lo[t], self.hi[t])
+            target = np.clip(x[t] - np.linalg.lstsq(self.JP, r, rcond=None)[0], self.lo[t], self.hi[t])
             dt = target - x[t]
             size = float(np.max(np.abs(dt) / self.bar))
+            # converged by the whole step, never by one a failure cut short (that is no optimum)
             if size < SPREAD_TOL:
                 if fresh:
                     names = self.alt.names
@@ -244,8 +241,11 @@ class LawOptimum:
                 self._take(self.alt.jacobian(x))
                 fresh, radius = True, math.inf
                 continue
+            if size > radius:
+                dt *= radius / size
+                size = radius
             y = x.copy()
-            y[t] = target
+            y[t] = x[t] + dt
             if self.c_idx:
                 y[self.c_idx] = np.clip(x[self.c_idx] - self.M @ dt, self.lo[self.c_idx], self.hi[self.c_idx])
             y, r_new = self.inner(y)
