@@ -300,10 +300,10 @@ def test_a_map_curve_named_is_read(tmp_path):
 def test_the_roughness_laws_spread_points_to_the_law_the_curve_was_made_with():
     """A rough curve (sigma = 0.5) made by the solver under the truncated Gaussian at K = 3, fitted under the
     default Gauss-Hermite rule with E* and the rms held: that fit's w is far from the truth (the rule's
-    outermost node sets it), and the model spread, the optimum moved to truncated_gaussian:3 by chord
-    Gauss-Newton steps, gives the true w back to 10% (0.0530 for 0.05 here, 0.0493 with 120 points a leg;
-    the default rule's fit says 0.129): the spread is the distance to what the other law would fit, not a
-    number of its own; it warns."""
+    outermost node sets it), and the model spread, the optimum of truncated_gaussian:3's residuals sought from
+    the fit's (fitting/outcome.py LawOptimum), gives the true w back to 10% (0.0534 for 0.05, after six steps
+    in ln w of -0.032, -0.62, -0.20, -0.092, -0.012, -0.0004; the default rule's fit says 0.140): the spread is
+    the distance to what the other law would fit, not a number of its own; it warns."""
     from petsc_adhesion.model.parameters import Model
     from petsc_adhesion.tracing.model_spread import Rule
 

@@ -41,9 +41,10 @@ docs/fitting.md measures how often it holds).  The result is a
 parameter is at a bound or undetermined, with a warning for each, and for a chi^2 the noise
 cannot explain (:mod:`~petsc_adhesion.fitting.results`).
 
-With roughness, w's and E*'s model spread: the optimum moved to each other roughness law by one
-Gauss-Newton step, dx = -(J^T J)^-1 J^T r_law, r_law the residuals under that law at the optimum
-(one curve per law; :func:`~petsc_adhesion.fitting.outcome.curve_spread`).  What the curve shows by itself
+With roughness, w's and E*'s model spread: the optimum moved to each other roughness law, the least
+squares of the residuals r_law under that law solved from the fit's optimum by Gauss-Newton in the branch's
+coordinates with the others re-solved at each (variable projection; a few curves per law;
+:func:`~petsc_adhesion.fitting.outcome.curve_spread`).  What the curve shows by itself
 and the domain's checks are :mod:`~petsc_adhesion.fitting.domain`'s, the optimum's reading
 :mod:`~petsc_adhesion.fitting.outcome`'s.
 """
@@ -298,14 +299,17 @@ class _Problem:
                                       time.perf_counter() - self.t0))
         return r
 
-    def jacobian(self, x) -> np.ndarray:
-        """Forward differences, every point kept on its piece (see the module)."""
+    def jacobian(self, x, columns=None) -> np.ndarray:
+        """Forward differences, every point kept on its piece (see the module); the columns of the coordinates
+        ``columns`` (indices) alone where given."""
         x = np.asarray(x, dtype=float)
         p = self.unpack(x)
         base, pieces = self._all(p)
-        J = np.empty((base.size, len(self.names)))
+        columns = range(len(self.names)) if columns is None else list(columns)
+        J = np.empty((base.size, len(columns)))
         n_pieces = len(self.forward(p).pieces)
-        for j, name in enumerate(self.names):
+        for col, j in enumerate(columns):
+            name = self.names[j]
             h = 1e-4 if name == "z0" else 1.0 if name in ("F0", "slope", "drag") else _STEP
             if self.table is not None and self.upper is not None and x[j] + h > self.upper[j]:
                 h = -h                  # the table ends at its last node: the difference turns back
@@ -314,7 +318,7 @@ class _Problem:
             q = self.unpack(xh)
             fc = self.forward(q)
             rh, _ = self._all(q, pieces if len(fc.pieces) == n_pieces else None, fc)
-            J[:, j] = (rh - base) / h
+            J[:, col] = (rh - base) / h
         return J
 
 

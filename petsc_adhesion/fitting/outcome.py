@@ -18,8 +18,8 @@ from ..tracing.measured import Measured, Missing
 from .domain import MU_BOUNDS
 from .results import BOUND_MARGIN, FitChoice, Instrument, undetermined
 
-__all__ = ["bounds", "verdicts", "instrument_values", "curve_spread", "SIGMA_MAX", "INSTRUMENT_FACTOR",
-           "SPREAD_STEPS"]
+__all__ = ["bounds", "verdicts", "instrument_values", "curve_spread", "branch_coordinates", "LawOptimum",
+           "SIGMA_MAX", "INSTRUMENT_FACTOR", "SPREAD_STEPS", "SPREAD_TOL"]
 
 #: The largest roughness sigma = rms / eps fitted.
 SIGMA_MAX = 3.0
@@ -138,16 +138,139 @@ def instrument_values(pb, choice: FitChoice, x, lo, hi, p: dict, sd: dict) -> tu
     return Instrument(c, k, v, d, pb.feat.contact_slope_N_m), warned
 
 
-#: Gauss-Newton steps (with the fit's Jacobian) that move the optimum to another roughness law, at most; they
-#: stop where a step moves ln w by less than a tenth of its bar.
-SPREAD_STEPS = 3
+#: The law's optimum is sought in at most this many Gauss-Newton steps in the branch's coordinates.
+SPREAD_STEPS = 12
+#: The optimum is reached where a Gauss-Newton step, its Jacobian differenced at the point, moves each branch
+#: coordinate by less than this share of its bar.
+SPREAD_TOL = 0.1
+
+
+def branch_coordinates(names: tuple) -> list:
+    """The fitted coordinates that move the solver's branch (mu, sigma): ln mu, sigma, and ln w where E* is held
+    (mu then moves with w, eq. 9).  The others (z0, F0, the instrument's; ln w beside a fitted ln mu) read the
+    same branch behind another spring or scale, no curve traced (fitting/branches.py)."""
+    return [j for j, n in enumerate(names) if n in ("ln_mu", "sigma") or (n == "ln_gamma" and "ln_mu" not in names)]
+
+
+class LawOptimum:
+    """The fit's optimum moved to another roughness law by variable projection (Golub and Pereyra): the branch's
+    coordinates t (:func:`branch_coordinates`) outside, the others c inside.
+
+    Inside, at each t, c(t) minimises |r_law(t, c)|^2 (bounded least squares on the branch read behind other
+    springs and scales: no curve traced).  Outside, Gauss-Newton on the projected residuals r_P(t) = r_law(t,
+    c(t)), whose Jacobian is
+
+        J_P = (I - J_c J_c^+) J_t      (Kaufman's form: exact at c(t), where J_c^T r_P = 0),
+
+    a step dt = -J_P^+ r_P taken only where it lowers |r_P|^2 (else retried with J_P differenced afresh at the
+    point, then shortened to a quarter in bars), J_P carried between accepted steps by Broyden's rank-one update
+
+        J_P <- J_P + (dr - J_P dt) dt^T / (dt^T dt),     dr the change of r_P,
+
+    and c's start at the next t predicted to first order, c - J_c^+ J_t dt.  The first J_P is the fit's J
+    projected (no curve), so a law near the reference costs a curve, its difference and the last step's.  Converged where a step
+    with J_P differenced at the point moves each coordinate of t by less than SPREAD_TOL of its bar: there
+    J_P^T r_P = J_t^T r_P, the gradient in t, is that small, and in c it is the inner solve's zero; that last
+    step is taken too where it lowers |r_P|^2, so what is left is of second order.  One curve is traced per new
+    t and one per coordinate of t for each difference."""
+
+    def __init__(self, alt, x, J, bar, lo, hi):
+        self.alt, self.lo, self.hi, self.bar = alt, lo, hi, bar
+        self.t_idx = branch_coordinates(alt.names)
+        self.c_idx = [j for j in range(len(alt.names)) if j not in self.t_idx]
+        self.x = x.copy()
+        self.steps: list = []           # the accepted steps in t
+        self._take(J)
+
+    def _take(self, J) -> None:
+        """J_P and the first-order move of c along t (J_c^+ J_t) from a Jacobian J at (or near) the point."""
+        Jt, Jc = J[:, self.t_idx], J[:, self.c_idx]
+        self.M = np.linalg.lstsq(Jc, Jt, rcond=None)[0] if self.c_idx else np.zeros((0, len(self.t_idx)))
+        self.JP = Jt - Jc @ self.M
+
+    def residuals(self, x) -> np.ndarray:
+        return self.alt._all(self.alt.unpack(x))[0]
+
+    def inner(self, x) -> tuple:
+        """(x with c(t) at x's t, from x's c; its residuals r_P)."""
+        from scipy.optimize import least_squares
+
+        if not self.c_idx:
+            return x, self.residuals(x)
+        c = self.c_idx
+
+        def at(y):
+            z = x.copy()
+            z[c] = y
+            return z
+
+        lo, hi = self.lo[c], self.hi[c]
+        y0 = np.clip(x[c], lo + 1e-9 * np.where(np.isfinite(hi - lo), hi - lo, 1.0), hi - 1e-9)
+        res = least_squares(lambda y: self.residuals(at(y)), y0, jac=lambda y: self.alt.jacobian(at(y), c),
+                            bounds=(lo, hi), method="trf", x_scale="jac", ftol=1e-10, xtol=1e-10, gtol=1e-10)
+        z = at(res.x)
+        return z, self.residuals(z)
+
+    def solve(self) -> tuple:
+        """(the moved optimum x, None) or (None, why it was not reached)."""
+        t = self.t_idx
+        x, r = self.inner(self.x)
+        chi2 = float(r @ r)
+        fresh, radius = False, math.inf          # J_P differenced at x; the step's largest size in bars
+        for _ in range(SPREAD_STEPS):
+            target = np.clip(x[t] - np.linalg.lstsq(self.JP, r, rcond=None)[0], self.lo[t], self.hi[t])
+            dt = target - x[t]
+            size = float(np.max(np.abs(dt) / self.bar))
+            # converged by the whole step, never by one a failure cut short (that is no optimum)
+            if size < SPREAD_TOL:
+                if fresh:
+                    names = self.alt.names
+                    at = [names[j] for j in t + [names.index("ln_gamma")]
+                          if min(x[j] - self.lo[j], self.hi[j] - x[j]) <= BOUND_MARGIN]
+                    if at:
+                        return None, f"its optimum is at the fit's bound of {', '.join(dict.fromkeys(at))}"
+                    if size > 0:        # the last step too, where it lowers chi^2: its error is second order
+                        y = x.copy()
+                        y[t] = target
+                        y, r_new = self.inner(y)
+                        if float(r_new @ r_new) < chi2:
+                            self.steps.append(dt)
+                            x = y
+                    self.x = x
+                    return x, None
+                self._take(self.alt.jacobian(x))
+                fresh, radius = True, math.inf
+                continue
+            if size > radius:
+                dt *= radius / size
+                size = radius
+            y = x.copy()
+            y[t] = x[t] + dt
+            if self.c_idx:
+                y[self.c_idx] = np.clip(x[self.c_idx] - self.M @ dt, self.lo[self.c_idx], self.hi[self.c_idx])
+            y, r_new = self.inner(y)
+            chi2_new = float(r_new @ r_new)
+            if chi2_new < chi2:
+                self.JP += np.outer((r_new - r) - self.JP @ dt, dt) / float(dt @ dt)
+                self.steps.append(dt)
+                x, r, chi2 = y, r_new, chi2_new
+                fresh = False
+                radius = 2 * size if math.isfinite(radius) else radius
+            elif not fresh:
+                self._take(self.alt.jacobian(x))
+                fresh = True
+            else:
+                radius = 0.25 * size
+        return None, (f"not converged in {SPREAD_STEPS} Gauss-Newton steps (the last moved "
+                      f"{size:.2g} bars): no optimum to report")
 
 
 def curve_spread(pb, x, J, JtJ_inv, quantities: dict, A, rules: tuple, lo, hi):
-    """w's and E*'s model spread: the optimum moved to each roughness law of ``rules`` by Gauss-Newton steps
-    from the fit's with the fit's Jacobian J (a chord method), dx = -(J^T J)^-1 J^T r_law(x_i), r_law the
-    residuals under that law, at most SPREAD_STEPS, within the fit's bounds (one curve traced per step and
-    law; the first step is the refit's to first order in the law's change)."""
+    """w's and E*'s model spread: the fit's optimum moved to each roughness law of ``rules``, the least squares
+    of that law's residuals r_law solved from the fit's optimum x by :class:`LawOptimum` (variable projection,
+    Gauss-Newton in the branch's coordinates with Broyden's update of the fit's Jacobian J, differenced afresh
+    where a step fails and to check convergence), within the fit's bounds.  A law whose optimum is not reached
+    in SPREAD_STEPS steps, or lies at a bound, has its moved values Missing with the reason."""
     from ..tracing.model_spread import ModelSpread, Rule, spread_quantity
 
     model = replace(pb.template, sigma=pb.unpack(x)["sigma"])
@@ -160,31 +283,35 @@ def curve_spread(pb, x, J, JtJ_inv, quantities: dict, A, rules: tuple, lo, hi):
         return Missing("the fit's covariance is singular: its optimum cannot be moved to another law")
     names = pb.names
     i_w = names.index("ln_gamma")
+    t_idx = branch_coordinates(names)
+    bar = np.sqrt(np.maximum(np.diag(JtJ_inv)[t_idx], 0.0))
+    bar = np.where(bar > 0, bar, 1.0)
     moved_w: list[Measured | Missing] = []
     moved_E: list[Measured | Missing] = []
     notes, times = [], []
     t0 = time.perf_counter()
     for rule in rules:
         t = time.perf_counter()
-        alt = replace(pb, template=rule.model(pb.template), cache={}, progress=None)
+        alt = replace(pb, template=rule.model(pb.template), cache={}, progress=None, traces=0, evaluations=0)
         alt.weight = pb.weight.copy()
         try:
-            xi = x.copy()
-            bar = math.sqrt(max(JtJ_inv[i_w, i_w], 0.0)) or 1.0
-            for _ in range(SPREAD_STEPS):
-                r_law, _ = alt._all(alt.unpack(xi))
-                step = -JtJ_inv @ (J.T @ r_law)
-                xi = np.clip(xi + step, lo, hi)
-                if abs(step[i_w]) < 0.1 * bar:
-                    break
-            dx = xi - x
-            y = A @ xi
-            moved_w.append(Measured(math.exp(y[i_w])))
-            if "ln_mu" in names:
-                # ln E* differs from A's row by a constant: E* at the moved optimum is E* exp(change of the row)
-                d = A @ dx
-                moved_E.append(Measured(float(quantities["E_star"].value) * math.exp(d[names.index("ln_mu")]))
-                               if isinstance(quantities["E_star"], Measured) else Missing("E* undetermined"))
+            law = LawOptimum(alt, x, J, bar, lo, hi)
+            xi, why = law.solve()
+            if xi is None:
+                moved_w.append(Missing(f"{rule.label}: {why}"))
+                moved_E.append(Missing(f"{rule.label}: {why}"))
+                notes.append(f"{rule.label}: {why}")
+            else:
+                dx = xi - x
+                y = A @ xi
+                moved_w.append(Measured(math.exp(y[i_w])))
+                notes.append(f"{rule.label}: its optimum reached in {len(law.steps)} Gauss-Newton steps and "
+                             f"{alt.traces} curves, ln w moved {dx[i_w]:+.3g}")
+                if "ln_mu" in names:
+                    # ln E* differs from A's row by a constant: E* at the moved optimum is E* exp(change of the row)
+                    d = A @ dx
+                    moved_E.append(Measured(float(quantities["E_star"].value) * math.exp(d[names.index("ln_mu")]))
+                                   if isinstance(quantities["E_star"], Measured) else Missing("E* undetermined"))
         except (ValueError, RuntimeError, FloatingPointError) as why:
             moved_w.append(Missing(f"{rule.label}: {why}"))
             moved_E.append(Missing(f"{rule.label}: {why}"))

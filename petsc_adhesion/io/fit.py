@@ -57,7 +57,7 @@ DESCRIBE_FIT = {
                          "rule_times_s: s",
                          "the model spread of a fit with roughness (docs/model.md, docs/fitting.md): a pull-off's "
                          "gamma by the same root solve under the other roughness laws (rules), a curve's gamma "
-                         "and E* by the optimum moved to each law (one Gauss-Newton step); quantities/NNNN: the "
+                         "and E* by the optimum of each law's residuals sought from the fit's (fitting/outcome.py); quantities/NNNN: the "
                          "value under the reference's law with its bar, the spread, relative and warning; its "
                          "group values: the value under each rule, one attribute per rule (absent: not found, "
                          "missing says why)"),

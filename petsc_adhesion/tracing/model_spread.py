@@ -198,7 +198,8 @@ class ModelSpread:
 
     ``reference``: the rule the curve was traced with; ``rules``: the others, in the order of every
     :attr:`Quantity.values`; ``quantities``: one per event quantity of the reference; ``notes``: where a law
-    has another set of events (that is its spread), or its curve failed or ended early; ``wall_time_s``:
+    has another set of events (that is its spread), or its curve failed or ended early (a fit's spread: how
+    each law's optimum was reached, or why not); ``wall_time_s``:
     the time of all the laws' curves, ``rule_times_s`` of each; ``force_nN``, ``approach_nm``: the units of
     F and lambda in nN and nm with physical inputs (None without).
     """
