@@ -153,6 +153,7 @@ def make_problem(mu=1.0, sigma=0.0, r=None, pmat="dense", **model):
 #: near the end, where one of them could run on one worker with the other idle.  Handed out first, the short
 #: files fill the gaps at the end (the longest-first rule of scheduling on two machines).
 LONGEST_FIRST = ("test_extremes.py", "test_sweep.py", "test_critical.py", "test_checkpoint.py", "test_fuzz.py",
+                 "test_checkpoint_study.py",
                  "test_fitting.py", "test_hostile.py", "test_soft.py", "test_error_estimate.py", "test_spring.py",
                  "test_kill.py", "test_continuation.py", "test_fit_instrument.py")
 

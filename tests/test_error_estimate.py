@@ -5,7 +5,7 @@ The estimator (error_estimate.py) locates each event again on nested levels of
 its own grid and extrapolates; its calibration over 207 quantities is
 docs/coverage.md.  Here the truth is independent of it: eq. (28) at mu = 0 (the
 half-infinite model, far field included), and at mu = 1 a run refined until its
-bars are below 1e-8.
+bars are below 3e-8.
 """
 import json
 
@@ -41,8 +41,10 @@ def test_bars_cover_the_rigid_closed_form(tmp_path):
 
 @pytest.fixture(scope="module")
 def refined(tmp_path_factory):
-    """mu = 1, the events up to equilibrium, with bars below 1e-8 (levels up to 3 or 4)."""
-    return summary(tmp_path_factory.mktemp("refined"), "ref", "-adh_mu", 1, "-cont_F_max", 0, "-target_error", 1e-8)
+    """mu = 1, the events up to equilibrium, refined to -target_error 1e-7: bars 8e-9 to 2.8e-8, its values
+    within 7.7e-9 of a run refined to 1e-8 (whose bars are 2e-9 to 3.7e-9), which took 18.5 CPU s where this
+    takes 5.9 (measured, load 10).  The checks below add the reference's bar to the one they test."""
+    return summary(tmp_path_factory.mktemp("refined"), "ref", "-adh_mu", 1, "-cont_F_max", 0, "-target_error", 1e-7)
 
 
 def _events(s):
@@ -59,7 +61,7 @@ def test_bars_cover_a_refined_truth(tmp_path, refined, target):
     s = summary(tmp_path, "run", "-adh_mu", 1, "-cont_F_max", 0, *args)
     assert s["complete"]
     for (kind, e), (_, t) in zip(_events(s), _events(refined)):
-        assert t.get("F_err", 0) <= 1e-8 and t.get("lambda_err", 0) <= 1e-8
+        assert t.get("F_err", 0) <= 3e-8 and t.get("lambda_err", 0) <= 3e-8
         for q in ("lambda", "F"):
             if f"{q}_err" not in e:             # a landing's lambda is its fold's; an equilibrium's F is 0
                 continue

@@ -111,12 +111,14 @@ def test_measured_zone_of_a_gaussian_attraction():
 def test_rough_soft_sphere_bars_cover_finer_grids(tmp_path):
     """mu = 100, sigma = 1 (the roughness holds the surfaces at its wall; the edge is Hertz-like, its
     attraction 0.09 to 0.3 wide where the JKR-edge formula says 0.0018): on grids sized by the zone the
-    state shows, the default run's events and bars against the same curve refined to -target_error 3e-6
-    (levels up to 2 and 3): every event within its bar; and the grids stay small (below 1000 nodes,
-    where grids sized by the formula took 3745)."""
+    state shows, the default run's events and bars against the same curve refined to -target_error 1e-5:
+    every event within its bar; and the grids stay small (below 1000 nodes, where grids sized by the
+    formula took 3745).  The reference's own bars are below a quarter of the default's (measured: 0.01 to
+    0.19 of them), and it is within 2.3e-6 in lambda and 1.3e-8 in F (at most 4% of a default bar) of the
+    curve refined to -target_error 3e-6, which took 64 CPU s where 1e-5 takes 20 (and the default 8.5)."""
     import json
     runs = {}
-    for name, extra in (("default", ()), ("fine", ("-target_error", "3e-6"))):
+    for name, extra in (("default", ()), ("fine", ("-target_error", "1e-5"))):
         js = tmp_path / f"{name}.json"
         proc = run_cli("-adh_mu", 100, "-adh_sigma", 1, "-adh_model_spread", "false", *extra, "-summary", js)
         assert proc.returncode == 0, proc.stderr
@@ -127,6 +129,6 @@ def test_rough_soft_sphere_bars_cover_finer_grids(tmp_path):
     assert [e["kind"] for e in events(d)] == [e["kind"] for e in events(f)] == \
         ["F_min", "snap_on", "snap_off", "equilibrium"]
     for a, b in zip(events(d), events(f)):
-        assert abs(a["lambda"] - b["lambda"]) <= a["lambda_err"], (a, b)
+        assert abs(a["lambda"] - b["lambda"]) <= a["lambda_err"] and b["lambda_err"] < a["lambda_err"] / 4, (a, b)
         if a["kind"] != "equilibrium":
-            assert abs(a["F"] - b["F"]) <= a["F_err"], (a, b)
+            assert abs(a["F"] - b["F"]) <= a["F_err"] and b["F_err"] < a["F_err"] / 4, (a, b)
