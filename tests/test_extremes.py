@@ -132,12 +132,14 @@ def test_stiff_end_bars_cover_a_refined_reference(tmp_path):
             assert abs(f["lambda_grid"] - lam) > 100 * abs(f["lambda"] - lam)
 
 
-@pytest.mark.parametrize("case", [(5.0, 0.0), (10.0, 0.2)], ids=["mu5", "mu10-sigma0.2"])
+@pytest.mark.parametrize("case", [(10.0, 0.2)], ids=["mu10-sigma0.2"])
 def test_two_ranks_pass_the_stiff_folds_as_one_does(tmp_path, hardest, case):
     """Two ranks trace one rank's curve through every fold.  With block Jacobi on two ranks (the default
-    before), GMRES could not converge beside the primary snap-off, where G_H is singular: both cases stopped
-    there ("step below -cont_ds_min" at lambda = -8.19 and -12.58) with one fold pair found.  The one rank's
-    run of a case of HARDEST (the same options) is the hardest fixture's."""
+    before), GMRES could not converge beside the primary snap-off, where G_H is singular: mu = 5, sigma = 0
+    and mu = 10, sigma = 0.2 both stopped there ("step below -cont_ds_min" at lambda = -8.19 and -12.58) with
+    one fold pair found.  The suite keeps the stiffer of the two (the same defect, the same primary snap-off;
+    mu = 5's two-rank run cost about 45 s more).  The one rank's run of a case of HARDEST (the same options)
+    is the hardest fixture's."""
     args = ("-adh_mu", case[0], "-adh_sigma", case[1], "-cont_F_max", 0.2, "-cont_error_estimate", "false",
             "-adh_model_spread", "false")
     runs = []
