@@ -30,14 +30,60 @@ _SUBDIVIDE = 8
 
 def _spline(x: np.ndarray, y: np.ndarray, left: float | None, right: float | None):
     """A cubic spline through (x, y) with the slopes ``left``/``right`` at the ends where given."""
-    from scipy.interpolate import CubicSpline
-
     if x.size < 3:
         return lambda t: np.interp(t, x, y)
-    bc: tuple = ((1, left) if left is not None else "not-a-knot", (1, right) if right is not None else "not-a-knot")
-    if x.size == 3 and "not-a-knot" in bc:
-        bc = tuple((2, 0.0) if b == "not-a-knot" else b for b in bc)
-    return CubicSpline(x, y, bc_type=bc)
+    if x.size == 3 and (left is None or right is None):
+        from scipy.interpolate import CubicSpline
+
+        bc: tuple = ((1, left) if left is not None else (2, 0.0), (1, right) if right is not None else (2, 0.0))
+        return CubicSpline(x, y, bc_type=bc)
+    return cubic_spline(x, y, left, right)
+
+
+def cubic_spline(x: np.ndarray, y: np.ndarray, left: float | None = None, right: float | None = None):
+    """scipy's ``CubicSpline(x, y, bc_type)`` through at least 4 points (x increasing), the slope given at an end
+    (``left``, ``right``) or not-a-knot there, as the same PPoly to the bit: the same tridiagonal system for the
+    slopes at the points, solved by the same LAPACK routine (gtsv), and the same Hermite coefficients, without
+    the checks and copies that made up most of its cost on the few hundred points of a branch (a fit builds 7
+    to 10 a curve; tests/test_family.py compares them with scipy's).  Fewer points: scipy's own."""
+    from scipy.interpolate import CubicSpline, PPoly
+    from scipy.linalg.lapack import dgtsv
+
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    n = x.size
+    if n < 4:
+        return CubicSpline(x, y, bc_type=((1, left) if left is not None else "not-a-knot",
+                                          (1, right) if right is not None else "not-a-knot"))
+    dx = np.diff(x)
+    slope = np.diff(y) / dx
+    # the system's three diagonals and its right side, as CubicSpline fills its banded matrix
+    dl, d, du, b = np.empty(n - 1), np.empty(n), np.empty(n - 1), np.empty(n)
+    d[1:-1] = 2 * (dx[:-1] + dx[1:])
+    du[1:] = dx[:-1]
+    dl[:-1] = dx[1:]
+    b[1:-1] = 3 * (dx[1:] * slope[:-1] + dx[:-1] * slope[1:])
+    if left is None:
+        d[0], du[0] = dx[1], x[2] - x[0]
+        w = x[2] - x[0]
+        b[0] = ((dx[0] + 2 * w) * dx[1] * slope[0] + dx[0] ** 2 * slope[1]) / w
+    else:
+        d[0], du[0], b[0] = 1.0, 0.0, left
+    if right is None:
+        d[-1], dl[-1] = dx[-2], x[-1] - x[-3]
+        w = x[-1] - x[-3]
+        b[-1] = (dx[-1] ** 2 * slope[-2] + (2 * w + dx[-1]) * dx[-2] * slope[-1]) / w
+    else:
+        d[-1], dl[-1], b[-1] = 1.0, 0.0, right
+    *_, s, info = dgtsv(dl, d, du, b, 1, 1, 1, 1)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"the spline's system is singular (gtsv info {info})")
+    t = (s[:-1] + s[1:] - 2 * slope) / dx
+    c = np.empty((4, n - 1))
+    c[0] = t / dx
+    c[1] = (slope - s[:-1]) / dx - t
+    c[2] = s[:-1]
+    c[3] = y[:-1]
+    return PPoly.construct_fast(c, x)
 
 
 class Legs:
@@ -82,19 +128,20 @@ class Legs:
         # turning point rather than a point next to it
         gaps = np.diff(lam)
         least = max(1e-3 * float(np.median(gaps)) if gaps.size else 0.0, 1e-12)
-        kept = [0]
-        for i in range(1, lam.size):
-            if lam[i] - lam[kept[-1]] > least:
-                kept.append(i)
-            elif end is not None and i == lam.size - 1 and len(kept) > 1:
-                kept[-1] = i
-        lam, Z, F = lam[kept], Z[kept], F[kept]
+        if not np.all(gaps > least):              # (where every gap is wider, every point is kept)
+            kept = [0]
+            for i in range(1, lam.size):
+                if lam[i] - lam[kept[-1]] > least:
+                    kept.append(i)
+                elif end is not None and i == lam.size - 1 and len(kept) > 1:
+                    kept[-1] = i
+            lam, Z, F = lam[kept], Z[kept], F[kept]
         if lam.size == 1:
             return Piece(lam, Z, F, np.full_like(lam, np.nan), start, end)
         zs = _spline(lam, Z, 0.0 if start is not None else None, 0.0 if end is not None else None)
         fs = _spline(lam, F, -self.K if start is not None else None, -self.K if end is not None else None)
         t = np.linspace(0.0, 1.0, _SUBDIVIDE + 1)[:-1]
-        dense = np.r_[(lam[:-1, None] + np.diff(lam)[:, None] * t[None, :]).ravel(), lam[-1]]
+        dense = np.concatenate(((lam[:-1, None] + np.diff(lam)[:, None] * t[None, :]).ravel(), lam[-1:]))
         Zd, Fd = np.asarray(zs(dense), dtype=float), np.asarray(fs(dense), dtype=float)
         if start is not None:
             Zd[0] = Z[0]
@@ -210,17 +257,15 @@ def spring_legs(t: np.ndarray, lam: np.ndarray, F: np.ndarray, K: float) -> Legs
     parameter monotone along it) by ``lam`` and ``F``: Z = lambda + F / K and its rate in t from cubic splines
     in t, the turning points of Z where that rate changes sign (the roots of the spline's derivative), their
     jumps landing on the next piece that holds their Z."""
-    from scipy.interpolate import CubicSpline
-
     t, lam, F = (np.asarray(a, dtype=float) for a in (t, lam, F))
-    Z = CubicSpline(t, lam + F / K)
+    Z = cubic_spline(t, lam + F / K)
     dZ = Z.derivative()
     rate = dZ(t)
     roots = np.asarray(dZ.roots(extrapolate=False), dtype=float)
     # a root where the rate changes sign is a turning point: a maximum of Z (jump_in) or a minimum (jump_off)
     curv = Z.derivative(2)(roots)
     roots, curv = roots[curv != 0], curv[curv != 0]
-    ls, fs = CubicSpline(t, lam), CubicSpline(t, F)
+    ls, fs = cubic_spline(t, lam), cubic_spline(t, F)
     jump_in = [Turn(float(ls(r)), float(fs(r))) for r in roots[curv < 0]]
     jump_off = [Turn(float(ls(r)), float(fs(r))) for r in roots[curv > 0]]
     return Legs(lam, F, rate > 0, K, jump_in, jump_off)

@@ -318,7 +318,8 @@ class FamilyCurve:
         u = np.linspace(u1, u0, min(n, 200) + 1)[:-1]
         lam_far = 1.0 - np.exp(u)
         t_far = self.tau[0] - (u - u0) * (1.0 - lam0) / rate
-        return np.r_[t_far, self.tau], np.r_[lam_far, self.lam], np.r_[factor * rigid_load(lam_far), self.F]
+        return (np.concatenate((t_far, self.tau)), np.concatenate((lam_far, self.lam)),
+                np.concatenate((factor * rigid_load(lam_far), self.F)))
 
 
 @dataclass(frozen=True)

@@ -286,7 +286,7 @@ class _Problem:
         if "ln_k" in self.names:            # the spring constant's stated uncertainty: a Gaussian prior
             assert self.choice.spring_err is not None, "ln_k is fitted with a stated uncertainty"
             rJ.append((p["k"] - self.spring.k) / self.choice.spring_err)
-        return np.r_[rF, rJ], pieces
+        return np.concatenate((rF, rJ)), pieces
 
     def residuals(self, x) -> np.ndarray:
         r = self._all(self.unpack(x))[0]
