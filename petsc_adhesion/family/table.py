@@ -210,8 +210,10 @@ class FamilyTable:
                        errors={f: np.asarray(errors[f], float) for f in ERROR_FIELDS})
 
     # -- a curve -----------------------------------------------------------------------
-    def curve(self, mu: float, sigma: float) -> FamilyCurve:
-        """The interpolated curve at (mu, sigma): lambda and F at the nodes tau (OutOfRange outside the table)."""
+    def curve(self, mu: float, sigma: float, error: bool = True) -> FamilyCurve:
+        """The interpolated curve at (mu, sigma): lambda and F at the nodes tau (OutOfRange outside the table);
+        ``error`` False: without the interpolation error stated about it (Missing: a fit's search reads the legs
+        alone, and the error's lookup was a tenth of a curve behind a spring)."""
         self.check(mu, sigma)
         i0, wm = lagrange(np.log(self.mu), math.log(mu))
         j0, ws = lagrange(self.sigma, float(sigma))
@@ -219,7 +221,8 @@ class FamilyTable:
         block = (slice(i0, i0 + wm.size), slice(j0, j0 + ws.size))
         lam = np.tensordot(w, self.lam[block], axes=([0, 1], [0, 1]))
         F = np.tensordot(w, self.F[block], axes=([0, 1], [0, 1]))
-        return FamilyCurve(float(mu), float(sigma), self.tau, lam, F, self.F_max, self.error(mu, sigma))
+        return FamilyCurve(float(mu), float(sigma), self.tau, lam, F, self.F_max, self.error(mu, sigma) if error else
+                           Missing("the table's interpolation error was not asked for with this curve"))
 
     # -- the file ----------------------------------------------------------------------
     def save(self, path: str) -> None:
