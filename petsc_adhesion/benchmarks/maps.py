@@ -50,8 +50,11 @@ def run(n: int) -> dict:
     m = synthetic_map((n, n), truth, spring, Sampling(noise=0.01 * 2 * math.pi * R * 0.05, points=100, z0=5e-9))
     made = time.perf_counter() - t0
     t1, c1 = time.perf_counter(), time.process_time()
+    shown = [0]
+
     def say(pr) -> None:            # rank 0's line every 256 pixels: a map stopped part way still measured
-        if pr.done % 256 == 0 or pr.done == pr.total:
+        if pr.done // 256 > shown[0] or pr.done == pr.total:
+            shown[0] = pr.done // 256
             print(f"{pr.done} of {pr.total} pixels, {pr.elapsed:.0f} s wall, rank 0 CPU "
                   f"{time.process_time() - c1:.1f} s, load {os.getloadavg()[0]:.1f}", flush=True)
 

@@ -115,14 +115,21 @@ def maugis_dugdale_curve(mu: float, m: ArrayLike) -> tuple[float | np.ndarray, f
     return _out(_MD_RADIUS * math.sqrt(mu) * A), _out(P / 2.0), _out(_MD_APPROACH * mu * D)
 
 
+#: The grid in x = log(m - 1) that brackets the pull-off's minimum, and m - 1 on it (the same every time).
+_PULL_OFF_GRID = (np.linspace(math.log(1e-14), math.log(1e14), 561),
+                  np.exp(np.linspace(math.log(1e-14), math.log(1e14), 561)))
+for _a in _PULL_OFF_GRID:
+    _a.flags.writeable = False
+
+
 def _md_pull_off(mu: float) -> float:
     if mu == 0.0:
         return DMT_PULL_OFF
     lmd = float(maugis_parameter(mu))
     # x = log(m - 1): the minimum moves from m - 1 ~ lmd^-3/2 (DMT) to ~ lmd^-2
     # (JKR), decades apart; a grid over x brackets it before Brent refines it
-    x = np.linspace(math.log(1e-14), math.log(1e14), 561)
-    P = _md_curve(lmd, np.exp(x))[1]
+    x, q = _PULL_OFF_GRID
+    P = _md_curve(lmd, q)[1]
     i = int(np.argmin(P))
     lo, hi = x[max(i - 1, 0)], x[min(i + 1, x.size - 1)]
     def load(y):
