@@ -256,7 +256,7 @@ class Legs:
             x = new
             if done:
                 break
-        return self._far_factor * rigid_load(x)
+        return np.asarray(self._far_factor * rigid_load(x), dtype=float)
 
 
 def spring_legs(t: np.ndarray, lam: np.ndarray, F: np.ndarray, K: float) -> Legs:
