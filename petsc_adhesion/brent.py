@@ -84,22 +84,24 @@ def minimum(f, a: float, b: float, xatol: float = 1e-5, maxiter: int = 500) -> f
         raise ValueError("Optimization bounds must be finite scalars.")
     if a > b:
         raise ValueError("The lower bound exceeds the upper bound.")
-    # numpy floats from here on, as scipy's (a subclass of float, which numpy 1's stubs do not say)
-    a, b = np.float64(a), np.float64(b)  # type: ignore[assignment]
+    # Python floats inside (IEEE doubles: numpy's arithmetic to the bit, without its scalars' overhead, which
+    # was most of a Maugis-Dugdale pull-off's cost); f gets numpy floats, as scipy gives them
+    a, b = float(a), float(b)
+    f64 = np.float64
     sqrt_eps = math.sqrt(2.2e-16)
     golden_mean = 0.5 * (3.0 - math.sqrt(5.0))
     fulc = a + golden_mean * (b - a)
     nfc, xf = fulc, fulc
     rat = e = 0.0
-    fx = f(xf)
+    fx = float(f(f64(xf)))
     num = 1
     ffulc = fnfc = fx
     xm = 0.5 * (a + b)
-    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+    tol1 = sqrt_eps * abs(xf) + xatol / 3.0
     tol2 = 2.0 * tol1
-    while np.abs(xf - xm) > (tol2 - 0.5 * (b - a)):
+    while abs(xf - xm) > (tol2 - 0.5 * (b - a)):
         golden = True
-        if np.abs(e) > tol1:                                   # a parabolic fit
+        if abs(e) > tol1:                                      # a parabolic fit
             golden = False
             r = (xf - nfc) * (fx - ffulc)
             q = (xf - fulc) * (fx - fnfc)
@@ -107,20 +109,20 @@ def minimum(f, a: float, b: float, xatol: float = 1e-5, maxiter: int = 500) -> f
             q = 2.0 * (q - r)
             if q > 0.0:
                 p = -p
-            q = np.abs(q)
+            q = abs(q)
             r, e = e, rat
-            if np.abs(p) < np.abs(0.5 * q * r) and p > q * (a - xf) and p < q * (b - xf):
+            if abs(p) < abs(0.5 * q * r) and p > q * (a - xf) and p < q * (b - xf):
                 rat = (p + 0.0) / q
                 x = xf + rat
                 if (x - a) < tol2 or (b - x) < tol2:
-                    rat = tol1 * (np.sign(xm - xf) + ((xm - xf) == 0))
+                    rat = tol1 * _sign1(xm - xf)
             else:
                 golden = True
         if golden:                                             # a golden-section step
             e = (a - xf) if xf >= xm else (b - xf)
             rat = golden_mean * e
-        x = xf + (np.sign(rat) + (rat == 0)) * np.maximum(np.abs(rat), tol1)
-        fu = f(x)
+        x = xf + _sign1(rat) * _larger(abs(rat), tol1)
+        fu = float(f(f64(x)))
         num += 1
         if fu <= fx:
             if x >= xf:
@@ -141,8 +143,18 @@ def minimum(f, a: float, b: float, xatol: float = 1e-5, maxiter: int = 500) -> f
             elif fu <= ffulc or fulc == xf or fulc == nfc:
                 fulc, ffulc = x, fu
         xm = 0.5 * (a + b)
-        tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+        tol1 = sqrt_eps * abs(xf) + xatol / 3.0
         tol2 = 2.0 * tol1
         if num >= maxiter:
             break
-    return xf
+    return f64(xf)  # type: ignore[return-value]
+
+
+def _sign1(x: float) -> float:
+    """numpy's sign(x) + (x == 0), scipy's: 1 at and above 0, -1 below, NaN for NaN."""
+    return x if x != x else (1.0 if x >= 0.0 else -1.0)
+
+
+def _larger(x: float, y: float) -> float:
+    """numpy's maximum(x, y): NaN where either is."""
+    return x if x != x else y if y != y else (x if x >= y else y)

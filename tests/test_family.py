@@ -117,6 +117,50 @@ def test_off_node_curves_are_the_solver_s_within_the_measured_error(table):
         assert all(b == err.event_F for b in bars)                 # the bar every event carries
 
 
+def test_the_legs_splines_are_scipys_to_the_bit():
+    """cubic_spline, the legs' splines without scipy's checks: the coefficients and the values of scipy's
+    CubicSpline, to the last bit, for one column or several (each as alone), the slope given or not-a-knot at
+    each end."""
+    from scipy.interpolate import CubicSpline
+
+    from petsc_adhesion.family.legs import cubic_spline
+
+    rng = np.random.default_rng(11)
+    for n in (4, 5, 9, 300):
+        x = np.cumsum(rng.uniform(0.01, 2.0, n))
+        Y = rng.normal(size=(n, 3))
+        at = np.sort(rng.uniform(x[0] - 1, x[-1] + 1, 200))
+        for left in (None, np.array([0.0, -0.3, 2.0])):
+            for right in (None, np.array([0.5, 1.7, -1.0])):
+                ours = cubic_spline(x, Y, left, right)
+                values = ours(at)
+                for j in range(3):
+                    bc = ((1, left[j]) if left is not None else "not-a-knot",
+                          (1, right[j]) if right is not None else "not-a-knot")
+                    theirs = CubicSpline(x, Y[:, j], bc_type=bc)
+                    assert np.array_equal(ours.c[:, :, j], theirs.c)
+                    assert np.array_equal(values[:, j], theirs(at))
+                    one = cubic_spline(x, Y[:, j], None if left is None else left[j],
+                                       None if right is None else right[j])
+                    assert np.array_equal(one.c, theirs.c)
+
+
+def test_the_far_branch_is_the_rigid_sphere_behind_the_spring():
+    """Below a branch's start the legs continue it by the rigid sphere (eq. 28) scaled to the branch there: each
+    force it gives is c F_rigid(lambda) at the lambda that puts the spring's base at Z, lambda = Z - F / K,
+    to 1e-13 (its Newton steps against the closed form)."""
+    from petsc_adhesion.model.reference.rigid import rigid_load
+
+    lam = np.linspace(-3.0, 0.1, 40)
+    F = 0.9 * rigid_load(lam)                   # a far branch 10% weaker than the rigid sphere's
+    for K in (1e-3, 0.05, 2.0):
+        legs = spring_legs(np.arange(lam.size, dtype=float), lam, F, K)
+        Z = np.linspace(legs.pieces[0].Z_lo - 5000.0, legs.pieces[0].Z_lo - 1e-3, 300)
+        got = legs._far(Z)
+        want = legs._far_factor * rigid_load(Z - got / K)
+        assert np.max(np.abs(got - want) / np.abs(want)) < 1e-13
+
+
 def test_spring_legs_are_forward_py_s_on_the_same_curve():
     """The legs found from a branch alone (turning points of Z where its spline's rate changes sign) against
     fitting/forward.py's from the library's located jump events on the same traced curve: the same jumps to

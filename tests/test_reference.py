@@ -205,6 +205,19 @@ def test_maugis_dugdale_matches_adhesion_package():
     np.testing.assert_allclose(maugis_dugdale_pull_off(mu), list(ADHESION_PULL_OFF.values()), rtol=0, atol=2e-11)
 
 
+def test_maugis_dugdale_scalar_load_is_the_curves_to_the_bit():
+    # the pull-off's minimization reads the load one m at a time, now in Python floats: numpy's curve at that
+    # one m (what it read before) is the reference, on both sides of the series for small sqrt(m^2 - 1) and
+    # over the whole range of m
+    from petsc_adhesion.model.reference.maugis_dugdale import _md_curve, _md_load
+
+    rng = np.random.default_rng(7)
+    q = np.r_[np.exp(rng.uniform(math.log(1e-14), math.log(1e14), 400)), 0.0199**2 / 2, 0.0201**2 / 2]
+    for lmd in 10 ** rng.uniform(-4, 4, 40):
+        want = [float(_md_curve(float(lmd), float(x))[1]) for x in q]
+        assert [_md_load(float(lmd), float(x)) for x in q] == want
+
+
 def test_maugis_dugdale_limits():
     # measured: 1 + F = 3.4e-5 at mu = 1e-3 (goes as mu^1.5),
     #           F + 0.75 = -2.4e-5 at mu = 50 (goes as mu^-2)

@@ -3,7 +3,7 @@
     python -m petsc_adhesion.benchmarks.fitting pull_off   # JKR, DMT, Maugis-Dugdale against ours, by mu
     python -m petsc_adhesion.benchmarks.fitting coverage   # do the curve fit's 95% intervals hold? (about 30 min)
     python -m petsc_adhesion.benchmarks.fitting real       # the measured curve of tests/data, fitted, with its figure
-    python -m petsc_adhesion.benchmarks.fitting speed [-before] [-cache DIR]     # the CPU of one fit, by mu
+    python -m petsc_adhesion.benchmarks.fitting speed [-before] [-cache DIR] [-mus 0.001,0.1]  # one fit's CPU
     python -m petsc_adhesion.benchmarks.fitting table_coverage [-cases N] [-cache DIR]   # mu 1e-3 to 1e3
     python -m petsc_adhesion.benchmarks.fitting -table     # the sections again from docs/data/fitting_*.json
 
@@ -261,10 +261,11 @@ def _partial(name: str, rows: list) -> None:
                   f, indent=1)
 
 
-def speed_rows(before: bool, cache: str | None) -> list:
-    """The CPU of one fit through the table (and with ``before`` on the solver alone) at SPEED_MUS: at each mu
-    curves of one truth with the noise of each seed, fitted one after the other in this process (the first at a
-    mu traces its solver curve, the later ones find it where they land on its lattice point)."""
+def speed_rows(before: bool, cache: str | None, mus: tuple | None = None) -> list:
+    """The CPU of one fit through the table (and with ``before`` on the solver alone) at SPEED_MUS (``mus``: those
+    of them alone): at each mu curves of one truth with the noise of each seed, fitted one after the other in this
+    process (the first at a mu traces its solver curve, the later ones find it where they land on its lattice
+    point)."""
     _init()
     import scipy.stats  # noqa: F401  (a fit's p-value imports it once a process: 1 s, outside the timings)
 
@@ -274,7 +275,7 @@ def speed_rows(before: bool, cache: str | None) -> list:
     shipped()                                            # read once, outside the timings
     rows = []
     K = SYNTH["spring"] * SYNTH["epsilon"] / (2 * math.pi * SYNTH["radius"] * SYNTH["gamma"])
-    for mu in (BEFORE_MUS if before else SPEED_MUS):
+    for mu in [m for m in (BEFORE_MUS if before else SPEED_MUS) if mus is None or m in mus]:
         BRANCHES.clear()                                # each mu's first fit pays for its curves
         for order, seed in enumerate(SPEED_SEEDS[mu][:1] if before else SPEED_SEEDS[mu]):
             data, truth, bodies, spring = _synthetic(mu, K, SYNTH["noise_share"], seed, cache, finer=False)
@@ -310,12 +311,13 @@ def speed_section(rows: list, made: dict) -> str:
             if not sel:
                 continue
             first, later = sel[0], sel[1:]
+            mu_cell = f"{mu:g}" if "earlier" not in first else f"{mu:g} (an earlier run, {first['earlier']})"
             search = [r["search_cpu_s"] for r in sel if "search_cpu_s" in r]
             cpus = [r["cpu_s"] for r in later]
             med = f"{np.median(cpus):.3g}" if cpus else "-"
             each = ", ".join(f"{c:.2g}" for c in cpus) or "-"
             counts = ", ".join(f"{r['traces']}/{r.get('shared', 0)}" for r in sel)
-            lines.append(f"| {mu:g} | {kind} | {first['cpu_s']:.3g} | {len(later)} | {med} | {each} | "
+            lines.append(f"| {mu_cell} | {kind} | {first['cpu_s']:.3g} | {len(later)} | {med} | {each} | "
                          f"{f'{np.median(search):.3g}' if search else '-'} | {counts} |")
     refused = [r for r in rows if "cpu_s" not in r]
     for r in refused:
@@ -443,7 +445,16 @@ def main(argv: list[str]) -> int:
     if argv[:1] == ["-case"]:
         print(json.dumps(coverage_case(float(argv[1]), int(argv[2]))))
         return 0
-    value = {a: argv[i + 1] for i, a in enumerate(argv[:-1]) if a in ("-cache", "-cases")}
+    value = {a: argv[i + 1] for i, a in enumerate(argv[:-1]) if a in ("-cache", "-cases", "-mus")}
+    try:
+        mus = None if "-mus" not in value else tuple(float(m) for m in value["-mus"].split(","))
+    except ValueError:
+        print(f"-mus {value['-mus']}: expected Tabor parameters separated by commas, of {SPEED_MUS}", file=sys.stderr)
+        return 2
+    if mus is not None and not set(mus) <= set(SPEED_MUS):
+        print(f"-mus {value['-mus']}: expected Tabor parameters of {', '.join(f'{m:g}' for m in SPEED_MUS)}",
+              file=sys.stderr)
+        return 2
     parts = [a for a in argv if not a.startswith("-") and a not in value.values()] or ["pull_off", "real", "coverage"]
     redraw = "-table" in argv
     cache = value.get("-cache")
@@ -461,7 +472,7 @@ def main(argv: list[str]) -> int:
         text = pull_off_section(d["rows"], d["made"])
         paths.write_section(DOC, text)
         print(text)
-    for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache), speed_section),
+    for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache, mus), speed_section),
                                    ("table_coverage", lambda: table_coverage_rows(int(value.get("-cases", 60)), cache,
                                                                     "-make_only" in argv, "-made_only" in argv),
                                     table_coverage_section)):
@@ -475,7 +486,12 @@ def main(argv: list[str]) -> int:
             old = []
             if part == "speed" and os.path.exists(_data(part)):       # -before adds to the table path's rows
                 with open(_data(part)) as f:
-                    old = [r for r in json.load(f)["rows"] if r.get("path_kind") != rows[0].get("path_kind")]
+                    was = json.load(f)
+                # and -mus to the rows of the other mu, each said to be of an earlier run (its commit)
+                commit = str(was["made"].get("commit") or "?")[:7]
+                old = [r for r in was["rows"] if r.get("path_kind") != rows[0].get("path_kind")] + \
+                    [{**r, "earlier": r.get("earlier", commit)} for r in was["rows"]
+                     if r.get("path_kind") == rows[0].get("path_kind") and mus is not None and r["mu"] not in mus]
             with open(_data(part), "w") as f:
                 json.dump({"made": {"seconds": time.perf_counter() - t, "load": f"{os.getloadavg()[0]:.1f}",
                                     **paths.source()}, "rows": old + rows}, f, indent=1)

@@ -19,6 +19,8 @@ import os
 import sys
 import time
 
+import numpy as np
+
 __all__ = ["run", "main", "R", "EPS", "MATERIALS"]
 
 R, EPS, K_SPRING = 20e-9, 0.3e-9, 1.0
@@ -50,14 +52,37 @@ def run(n: int) -> dict:
     m = synthetic_map((n, n), truth, spring, Sampling(noise=0.01 * 2 * math.pi * R * 0.05, points=100, z0=5e-9))
     made = time.perf_counter() - t0
     t1, c1 = time.perf_counter(), time.process_time()
+    shown = [0]
+
     def say(pr) -> None:            # rank 0's line every 256 pixels: a map stopped part way still measured
-        if pr.done % 256 == 0 or pr.done == pr.total:
+        if pr.done // 256 > shown[0] or pr.done == pr.total:
+            shown[0] = pr.done // 256
             print(f"{pr.done} of {pr.total} pixels, {pr.elapsed:.0f} s wall, rank 0 CPU "
                   f"{time.process_time() - c1:.1f} s, load {os.getloadavg()[0]:.1f}", flush=True)
 
-    r = fit_map(m, Bodies(radius=R, young1=30e9, poisson1=0.0, epsilon=EPS), spring, progress=say)
+    # each fit's CPU, timed from outside the library (the map's own fit_curve wrapped for this run alone)
+    from petsc_adhesion.maps import fit as map_fit
+
+    own = map_fit.fit_curve
+    fits: list = []
+
+    def timed(*args, **kwargs):
+        c = time.process_time()
+        f = own(*args, **kwargs)
+        fits.append((time.process_time() - c, f.traces))
+        return f
+
+    map_fit.fit_curve = timed
+    try:
+        r = fit_map(m, Bodies(radius=R, young1=30e9, poisson1=0.0, epsilon=EPS), spring, progress=say)
+    finally:
+        map_fit.fit_curve = own
     wall, cpu = time.perf_counter() - t1, time.process_time() - c1
-    cpus = PETSc.COMM_WORLD.tompi4py().gather(cpu, root=0)
+    comm = PETSc.COMM_WORLD.tompi4py()
+    cpus = comm.gather(cpu, root=0)
+    every = comm.allgather(fits)
+    each = np.array([c for part in every for c, _ in part])
+    traced = np.array([t > 0 for part in every for _, t in part])
     covered = {"gamma": 0, "E_star": 0}
     for p in r.pixels:
         t = truth(p.entry.ix, p.entry.iy)
@@ -75,6 +100,10 @@ def run(n: int) -> dict:
             "pixels_per_s": n * n / wall, "cpu_s_per_pixel": None if cpus is None else sum(cpus) / (n * n),
             "ok": r.count("ok"), "flagged": n * n - r.count("ok"), "covered_95": covered,
             "solver_curves_traced": sum(p.traces for p in r.pixels),
+            "fit_cpu_s_median": float(np.median(each)) if each.size else None,
+            "fit_cpu_s_median_found": float(np.median(each[~traced])) if (~traced).any() else None,
+            "fits_that_traced": int(traced.sum()), "their_cpu_s": float(each[traced].sum()),
+            "fits_cpu_s": float(each.sum()),
             "load_average": os.getloadavg()[0], "setup_cpu_s": c1 - c0}
 
 
@@ -90,7 +119,10 @@ def main(argv=None) -> int:
         print(f"map {n}x{n} on {out['ranks']} rank(s): {out['wall_s']:.1f} s wall, "
               f"{out['pixels_per_s']:.3g} pixels/s, {out['cpu_s_per_pixel']:.2f} CPU s a pixel; "
               f"{out['ok']} ok, {out['flagged']} flagged; 95% intervals cover w in {out['covered_95']['gamma']}, "
-              f"E* in {out['covered_95']['E_star']} of {n * n}; {out['solver_curves_traced']} solver curves traced; "
+              f"E* in {out['covered_95']['E_star']} of {n * n}; {out['solver_curves_traced']} solver curves traced "
+              f"by {out['fits_that_traced']} fits ({out['their_cpu_s']:.1f} CPU s of the fits' "
+              f"{out['fits_cpu_s']:.1f}); a fit's median {out['fit_cpu_s_median'] or math.nan:.3f} CPU s, "
+              f"{out['fit_cpu_s_median_found'] or math.nan:.3f} where it found its branch; "
               f"load average {out['load_average']:.1f}")
         os.makedirs(paths.DATA, exist_ok=True)
         with open(os.path.join(paths.DATA, f"maps_{n}_np{out['ranks']}.json"), "w") as f:

@@ -30,14 +30,62 @@ _SUBDIVIDE = 8
 
 def _spline(x: np.ndarray, y: np.ndarray, left: float | None, right: float | None):
     """A cubic spline through (x, y) with the slopes ``left``/``right`` at the ends where given."""
-    from scipy.interpolate import CubicSpline
-
     if x.size < 3:
         return lambda t: np.interp(t, x, y)
-    bc: tuple = ((1, left) if left is not None else "not-a-knot", (1, right) if right is not None else "not-a-knot")
-    if x.size == 3 and "not-a-knot" in bc:
-        bc = tuple((2, 0.0) if b == "not-a-knot" else b for b in bc)
-    return CubicSpline(x, y, bc_type=bc)
+    if x.size == 3 and (left is None or right is None):
+        from scipy.interpolate import CubicSpline
+
+        bc: tuple = ((1, left) if left is not None else (2, 0.0), (1, right) if right is not None else (2, 0.0))
+        return CubicSpline(x, y, bc_type=bc)
+    return cubic_spline(x, y, left, right)
+
+
+def cubic_spline(x: np.ndarray, y: np.ndarray, left=None, right=None):
+    """scipy's ``CubicSpline(x, y, bc_type)`` through at least 4 points (x increasing), the slope given at an end
+    (``left``, ``right``; one a column of ``y`` of shape (n, k)) or not-a-knot there, as the same PPoly to the
+    bit: the same tridiagonal system for the slopes at the points, solved by the same LAPACK routine (gtsv, all
+    the columns at once: each as alone), and the same Hermite coefficients, without the checks and copies that
+    made up most of its cost on the few hundred points of a branch (a fit builds some twenty curves behind a
+    spring, each 3 to 8 splines; tests/test_family.py compares them with scipy's).  Fewer points: scipy's own."""
+    from scipy.interpolate import CubicSpline, PPoly
+    from scipy.linalg.lapack import dgtsv
+
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    n = x.size
+    if n < 4:
+        return CubicSpline(x, y, bc_type=((1, left) if left is not None else "not-a-knot",
+                                          (1, right) if right is not None else "not-a-knot"))
+    dx = np.diff(x)
+    dxr = dx.reshape((n - 1,) + (1,) * (y.ndim - 1))
+    slope = np.diff(y, axis=0) / dxr
+    # the system's three diagonals and its right side, as CubicSpline fills its banded matrix
+    dl, d, du, b = np.empty(n - 1), np.empty(n), np.empty(n - 1), np.empty(y.shape, order="F")
+    d[1:-1] = 2 * (dx[:-1] + dx[1:])
+    du[1:] = dx[:-1]
+    dl[:-1] = dx[1:]
+    b[1:-1] = 3 * (dxr[1:] * slope[:-1] + dxr[:-1] * slope[1:])
+    if left is None:
+        d[0], du[0] = dx[1], x[2] - x[0]
+        w = x[2] - x[0]
+        b[0] = ((dxr[0] + 2 * w) * dxr[1] * slope[0] + dxr[0] ** 2 * slope[1]) / w
+    else:
+        d[0], du[0], b[0] = 1.0, 0.0, left
+    if right is None:
+        d[-1], dl[-1] = dx[-2], x[-1] - x[-3]
+        w = x[-1] - x[-3]
+        b[-1] = (dxr[-1] ** 2 * slope[-2] + (2 * w + dxr[-1]) * dxr[-2] * slope[-1]) / w
+    else:
+        d[-1], dl[-1], b[-1] = 1.0, 0.0, right
+    *_, s, info = dgtsv(dl, d, du, b, 1, 1, 1, 1)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"the spline's system is singular (gtsv info {info})")
+    t = (s[:-1] + s[1:] - 2 * slope) / dxr
+    c = np.empty((4, n - 1) + y.shape[1:])
+    c[0] = t / dxr
+    c[1] = (slope - s[:-1]) / dxr - t
+    c[2] = s[:-1]
+    c[3] = y[:-1]
+    return PPoly.construct_fast(c, x)
 
 
 class Legs:
@@ -82,20 +130,26 @@ class Legs:
         # turning point rather than a point next to it
         gaps = np.diff(lam)
         least = max(1e-3 * float(np.median(gaps)) if gaps.size else 0.0, 1e-12)
-        kept = [0]
-        for i in range(1, lam.size):
-            if lam[i] - lam[kept[-1]] > least:
-                kept.append(i)
-            elif end is not None and i == lam.size - 1 and len(kept) > 1:
-                kept[-1] = i
-        lam, Z, F = lam[kept], Z[kept], F[kept]
+        if not np.all(gaps > least):              # (where every gap is wider, every point is kept)
+            kept = [0]
+            for i in range(1, lam.size):
+                if lam[i] - lam[kept[-1]] > least:
+                    kept.append(i)
+                elif end is not None and i == lam.size - 1 and len(kept) > 1:
+                    kept[-1] = i
+            lam, Z, F = lam[kept], Z[kept], F[kept]
         if lam.size == 1:
             return Piece(lam, Z, F, np.full_like(lam, np.nan), start, end)
-        zs = _spline(lam, Z, 0.0 if start is not None else None, 0.0 if end is not None else None)
-        fs = _spline(lam, F, -self.K if start is not None else None, -self.K if end is not None else None)
         t = np.linspace(0.0, 1.0, _SUBDIVIDE + 1)[:-1]
-        dense = np.r_[(lam[:-1, None] + np.diff(lam)[:, None] * t[None, :]).ravel(), lam[-1]]
-        Zd, Fd = np.asarray(zs(dense), dtype=float), np.asarray(fs(dense), dtype=float)
+        dense = np.concatenate(((lam[:-1, None] + np.diff(lam)[:, None] * t[None, :]).ravel(), lam[-1:]))
+        if lam.size >= 4:                       # Z and F in one spline of two columns (each as alone)
+            both = cubic_spline(lam, np.column_stack((Z, F)), None if start is None else np.array([0.0, -self.K]),
+                                None if end is None else np.array([0.0, -self.K]))(dense)
+            Zd, Fd = both[:, 0].copy(), both[:, 1].copy()
+        else:
+            zs = _spline(lam, Z, 0.0 if start is not None else None, 0.0 if end is not None else None)
+            fs = _spline(lam, F, -self.K if start is not None else None, -self.K if end is not None else None)
+            Zd, Fd = np.asarray(zs(dense), dtype=float), np.asarray(fs(dense), dtype=float)
         if start is not None:
             Zd[0] = Z[0]
         Zd = np.maximum.accumulate(Zd)                 # no overshoot of the spline about a turning point
@@ -181,17 +235,28 @@ class Legs:
 
     def _far(self, Z: np.ndarray) -> np.ndarray:
         """The far branch below the branch's start: the rigid sphere's load (eq. 28) times its ratio to the
-        branch's at the start, at the lambda of Z = lambda + F / K (bisection: Z <= lambda <= lambda_0)."""
+        branch's at the start, at the lambda of Z = lambda + F / K.  That lambda lies in [Z, lambda_0], where
+        Z(lambda) rises (the far branch is stable behind the spring below the branch's start): Newton's method on
+        h(lambda) = lambda + F(lambda) / K - Z, with dF/dlambda = (8/3) c ((1 - lambda)^-9 - (1 - lambda)^-3)
+        from eq. 28, each step kept inside the bracket where h changes sign (halved where it would leave it), to
+        a few units in the last place: the root the bisection this replaced found (to 1e-15 of F), in 3 to 6 steps
+        instead of its 60."""
+        Z = np.asarray(Z, dtype=float)
         lo, hi = np.minimum(Z, self._lam0 - 1e-12), np.full_like(Z, self._lam0)
-
-        def load(lam):
-            return self._far_factor * rigid_load(lam)
-
+        c = self._far_factor / self.K
+        x = lo.copy()
         for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            above = mid + load(mid) / self.K > Z
-            hi, lo = np.where(above, mid, hi), np.where(above, lo, mid)
-        return load(0.5 * (lo + hi))
+            g = 1.0 - x
+            h = x + c * (1.0 - 4.0 * g**6) / (3.0 * g**8) - Z
+            above = h > 0
+            hi, lo = np.where(above, x, hi), np.where(above, lo, x)
+            new = x - h / (1.0 + c * (8.0 / 3.0) * (g**-9 - g**-3))
+            new = np.where((new >= lo) & (new <= hi), new, 0.5 * (lo + hi))
+            done = np.all(np.abs(new - x) <= 4e-16 * np.maximum(np.abs(x), 1.0))
+            x = new
+            if done:
+                break
+        return np.asarray(self._far_factor * rigid_load(x), dtype=float)
 
 
 def spring_legs(t: np.ndarray, lam: np.ndarray, F: np.ndarray, K: float) -> Legs:
@@ -199,17 +264,35 @@ def spring_legs(t: np.ndarray, lam: np.ndarray, F: np.ndarray, K: float) -> Legs
     parameter monotone along it) by ``lam`` and ``F``: Z = lambda + F / K and its rate in t from cubic splines
     in t, the turning points of Z where that rate changes sign (the roots of the spline's derivative), their
     jumps landing on the next piece that holds their Z."""
-    from scipy.interpolate import CubicSpline
+    from scipy.interpolate import PPoly
 
     t, lam, F = (np.asarray(a, dtype=float) for a in (t, lam, F))
-    Z = CubicSpline(t, lam + F / K)
+    if t.size < 4:
+        return _spring_legs_few(t, lam, F, K)
+    # Z, lambda and F in one spline of three columns (each as alone), Z's own for its derivatives
+    splines = cubic_spline(t, np.column_stack((lam + F / K, lam, F)))
+    Z = PPoly.construct_fast(np.ascontiguousarray(splines.c[:, :, 0]), splines.x)
     dZ = Z.derivative()
     rate = dZ(t)
     roots = np.asarray(dZ.roots(extrapolate=False), dtype=float)
     # a root where the rate changes sign is a turning point: a maximum of Z (jump_in) or a minimum (jump_off)
     curv = Z.derivative(2)(roots)
     roots, curv = roots[curv != 0], curv[curv != 0]
-    ls, fs = CubicSpline(t, lam), CubicSpline(t, F)
-    jump_in = [Turn(float(ls(r)), float(fs(r))) for r in roots[curv < 0]]
-    jump_off = [Turn(float(ls(r)), float(fs(r))) for r in roots[curv > 0]]
+    at = splines(roots)
+    jump_in = [Turn(float(v[1]), float(v[2])) for v in at[curv < 0]]
+    jump_off = [Turn(float(v[1]), float(v[2])) for v in at[curv > 0]]
     return Legs(lam, F, rate > 0, K, jump_in, jump_off)
+
+
+def _spring_legs_few(t: np.ndarray, lam: np.ndarray, F: np.ndarray, K: float) -> Legs:
+    """spring_legs of a branch of fewer than 4 points: scipy's splines."""
+    from scipy.interpolate import CubicSpline
+
+    Z = CubicSpline(t, lam + F / K)
+    dZ = Z.derivative()
+    roots = np.asarray(dZ.roots(extrapolate=False), dtype=float)
+    curv = Z.derivative(2)(roots)
+    roots, curv = roots[curv != 0], curv[curv != 0]
+    ls, fs = CubicSpline(t, lam), CubicSpline(t, F)
+    return Legs(lam, F, dZ(t) > 0, K, [Turn(float(ls(r)), float(fs(r))) for r in roots[curv < 0]],
+                [Turn(float(ls(r)), float(fs(r))) for r in roots[curv > 0]])

@@ -212,8 +212,10 @@ class FamilyTable:
                        errors={f: np.asarray(errors[f], float) for f in ERROR_FIELDS})
 
     # -- a curve -----------------------------------------------------------------------
-    def curve(self, mu: float, sigma: float) -> FamilyCurve:
-        """The interpolated curve at (mu, sigma): lambda and F at the nodes tau (OutOfRange outside the table)."""
+    def curve(self, mu: float, sigma: float, error: bool = True) -> FamilyCurve:
+        """The interpolated curve at (mu, sigma): lambda and F at the nodes tau (OutOfRange outside the table);
+        ``error`` False: without the interpolation error stated about it (Missing: a fit's search reads the legs
+        alone, and the error's lookup was a tenth of a curve behind a spring)."""
         self.check(mu, sigma)
         i0, wm = lagrange(np.log(self.mu), math.log(mu))
         j0, ws = lagrange(self.sigma, float(sigma))
@@ -221,7 +223,8 @@ class FamilyTable:
         block = (slice(i0, i0 + wm.size), slice(j0, j0 + ws.size))
         lam = np.tensordot(w, self.lam[block], axes=([0, 1], [0, 1]))
         F = np.tensordot(w, self.F[block], axes=([0, 1], [0, 1]))
-        return FamilyCurve(float(mu), float(sigma), self.tau, lam, F, self.F_max, self.error(mu, sigma))
+        return FamilyCurve(float(mu), float(sigma), self.tau, lam, F, self.F_max, self.error(mu, sigma) if error else
+                           Missing("the table's interpolation error was not asked for with this curve"))
 
     # -- the file ----------------------------------------------------------------------
     #: The arrays a table's file holds beside its format and version.
@@ -319,7 +322,8 @@ class FamilyCurve:
         u = np.linspace(u1, u0, min(n, 200) + 1)[:-1]
         lam_far = 1.0 - np.exp(u)
         t_far = self.tau[0] - (u - u0) * (1.0 - lam0) / rate
-        return np.r_[t_far, self.tau], np.r_[lam_far, self.lam], np.r_[factor * rigid_load(lam_far), self.F]
+        return (np.concatenate((t_far, self.tau)), np.concatenate((lam_far, self.lam)),
+                np.concatenate((factor * rigid_load(lam_far), self.F)))
 
 
 @dataclass(frozen=True)

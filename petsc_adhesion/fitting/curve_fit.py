@@ -135,6 +135,10 @@ class _Problem:
             self.labels[:turn] = np.arange(turn) >= feat.contact_from
         if feat.free_from is not None:
             self.labels[turn:] = np.arange(n - turn) < feat.free_from
+        # (fixed for the fit: its every evaluation assigns the points to pieces by them)
+        self.contact = self.labels == 1
+        self.unlabelled = [(name, own) for name, own in ((APPROACH, (self.legs == 0) & (self.labels < 0)),
+                                                         (RETRACT, (self.legs == 1) & (self.labels < 0))) if own.any()]
         # the points fitted: the legs of the segment asked for, within the piezo range asked for
         ch = self.choice
         self.mask = np.ones(n)
@@ -237,11 +241,9 @@ class _Problem:
     def assign(self, fc: ForwardCurve, Z: np.ndarray) -> np.ndarray:
         """The piece of every point: the far branch (the first piece) or the contact (the last) as the measured
         jumps say, else (a leg without a jump) the piece the model's own jumps put it on."""
-        pieces = np.where(self.labels == 1, len(fc.pieces) - 1, 0)
-        for leg, name in ((0, APPROACH), (1, RETRACT)):
-            own = (self.legs == leg) & (self.labels < 0)
-            if own.any():
-                pieces[own] = fc.assign(Z[own], name)
+        pieces = np.where(self.contact, len(fc.pieces) - 1, 0)
+        for name, own in self.unlabelled:
+            pieces[own] = fc.assign(Z[own], name)
         return pieces
 
     def model_force(self, p: dict, pieces: np.ndarray | None = None, fc: ForwardCurve | None = None):
@@ -287,7 +289,7 @@ class _Problem:
         if "ln_k" in self.names:            # the spring constant's stated uncertainty: a Gaussian prior
             assert self.choice.spring_err is not None, "ln_k is fitted with a stated uncertainty"
             rJ.append((p["k"] - self.spring.k) / self.choice.spring_err)
-        return np.r_[rF, rJ], pieces
+        return np.concatenate((rF, rJ)), pieces
 
     def residuals(self, x) -> np.ndarray:
         r = self._all(self.unpack(x))[0]

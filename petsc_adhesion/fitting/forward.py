@@ -119,4 +119,4 @@ def table_legs(table: FamilyTable, mu: float, sigma: float, K: float, reach: flo
     """The table's curve at (mu, sigma) behind the spring K as :class:`~petsc_adhesion.family.legs.Legs` (the
     contact continued linearly past the table's F_max, as a traced curve's past its end; its far branch
     tabulated beyond the base position ``reach``)."""
-    return table.curve(mu, sigma).behind(K, reach).legs
+    return table.curve(mu, sigma, error=False).behind(K, reach).legs     # (the legs carry no error bars)

@@ -5,8 +5,9 @@ The per-curve fit is one call of :func:`~petsc_adhesion.fitting.curve_fit.fit_cu
 (whatever it does, a map does: a faster fit makes a faster map).  Each rank fits its curves alone, on
 ``PETSc.COMM_SELF``, so that a pixel's fit is the same whichever rank fits it and however many there are:
 the map of one rank and of N is the same (tests/test_map.py).  The curves still to fit are dealt round by
-round, the k-th of a round to rank k; after each round the ranks' pixels are gathered to rank 0, which hands
-them to ``record`` (the journal a killed map resumes from) and ``progress``.  A curve that cannot be fitted
+round, the i-th of a round to rank i mod N (rounds of 1, 2, 4, ... up to ROUND curves a rank); after each round
+the ranks' pixels are gathered to rank 0, which hands them to ``record`` (the journal a killed map resumes from)
+and ``progress``.  A curve that cannot be fitted
 is a flagged pixel (:mod:`~petsc_adhesion.maps.result`), and the map goes on.
 """
 from __future__ import annotations
@@ -25,7 +26,13 @@ from ..model.physical import Bodies
 from .result import MapResult, Pixel, fitted_pixel, flagged_pixel
 from .source import MapEntry, MapSource, curves_map
 
-__all__ = ["MapProgress", "fit_map", "fit_pixel", "SOLVER_ERRORS"]
+__all__ = ["MapProgress", "fit_map", "fit_pixel", "SOLVER_ERRORS", "ROUND"]
+
+#: The curves a rank fits in a round, at most: rounds of 1, 2, 4, ... up to ROUND a rank.  A round ends with
+#: every rank waiting for the slowest (Open MPI's gather polls: the wait costs CPU too), and a curve whose fit
+#: traces a new branch costs 10 to 50 times one that finds it; over ROUND curves a rank's traces are spread
+#: among the others' fits.  The first rounds are short so that a map journals its first pixels soon.
+ROUND = 16
 
 
 @dataclass(frozen=True)
@@ -133,13 +140,15 @@ def fit_map(source: MapSource | Sequence[MeasuredCurve], bodies: Bodies, spring:
     pending = [e for e in source.entries if e.index not in known]
     total, resumed = len(source.entries), len(source.entries) - len(pending)
     pixels: dict[int, Pixel] = {i: p for i, p in known.items()}
-    for start in range(0, len(pending), size):
-        mine = pending[start + rank] if start + rank < len(pending) else None
-        pixel = None if mine is None else fit_pixel(source, mine, bodies, spring, choice, model, grid, solver,
-                                                    invols, spread_rules)
-        got = mpi.gather(pixel, root=0)
+    start, width = 0, 1
+    while start < len(pending):
+        block = pending[start:start + width * size]         # this round's curves, the i-th to rank i mod size
+        mine = [fit_pixel(source, e, bodies, spring, choice, model, grid, solver, invols, spread_rules)
+                for e in block[rank::size]]
+        got = mpi.gather(mine, root=0)
+        start, width = start + len(block), min(2 * width, ROUND)
         if rank == 0:
-            new = [p for p in got if p is not None]
+            new = [got[i % size][i // size] for i in range(len(block))]      # in the curves' order
             pixels.update((p.entry.index, p) for p in new)
             if record is not None:
                 record(new)

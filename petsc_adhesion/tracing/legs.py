@@ -156,9 +156,10 @@ def stable_pieces(lam, F, stable, K: float, jump_in: list[Turn], jump_off: list[
         start = _match(turns["jump_off"], used["jump_off"], cols[0][0], cols[1][0], K) if i0 > 0 else None
         end = _match(turns["jump_in"], used["jump_in"], cols[0][-1], cols[1][-1], K) if i1 < lam.size - 1 else None
         if start is not None:
-            cols = [np.r_[v, a] for a, v in zip(cols, (start.lam, start.Z(K), start.F, start.contact_radius))]
+            cols = [np.concatenate(([v], a)) for a, v in zip(cols, (start.lam, start.Z(K), start.F,
+                                                                      start.contact_radius))]
         if end is not None:
-            cols = [np.r_[a, v] for a, v in zip(cols, (end.lam, end.Z(K), end.F, end.contact_radius))]
+            cols = [np.concatenate((a, [v])) for a, v in zip(cols, (end.lam, end.Z(K), end.F, end.contact_radius))]
         pieces.append(Piece(cols[0], cols[1], cols[2], cols[3], start, end))
     if not pieces:
         raise ValueError("the branch has no state stable behind the spring")
