@@ -18,7 +18,7 @@ from ..tracing.measured import Measured, Missing
 from .domain import MU_BOUNDS
 from .results import BOUND_MARGIN, Z95, FitChoice, Instrument, undetermined
 
-__all__ = ["bounds", "verdicts", "instrument_values", "curve_spread", "held_at_bounds", "SIGMA_MAX", "INSTRUMENT_FACTOR",
+__all__ = ["bounds", "verdicts", "instrument_values", "curve_spread", "profiled", "SIGMA_MAX", "INSTRUMENT_FACTOR",
            "SPREAD_STEPS"]
 
 #: The largest roughness sigma = rms / eps fitted.
@@ -212,40 +212,32 @@ def curve_spread(pb, x, J, JtJ_inv, quantities: dict, A, rules: tuple, lo, hi):
     return ModelSpread(reference, rules, tuple(qs), tuple(notes), time.perf_counter() - t0, tuple(times))
 
 
-def held_at_bounds(cov_p: np.ndarray, J: np.ndarray, A: np.ndarray, d, s2: float, x: np.ndarray, lo: np.ndarray,
-                    hi: np.ndarray, names: tuple, notes: list, spread: np.ndarray | None = None) -> np.ndarray:
-    """The reported covariance where ln mu ended at a bound and the table's profile (``spread``,
+def profiled(cov_p: np.ndarray, J: np.ndarray, A: np.ndarray, d, s2: float, names: tuple,
+             spread: np.ndarray | None) -> np.ndarray:
+    """The reported covariance where the curve hardly determines mu and the table's profile (``spread``,
     :func:`~petsc_adhesion.fitting.table_search.mu_profile`: each coordinate's largest move over the mu the
-    curve allows) was taken: the others' block with the coordinates at a bound (BOUND_MARGIN) held there,
-    s^2 (J_f^T J_f)^-1 over the free columns J_f, each bar grown by its profile's move / Z95 (and the table's
-    step d d^T); each held one's own variance the full Jacobian's (what its warning quotes), uncorrelated
-    with the rest.  The full inverse lets ln mu move along a direction the curve does not determine far past
-    its bound (+-300 at the DMT end) and carries that linearly into the others (w's bar 16% at mu = 0.015,
-    K = 0.0098, where its move over the mu the curve allows is 0.6%); the profile measures that move on the
-    model's own curves.  Where there is no profile (no table, or ln mu inside its bounds), ``cov_p`` as it is."""
-    held = (x - lo <= BOUND_MARGIN) | (hi - x <= BOUND_MARGIN)
-    if spread is None or not held.any() or held.all():
+    curve allows) was taken: the others' block with ln mu held, s^2 (J_f^T J_f)^-1 over the other columns
+    J_f, each bar grown by its profile's move / Z95, linearly (a 95% interval then spans the profile's range
+    and the statistical interval about each end), and the table's step d d^T; ln E*'s own variance the full
+    Jacobian's (what its warning quotes), uncorrelated with the rest.  The full inverse lets ln mu move along
+    a direction the curve does not determine far out of the model's range (+-300 at the DMT end) and carries
+    that linearly into the others (w's bar 3% to 16% at mu = 0.015, K = 0.0098, where its move over the mu
+    the curve allows is 0.6%); the profile measures that move on the model's own curves.  Without a profile
+    (no table, or mu determined), ``cov_p`` as it is."""
+    if spread is None or "ln_mu" not in names:
         return cov_p
-    free = ~held
+    j = names.index("ln_mu")
+    free = np.arange(len(names)) != j
     try:
         sub = np.linalg.inv(J[:, free].T @ J[:, free]) * s2
     except np.linalg.LinAlgError:
         return cov_p
-    cov = np.zeros((x.size, x.size))
-    cov[np.ix_(free, free)] = sub
-    # the others' moves over the mu the curve allows (the table's profile) added to their bars, linearly: a
-    # 95% interval then spans the profile's range and the statistical interval about each end
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    grow = np.where(sd > 0, (sd + spread / Z95) / np.where(sd > 0, sd, 1.0), 1.0)
-    cov = cov * np.outer(grow, grow)
+    sd = np.sqrt(np.clip(np.diag(sub), 0.0, None))
+    grow = np.where(sd > 0, (sd + spread[free] / Z95) / np.where(sd > 0, sd, 1.0), 1.0)
+    cov = np.zeros((len(names), len(names)))
+    cov[np.ix_(free, free)] = sub * np.outer(grow, grow)
     out = A @ cov @ A.T + (np.outer(d, d) if d is not None else 0.0)
-    for j in np.flatnonzero(held):
-        for i in np.flatnonzero(A[:, j]):       # the reported coordinates the held one enters (ln mu: ln E*)
-            out[i, :] = 0.0
-            out[:, i] = 0.0
-            out[i, i] = cov_p[i, i]
-    label = {"ln_mu": "mu", "ln_gamma": "w", "ln_invols": "the sensitivity", "ln_k": "k"}
-    notes.append("the bars of the others are with " + ", ".join(label.get(names[j], names[j])
-                                                               for j in np.flatnonzero(held))
-                 + " held at its bound (the model has no curve beyond it)")
+    out[j, :] = 0.0                     # the row of ln E* (A maps ln mu's index to it)
+    out[:, j] = 0.0
+    out[j, j] = cov_p[j, j]
     return out
