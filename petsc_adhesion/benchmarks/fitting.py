@@ -4,7 +4,8 @@
     python -m petsc_adhesion.benchmarks.fitting coverage   # do the curve fit's 95% intervals hold? (about 30 min)
     python -m petsc_adhesion.benchmarks.fitting real       # the measured curve of tests/data, fitted, with its figure
     python -m petsc_adhesion.benchmarks.fitting speed [-before] [-cache DIR]     # the CPU of one fit, by mu
-    python -m petsc_adhesion.benchmarks.fitting table_coverage [-cases N] [-cache DIR]   # mu 1e-3 to 1e3
+    python -m petsc_adhesion.benchmarks.fitting table_coverage [-cases N] [-cache DIR] [-collect]   # mu 1e-3 to 1e3
+    mpiexec -n 2 python -m petsc_adhesion.benchmarks.fitting table_coverage -cases 200 -cache DIR   # over ranks
     python -m petsc_adhesion.benchmarks.fitting -table     # the sections again from docs/data/fitting_*.json
 
 Each part writes its JSON into docs/data/ and its section of docs/fitting.md (in
@@ -362,14 +363,16 @@ def _journal_rows(cache: str | None) -> dict:
     return done
 
 
-def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False) -> list:
+def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False,
+                        collect: bool = False) -> list:
     """The first ``n`` cases of :func:`table_cases`, the cheapest (lowest mu, then smooth) first, dealt to the
     MPI ranks in turn: each a curve made by the solver (finer steps than the fit's), fitted through the default
     table (its roughness fitted where the truth's sigma > 0); each finished case journaled at once by its rank
     (``cache``/table_coverage.<rank>.jsonl), and a case journaled before (by any number of ranks, or in the
     data file) not run again: a kill or a next session continues.  Returns every finished case's row on rank 0
     (``make_only``: the curves made into the cache only, no rows; ``made_only``: the cases whose curve is in
-    the cache alone), None on the others."""
+    the cache alone; ``collect``: none run, the journaled rows gathered into the data file, as while another
+    run goes on), None on the others."""
     _init()
     from petsc4py import PETSc
 
@@ -377,7 +380,7 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
     rank, size = world.Get_rank(), world.Get_size()
     done = _journal_rows(cache)
     cases = sorted(table_cases(n), key=lambda c: (c["mu"] * (1 + 10 * c["sigma"]), c["case"]))
-    todo = [c for c in cases if c["case"] not in done]
+    todo = [] if collect else [c for c in cases if c["case"] not in done]
     journal = None if cache is None or make_only else \
         open(os.path.join(cache, f"table_coverage.{rank}.jsonl"), "a")
     if rank == 0:
@@ -400,7 +403,7 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
         row = truth if data is None else \
             _fit_row(data, truth, bodies, spring, "default", case["sigma"] > 0, PETSc.COMM_SELF)
         row.update(case=case["case"], noise_share=case["noise_share"], seed=case["seed"],
-                   version=TABLE_COVERAGE_VERSION, rank_of=size)
+                   version=TABLE_COVERAGE_VERSION, ranks=size)
         if journal is not None:
             journal.write(json.dumps(row) + "\n")
             journal.flush()
@@ -421,7 +424,7 @@ def table_coverage_section(rows: list, made: dict) -> str:
     keys = (("gamma", "w", "ln_gamma"), ("E_star", "E*", "ln_E_star"), ("rms", "rms", "sigma"))
     with_bar = {key: [r for r in rows if r.get(f"{key}_err") and r.get(f"{key}_fit") is not None]
                 for key, _, _ in keys}
-    n_cases = max([r["case"] for r in rows], default=-1) + 1
+    n_cases = made.get("cases", max([r["case"] for r in rows], default=-1) + 1)
     lines = ["## Coverage over the table's range", "",
              "<!-- made by: python -m petsc_adhesion.benchmarks.fitting table_coverage -cases N -cache DIR (data: "
              "docs/data/fitting_table_coverage.json; -table redraws from it; mpiexec -n 2 deals the cases to two "
@@ -554,7 +557,8 @@ def main(argv: list[str]) -> int:
         print(text)
     for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache), speed_section),
                                    ("table_coverage", lambda: table_coverage_rows(int(value.get("-cases", 60)), cache,
-                                                                    "-make_only" in argv, "-made_only" in argv),
+                                                                    "-make_only" in argv, "-made_only" in argv,
+                                                                    "-collect" in argv),
                                     table_coverage_section)):
         if part not in parts:
             continue
@@ -569,7 +573,8 @@ def main(argv: list[str]) -> int:
                     old = [r for r in json.load(f)["rows"] if r.get("path_kind") != rows[0].get("path_kind")]
             with open(_data(part), "w") as f:
                 json.dump({"made": {"seconds": time.perf_counter() - t, "load": f"{os.getloadavg()[0]:.1f}",
-                                    **paths.source()}, "rows": old + rows}, f, indent=1)
+                                    "cases": int(value.get("-cases", 60)), **paths.source()}, "rows": old + rows},
+                          f, indent=1)
         with open(_data(part)) as f:
             d = json.load(f)
         text = section(d["rows"], d["made"])
