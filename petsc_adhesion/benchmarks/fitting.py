@@ -60,6 +60,8 @@ NOISE_SHARES = (0.003, 0.01, 0.03)
 #: pull-off since version 2).
 SIGMA_TOP = 2.0
 TABLE_COVERAGE_VERSION = 2
+#: In the order the cases run: one rough case after every ROUGH_EVERY smooth ones.
+ROUGH_EVERY = 4
 
 
 def _data(name: str) -> str:
@@ -241,8 +243,7 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
 
 
 def _fit_row(data, truth, bodies, spring, table, rough: bool = False, comm=None) -> dict:
-    """One fit of a synthetic curve (its roughness fitted where ``rough``), timed (CPU), its numbers against
-    the truth."""
+    """One fit of a synthetic curve (its roughness fitted where ``rough``), timed (CPU), against the truth."""
     from ..fitting.curve_fit import TableStep, fit_curve
     from ..fitting.results import FitChoice
 
@@ -346,9 +347,8 @@ def _journal_rows(cache: str | None) -> dict:
     done = {}
     if os.path.exists(_data("table_coverage")):
         with open(_data("table_coverage")) as f:
-            for r in json.load(f).get("rows", []):
-                if r.get("version") == TABLE_COVERAGE_VERSION:
-                    done[r["case"]] = r
+            done.update((r["case"], r) for r in json.load(f).get("rows", [])
+                        if r.get("version") == TABLE_COVERAGE_VERSION)
     if cache:
         for name in sorted(os.listdir(cache)):
             if name.startswith("table_coverage.") and name.endswith(".jsonl"):
@@ -365,7 +365,8 @@ def _journal_rows(cache: str | None) -> dict:
 
 def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False,
                         collect: bool = False) -> list:
-    """The first ``n`` cases of :func:`table_cases`, the cheapest (lowest mu, then smooth) first, dealt to the
+    """The first ``n`` cases of :func:`table_cases`, the cheapest first (the smooth by mu, a rough one after
+    every ROUGH_EVERY of them), dealt to the
     MPI ranks in turn: each a curve made by the solver (finer steps than the fit's), fitted through the default
     table (its roughness fitted where the truth's sigma > 0); each finished case journaled at once by its rank
     (``cache``/table_coverage.<rank>.jsonl), and a case journaled before (by any number of ranks, or in the
@@ -379,7 +380,12 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
     world = PETSc.COMM_WORLD.tompi4py()
     rank, size = world.Get_rank(), world.Get_size()
     done = _journal_rows(cache)
-    cases = sorted(table_cases(n), key=lambda c: (c["mu"] * (1 + 10 * c["sigma"]), c["case"]))
+    # the cheapest first: the smooth cases by mu (through the table), one rough case (its roughness fitted on
+    # the solver's curves, a hundred times the CPU at low mu) after every ROUGH_EVERY smooth ones
+    smooth = sorted((c for c in table_cases(n) if c["sigma"] == 0), key=lambda c: c["mu"])
+    rough = sorted((c for c in table_cases(n) if c["sigma"] > 0), key=lambda c: c["mu"])
+    cases = sorted(smooth + rough, key=lambda c: (smooth.index(c) if c in smooth else
+                                                 ROUGH_EVERY * (rough.index(c) + 1) - 0.5))
     todo = [] if collect else [c for c in cases if c["case"] not in done]
     journal = None if cache is None or make_only else \
         open(os.path.join(cache, f"table_coverage.{rank}.jsonl"), "a")
@@ -398,21 +404,17 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
             data, truth = None, {"mu": case["mu"], "K": case["K"], "sigma": case["sigma"],
                                  "error": f"the synthetic curve: {str(e).splitlines()[0] if str(e) else type(e).__name__}"}
         if make_only:
-            print(f"case {case['case']} mu {case['mu']:.3g} made", flush=True)
             continue
         row = truth if data is None else \
             _fit_row(data, truth, bodies, spring, "default", case["sigma"] > 0, PETSc.COMM_SELF)
         row.update(case=case["case"], noise_share=case["noise_share"], seed=case["seed"],
                    version=TABLE_COVERAGE_VERSION, ranks=size)
-        if journal is not None:
-            journal.write(json.dumps(row) + "\n")
-            journal.flush()
-            os.fsync(journal.fileno())
+        if journal is not None:                 # on disk before the next case: a kill loses that one alone
+            journal.write(json.dumps(row) + "\n"), journal.flush(), os.fsync(journal.fileno())
         done[case["case"]] = row
         print(json.dumps({k: row.get(k) for k in ("case", "mu", "K", "sigma", "gamma_fit", "gamma_err", "cpu_s",
                                                  "error")}), flush=True)
-    if journal is not None:
-        journal.close()
+    journal.close() if journal is not None else None
     world.Barrier()
     if rank != 0 or make_only:
         return None if rank else []
@@ -436,7 +438,7 @@ def table_coverage_section(rows: list, made: dict) -> str:
              f"{SYNTH['epsilon'] * 1e9:g} nm, w = {SYNTH['gamma']:g} J/m^2, {SYNTH['points']} points a leg), each "
              f"fitted through the package's tables (the rough one, with the roughness fitted, where sigma > 0) with "
              f"R, epsilon and k given.  {len(rows)} of the first {n_cases} cases run so far (the cheapest first: "
-             f"low mu, smooth), spanning mu {min(r['mu'] for r in rows):.3g} to {max(r['mu'] for r in rows):.3g} "
+             f"the smooth by mu, a rough one after every {ROUGH_EVERY}), spanning mu {min(r['mu'] for r in rows):.3g} to {max(r['mu'] for r in rows):.3g} "
              f"and sigma up to {max(r.get('sigma', 0.0) for r in rows):.2g}; "
              f"their fits' CPU {sum(r.get('cpu_s', 0.0) for r in rows):.0f} s." if rows else "No case run yet.", ""]
     for key, label, coord in keys:
@@ -526,10 +528,6 @@ def pull_off_section(rows: list, made: dict) -> str:
         f"{name} {100 * (worst[k][f'{k}_ratio'] - 1):+.1f}% (mu = {worst[k]['mu']:g})"
         for k, name in (("dmt", "DMT"), ("jkr", "JKR"), ("maugis_dugdale", "Maugis-Dugdale"))) + "."]
     return "\n".join(lines) + "\n"
-
-
-# -- docs/fitting.md ------------------------------------------------------------------
-
 
 
 
