@@ -380,13 +380,13 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
     world = PETSc.COMM_WORLD.tompi4py()
     rank, size = world.Get_rank(), world.Get_size()
     done = _journal_rows(cache)
-    # the cheapest first: the smooth cases by mu (through the table), one rough case (its roughness fitted on
-    # the solver's curves, a hundred times the CPU at low mu) after every ROUGH_EVERY smooth ones
-    smooth = sorted((c for c in table_cases(n) if c["sigma"] == 0), key=lambda c: c["mu"])
-    rough = sorted((c for c in table_cases(n) if c["sigma"] > 0), key=lambda c: c["mu"])
-    cases = sorted(smooth + rough, key=lambda c: (smooth.index(c) if c in smooth else
-                                                 ROUGH_EVERY * (rough.index(c) + 1) - 0.5))
-    todo = [] if collect else [c for c in cases if c["case"] not in done]
+    # the cheapest first among the cases left: the smooth by mu (through the table), one rough case (its
+    # roughness fitted on the solver's curves, a hundred times the CPU at low mu) after every ROUGH_EVERY
+    left = [] if collect else [c for c in table_cases(n) if c["case"] not in done]
+    smooth = sorted((c for c in left if c["sigma"] == 0), key=lambda c: c["mu"])
+    rough = sorted((c for c in left if c["sigma"] > 0), key=lambda c: c["mu"])
+    todo = sorted(smooth + rough, key=lambda c: (smooth.index(c) if c in smooth else
+                                                ROUGH_EVERY * (rough.index(c) + 1) - 0.5))
     journal = None if cache is None or make_only else \
         open(os.path.join(cache, f"table_coverage.{rank}.jsonl"), "a")
     if rank == 0:
