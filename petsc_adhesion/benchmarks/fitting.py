@@ -4,7 +4,8 @@
     python -m petsc_adhesion.benchmarks.fitting coverage   # do the curve fit's 95% intervals hold? (about 30 min)
     python -m petsc_adhesion.benchmarks.fitting real       # the measured curve of tests/data, fitted, with its figure
     python -m petsc_adhesion.benchmarks.fitting speed [-before] [-cache DIR] [-mus 0.001,0.1]  # one fit's CPU
-    python -m petsc_adhesion.benchmarks.fitting table_coverage [-cases N] [-cache DIR]   # mu 1e-3 to 1e3
+    python -m petsc_adhesion.benchmarks.fitting table_coverage [-cases N] [-cache DIR] [-collect]   # mu 1e-3 to 1e3
+    mpiexec -n 2 python -m petsc_adhesion.benchmarks.fitting table_coverage -cases 200 -cache DIR   # over ranks
     python -m petsc_adhesion.benchmarks.fitting -table     # the sections again from docs/data/fitting_*.json
 
 Each part writes its JSON into docs/data/ and its section of docs/fitting.md (in
@@ -52,8 +53,15 @@ BEFORE_MUS = (1e-3, 0.1, 1.0)
 #: The coverage over the table's range: cases drawn (stream TABLE_COVERAGE_SEED) log-uniform in mu over
 #: [1e-3, 1e3] and in the spring K over [1e-4, 0.5] (units 2 pi R w / eps: a 2 mN/m to 10 N/m lever on a 20 nm
 #: tip at w = 0.05 J/m^2), the noise one of 0.3%, 1%, 3% of 2 pi R w.
-TABLE_COVERAGE_SEED = 34
+TABLE_COVERAGE_SEED = 3434
 NOISE_SHARES = (0.003, 0.01, 0.03)
+#: The largest roughness sigma = rms / eps drawn; the version of the cases and of the synthetic curves (a
+#: journal's or the data file's rows of another version are not this study's: the retract reaching its
+#: pull-off since version 2).
+SIGMA_TOP = 2.0
+TABLE_COVERAGE_VERSION = 2
+#: In the order the cases run: one rough case after every ROUGH_EVERY smooth ones.
+ROUGH_EVERY = 4
 
 
 def _data(name: str) -> str:
@@ -170,12 +178,17 @@ def coverage_section(rows: list, made: dict) -> str:
 
 # -- the speed and the coverage over the table's range ------------------------------------
 def table_cases(n: int) -> list[dict]:
-    """The first ``n`` cases of the coverage over the table's range: mu, K, the noise's share, the seed."""
+    """The first ``n`` cases of the coverage over the table's range: mu, K, the noise's share, sigma (0 for
+    half of them, else uniform in (0, SIGMA_TOP]), the seed."""
     rng = np.random.default_rng(TABLE_COVERAGE_SEED)
     out = []
     for i in range(n):
-        out.append({"case": i, "mu": float(10 ** rng.uniform(-3, 3)), "K": float(10 ** rng.uniform(-4, math.log10(0.5))),
-                    "noise_share": float(NOISE_SHARES[int(rng.integers(len(NOISE_SHARES)))]), "seed": 100 + i})
+        mu = float(10 ** rng.uniform(-3, 3))
+        K = float(10 ** rng.uniform(-4, math.log10(0.5)))
+        noise = float(NOISE_SHARES[int(rng.integers(len(NOISE_SHARES)))])
+        rough = bool(rng.uniform() < 0.5)
+        sigma = float(rng.uniform(0.0, SIGMA_TOP)) if rough else 0.0
+        out.append({"case": i, "mu": mu, "K": K, "noise_share": noise, "sigma": round(sigma, 6), "seed": 100 + i})
     return out
 
 
@@ -183,7 +196,8 @@ def table_cases(n: int) -> list[dict]:
 _CLEAN: dict = {}
 
 
-def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | None, finer: bool):
+def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | None, finer: bool,
+               sigma: float = 0.0):
     """A synthetic curve made by the solver (finer steps than the fit's where ``finer``) at (mu, K) with noise,
     the contact point and baseline drawn from ``seed``; read from ``cache`` where it was made before. (data,
     truth dict, the bodies given to the fit, the spring)."""
@@ -202,7 +216,7 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
     rng = np.random.default_rng(1000 + seed)
     z0, F0 = float(rng.uniform(-20e-9, 20e-9)), float(rng.uniform(-1e-9, 1e-9))
     noise = noise_share * 2 * math.pi * R * w
-    tag = "" if R == s["radius"] else f"_R{R:.4g}"
+    tag = ("" if R == s["radius"] else f"_R{R:.4g}") + (f"_s{sigma:.6g}" if sigma > 0 else "")
     name = None if cache is None else \
         os.path.join(cache, f"curve_{mu:.6g}_{K:.6g}_{noise_share:g}_{seed}_{int(finer)}{tag}.npz")
     made = math.nan
@@ -212,9 +226,10 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
     else:
         c0 = time.process_time()
         settings = curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1) if finer else None
-        made_of = (mu, K, R, finer)
+        made_of = (mu, K, R, finer, sigma)
         if made_of not in _CLEAN:      # one truth's noiseless curve, traced once: each seed shifts it, adds noise
-            _CLEAN[made_of] = synthetic_curve(Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w),
+            _CLEAN[made_of] = synthetic_curve(Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w,
+                                                     rms=sigma * eps if sigma > 0 else None),
                                               Spring(k), Sampling(points=s["points"]), settings=settings)
         c = _CLEAN[made_of]            # as synthetic_curve adds them: z0 and F0, then the noise of the seed
         F = c.F + F0 + noise * np.random.default_rng(seed).standard_normal(c.F.size)
@@ -222,23 +237,25 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
         made = time.process_time() - c0
         if name is not None:
             np.savez(name, z=data.z, F=data.F, turn=data.turn)
-    truth = {"mu": mu, "K": K, "gamma": w, "E_star": E, "z0_m": z0, "noise_N": noise, "made_cpu_s": made, "R": R}
+    truth = {"mu": mu, "K": K, "gamma": w, "E_star": E, "z0_m": z0, "noise_N": noise, "made_cpu_s": made, "R": R,
+             "sigma": sigma, "rms": sigma * eps}
     return data, truth, Bodies(radius=R, young1=None, poisson1=None, epsilon=eps), Spring(k)
 
 
-def _fit_row(data, truth, bodies, spring, table) -> dict:
-    """One fit of a synthetic curve, timed (CPU), its numbers against the truth."""
+def _fit_row(data, truth, bodies, spring, table, rough: bool = False, comm=None) -> dict:
+    """One fit of a synthetic curve (its roughness fitted where ``rough``), timed (CPU), against the truth."""
     from ..fitting.curve_fit import TableStep, fit_curve
+    from ..fitting.results import FitChoice
 
     c0, t0 = time.process_time(), time.perf_counter()
     try:
-        fit = fit_curve(data, bodies, spring, table=table)
+        fit = fit_curve(data, bodies, spring, FitChoice(roughness=rough), table=table, comm=comm)
     except ValueError as e:
         return {**truth, "error": str(e).splitlines()[0]}
     cpu, wall = time.process_time() - c0, time.perf_counter() - t0
     row = {**truth, "cpu_s": cpu, "wall_s": wall, "traces": fit.traces, "iterations": fit.iterations,
            "reduced_chi2": fit.reduced_chi2, "mu_fit": fit.mu, "warnings": list(fit.warnings)}
-    for key in ("gamma", "E_star"):
+    for key in ("gamma", "E_star", "rms"):
         q = getattr(fit, key)
         row[f"{key}_fit"] = getattr(q, "value", None)
         row[f"{key}_err"] = getattr(q, "err", None)
@@ -325,67 +342,146 @@ def speed_section(rows: list, made: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False) -> list:
-    """The first ``n`` cases of :func:`table_cases`, the cheapest (lowest mu) first: each a curve made by the
-    solver (finer steps than the fit's), fitted through the default table (``make_only``: made into the cache
-    only, no rows; ``made_only``: the cases whose curve is in the cache alone)."""
+def _journal_rows(cache: str | None) -> dict:
+    """The finished cases of this version (TABLE_COVERAGE_VERSION), by case number: the journals in ``cache``
+    (one a rank: table_coverage.<rank>.jsonl, a line a case) and the rows of the data file (a next session's
+    start: the committed study continues)."""
+    done = {}
+    if os.path.exists(_data("table_coverage")):
+        with open(_data("table_coverage")) as f:
+            done.update((r["case"], r) for r in json.load(f).get("rows", [])
+                        if r.get("version") == TABLE_COVERAGE_VERSION)
+    if cache:
+        for name in sorted(os.listdir(cache)):
+            if name.startswith("table_coverage.") and name.endswith(".jsonl"):
+                with open(os.path.join(cache, name)) as f:
+                    for line in f:
+                        try:
+                            r = json.loads(line)
+                        except json.JSONDecodeError:      # a line cut by a kill: the case runs again
+                            continue
+                        if r.get("version") == TABLE_COVERAGE_VERSION:
+                            done[r["case"]] = r
+    return done
+
+
+def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False,
+                        collect: bool = False) -> list:
+    """The first ``n`` cases of :func:`table_cases`, the cheapest first (the smooth by mu, a rough one after
+    every ROUGH_EVERY of them), dealt to the
+    MPI ranks in turn: each a curve made by the solver (finer steps than the fit's), fitted through the default
+    table (its roughness fitted where the truth's sigma > 0); each finished case journaled at once by its rank
+    (``cache``/table_coverage.<rank>.jsonl), and a case journaled before (by any number of ranks, or in the
+    data file) not run again: a kill or a next session continues.  Returns every finished case's row on rank 0
+    (``make_only``: the curves made into the cache only, no rows; ``made_only``: the cases whose curve is in
+    the cache alone; ``collect``: none run, the journaled rows gathered into the data file, as while another
+    run goes on), None on the others."""
     _init()
-    rows = []
-    for case in sorted(table_cases(n), key=lambda c: c["mu"]):
-        tag = "" if case["mu"] <= 1 else f"_R{SYNTH['radius'] * case['mu']:.4g}"
+    from petsc4py import PETSc
+
+    world = PETSc.COMM_WORLD.tompi4py()
+    rank, size = world.Get_rank(), world.Get_size()
+    done = _journal_rows(cache)
+    # the cheapest first among the cases left: the smooth by mu (through the table), one rough case (its
+    # roughness fitted on the solver's curves, a hundred times the CPU at low mu) after every ROUGH_EVERY
+    left = [] if collect else [c for c in table_cases(n) if c["case"] not in done]
+    smooth = sorted((c for c in left if c["sigma"] == 0), key=lambda c: c["mu"])
+    rough = sorted((c for c in left if c["sigma"] > 0), key=lambda c: c["mu"])
+    todo = sorted(smooth + rough, key=lambda c: (smooth.index(c) if c in smooth else
+                                                ROUGH_EVERY * (rough.index(c) + 1) - 0.5))
+    journal = None if cache is None or make_only else \
+        open(os.path.join(cache, f"table_coverage.{rank}.jsonl"), "a")
+    if rank == 0:
+        print(f"{len(done)} of {n} cases journaled before; {len(todo)} to run on {size} rank(s)", flush=True)
+    for case in todo[rank::size]:
+        tag = ("" if case["mu"] <= 1 else f"_R{SYNTH['radius'] * case['mu']:.4g}") + \
+            (f"_s{case['sigma']:.6g}" if case["sigma"] > 0 else "")
         name = f"curve_{case['mu']:.6g}_{case['K']:.6g}_{case['noise_share']:g}_{case['seed']}_1{tag}.npz"
         if made_only and not (cache and os.path.exists(os.path.join(cache, name))):
             continue
-        data, truth, bodies, spring = _synthetic(case["mu"], case["K"], case["noise_share"], case["seed"], cache,
-                                                 finer=True)
+        try:
+            data, truth, bodies, spring = _synthetic(case["mu"], case["K"], case["noise_share"], case["seed"],
+                                                     cache, finer=True, sigma=case["sigma"])
+        except Exception as e:          # the solver's failure to make the truth: said in the row, not fitted
+            data, truth = None, {"mu": case["mu"], "K": case["K"], "sigma": case["sigma"],
+                                 "error": f"the synthetic curve: {str(e).splitlines()[0] if str(e) else type(e).__name__}"}
         if make_only:
-            print(f"case {case['case']} mu {case['mu']:.3g} made", flush=True)
             continue
-        row = _fit_row(data, truth, bodies, spring, "default")
-        row.update(case=case["case"], noise_share=case["noise_share"], seed=case["seed"])
-        rows.append(row)
-        _partial("table_coverage", rows)
-        print(json.dumps({k: row.get(k) for k in ("case", "mu", "K", "gamma_fit", "gamma_err", "cpu_s")}), flush=True)
-    return rows
+        row = truth if data is None else \
+            _fit_row(data, truth, bodies, spring, "default", case["sigma"] > 0, PETSc.COMM_SELF)
+        row.update(case=case["case"], noise_share=case["noise_share"], seed=case["seed"],
+                   version=TABLE_COVERAGE_VERSION, ranks=size)
+        if journal is not None:                 # on disk before the next case: a kill loses that one alone
+            journal.write(json.dumps(row) + "\n"), journal.flush(), os.fsync(journal.fileno())
+        done[case["case"]] = row
+        print(json.dumps({k: row.get(k) for k in ("case", "mu", "K", "sigma", "gamma_fit", "gamma_err", "cpu_s",
+                                                 "error")}), flush=True)
+    journal.close() if journal is not None else None
+    world.Barrier()
+    if rank != 0 or make_only:
+        return None if rank else []
+    rows = sorted(_journal_rows(cache).values() if cache else done.values(), key=lambda r: r["mu"])
+    return [r for r in rows if r["case"] < n]
 
 
 def table_coverage_section(rows: list, made: dict) -> str:
-    ok = [r for r in rows if r.get("gamma_err") and r.get("E_star_err")]
+    keys = (("gamma", "w", "ln_gamma"), ("E_star", "E*", "ln_E_star"), ("rms", "rms", "sigma"))
+    with_bar = {key: [r for r in rows if r.get(f"{key}_err") and r.get(f"{key}_fit") is not None]
+                for key, _, _ in keys}
+    n_cases = made.get("cases", max([r["case"] for r in rows], default=-1) + 1)
     lines = ["## Coverage over the table's range", "",
              "<!-- made by: python -m petsc_adhesion.benchmarks.fitting table_coverage -cases N -cache DIR (data: "
-             "docs/data/fitting_table_coverage.json; -table redraws from it) -->", "",
-             f"Synthetic curves made by the solver (not by the table; steps half the fit's), the cases drawn "
-             f"log-uniform in mu over [1e-3, 1e3] and in K over [1e-4, 0.5], the noise {', '.join(f'{x:.1%}' for x in NOISE_SHARES)} of "
-             f"2 pi R w, sigma = 0 (R = {SYNTH['radius'] * 1e9:g} nm times mu above 1, epsilon = {SYNTH['epsilon'] * 1e9:g} nm, "
-             f"w = {SYNTH['gamma']:g} J/m^2, {SYNTH['points']} points a leg), each fitted through the package's table "
-             f"with R, epsilon and k given.  {len(ok)} of {len(rows)} cases gave both bars"
-             + (f"; the cases fitted span mu {min(r['mu'] for r in rows):.3g} to {max(r['mu'] for r in rows):.3g}"
-                if rows else "") + ".", ""]
-    for key, label in (("gamma", "w"), ("E_star", "E*")):
-        inside = [abs(r[f"{key}_fit"] - r[key]) <= 1.96 * r[f"{key}_err"] for r in ok]
-        ratio = [r[f"{key}_err"] / max(abs(r[f"{key}_fit"] - r[key]), 1e-300) for r in ok]
-        share = [r["table_share"].get("ln_gamma" if key == "gamma" else "ln_E_star", 0.0) /
-                 (r[f"{key}_err"] / r[f"{key}_fit"]) for r in ok if "table_share" in r]
+             "docs/data/fitting_table_coverage.json; -table redraws from it; mpiexec -n 2 deals the cases to two "
+             "ranks; a journal in DIR and the data file's rows: a killed or later run continues) -->", "",
+             f"Synthetic curves made by the solver (not by the table; steps half the fit's; the retract past its "
+             f"pull-off), the cases drawn log-uniform in mu over [1e-3, 1e3] and in K over [1e-4, 0.5], the noise "
+             f"{', '.join(f'{x:.1%}' for x in NOISE_SHARES)} of 2 pi R w, sigma 0 for half of them and uniform in "
+             f"(0, {SIGMA_TOP:g}] for the others (R = {SYNTH['radius'] * 1e9:g} nm times mu above 1, epsilon = "
+             f"{SYNTH['epsilon'] * 1e9:g} nm, w = {SYNTH['gamma']:g} J/m^2, {SYNTH['points']} points a leg), each "
+             f"fitted through the package's tables (the rough one, with the roughness fitted, where sigma > 0) with "
+             f"R, epsilon and k given.  {len(rows)} of the first {n_cases} cases run so far (the cheapest first: "
+             f"the smooth by mu, a rough one after every {ROUGH_EVERY}), spanning mu {min(r['mu'] for r in rows):.3g} to {max(r['mu'] for r in rows):.3g} "
+             f"and sigma up to {max(r.get('sigma', 0.0) for r in rows):.2g}; "
+             f"their fits' CPU {sum(r.get('cpu_s', 0.0) for r in rows):.0f} s." if rows else "No case run yet.", ""]
+    for key, label, coord in keys:
+        ok = with_bar[key]
+        truth = (lambda r: r["rms"]) if key == "rms" else (lambda r, key=key: r[key])
+        inside = [abs(r[f"{key}_fit"] - truth(r)) <= 1.96 * r[f"{key}_err"] for r in ok]
+        ratio = [r[f"{key}_err"] / max(abs(r[f"{key}_fit"] - truth(r)), 1e-300) for r in ok]
         if inside:
-            lines.append(f"- {label}: inside its 95% interval in **{sum(inside)} of {len(inside)}** cases "
-                         f"({sum(inside) / len(inside):.0%}); median bar / error {np.median(ratio):.2g}; the table's "
-                         f"step, a share of the bar: median {np.median(share) if share else math.nan:.2g}, largest "
-                         f"{max(share) if share else math.nan:.2g}.")
-    lines += ["", "| case | mu | K | noise | w fitted (J/m^2) | (w - w_true) / bar | E* fitted (Pa) | "
-              "(E* - E*_true) / bar | reduced chi^2 | step (bars: E*, w) | CPU (s) |",
-              "|---|---|---|---|---|---|---|---|---|---|---|"]
+            lines.append(f"- {label}: a bar in {len(ok)} cases, the truth inside its 95% interval in "
+                         f"**{sum(inside)} of {len(inside)}** ({sum(inside) / len(inside):.0%}); median bar / error "
+                         f"{np.median(ratio):.2g}.")
+    lines.append("")
+    missing = [r for r in rows if not with_bar["gamma"].count(r)]
+    if rows:
+        lines.append(f"Where w has no bar ({len(missing)} cases): " + ("; ".join(
+            f"mu {r['mu']:.3g}, K {r['K']:.2g}, sigma {r.get('sigma', 0.0):.2g}" for r in missing) or "none") + ".  "
+            "E* without a bar: " + (", ".join(f"mu {r['mu']:.3g} (K {r['K']:.2g})" for r in rows
+                                              if r not in with_bar['E_star']) or "none") + ".")
+    lines += ["", "| case | mu | K | sigma | noise | w fitted (J/m^2) | (w - w_true) / bar | E* fitted (Pa) | "
+              "(E* - E*_true) / bar | sigma fitted | (sigma - sigma_true) / bar | reduced chi^2 | CPU (s) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+
+    def cell(r, key):
+        if r.get(f"{key}_err") and r.get(f"{key}_fit") is not None:
+            t = r["rms"] if key == "rms" else r[key]
+            f, e = r[f"{key}_fit"], r[f"{key}_err"]
+            if key == "rms":
+                f, e, t = f / SYNTH["epsilon"], e / SYNTH["epsilon"], t / SYNTH["epsilon"]
+            return f"{f:.5g} +- {e:.2g}", f"{(f - t) / e:+.2f}"
+        why = [w.split(":", 1)[1].strip() for w in r.get("warnings", []) if w.startswith(f"{key} undetermined")]
+        return (f"none: {why[0]}" if why else "-"), ""
+
     for r in rows:
-        head = f"| {r.get('case', '')} | {r['mu']:.3g} | {r['K']:.2g} | {r.get('noise_share', 0):.1%} |"
-        if r not in ok:
-            why = r.get("error") or "; ".join(r.get("warnings", [])) or "no bar"
-            lines.append(f"{head} {why} | | | | | | |")
+        head = f"| {r.get('case', '')} | {r['mu']:.3g} | {r['K']:.2g} | {r.get('sigma', 0.0):.2g} | " \
+               f"{r.get('noise_share', 0):.1%} |"
+        if "error" in r:
+            lines.append(f"{head} {r['error']} | | | | | | | |")
             continue
-        st = r.get("step_bars", {})
-        lines.append(f"{head} {r['gamma_fit']:.5g} +- {r['gamma_err']:.2g} | "
-                     f"{(r['gamma_fit'] - r['gamma']) / r['gamma_err']:+.2f} | {r['E_star_fit']:.4g} +- "
-                     f"{r['E_star_err']:.2g} | {(r['E_star_fit'] - r['E_star']) / r['E_star_err']:+.2f} | "
-                     f"{r['reduced_chi2']:.3f} | {st.get('ln_E_star', math.nan):.2f}, {st.get('ln_gamma', math.nan):.2f} "
-                     f"| {r['cpu_s']:.2f} |")
+        w, e, g = cell(r, "gamma"), cell(r, "E_star"), cell(r, "rms") if r.get("sigma", 0) > 0 else ("-", "")
+        lines.append(f"{head} {w[0]} | {w[1]} | {e[0]} | {e[1]} | {g[0]} | {g[1]} | {r['reduced_chi2']:.3g} | "
+                     f"{r['cpu_s']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -436,10 +532,6 @@ def pull_off_section(rows: list, made: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-# -- docs/fitting.md ------------------------------------------------------------------
-
-
-
 
 def main(argv: list[str]) -> int:
     if argv[:1] == ["-case"]:
@@ -474,7 +566,8 @@ def main(argv: list[str]) -> int:
         print(text)
     for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache, mus), speed_section),
                                    ("table_coverage", lambda: table_coverage_rows(int(value.get("-cases", 60)), cache,
-                                                                    "-make_only" in argv, "-made_only" in argv),
+                                                                    "-make_only" in argv, "-made_only" in argv,
+                                                                    "-collect" in argv),
                                     table_coverage_section)):
         if part not in parts:
             continue
@@ -494,7 +587,8 @@ def main(argv: list[str]) -> int:
                      if r.get("path_kind") == rows[0].get("path_kind") and mus is not None and r["mu"] not in mus]
             with open(_data(part), "w") as f:
                 json.dump({"made": {"seconds": time.perf_counter() - t, "load": f"{os.getloadavg()[0]:.1f}",
-                                    **paths.source()}, "rows": old + rows}, f, indent=1)
+                                    "cases": int(value.get("-cases", 60)), **paths.source()}, "rows": old + rows},
+                          f, indent=1)
         with open(_data(part)) as f:
             d = json.load(f)
         text = section(d["rows"], d["made"])

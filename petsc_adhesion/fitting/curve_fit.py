@@ -65,10 +65,10 @@ from .branches import BRANCHES
 from .forward import APPROACH, RETRACT, ForwardCurve, table_choice, table_covers, table_legs
 from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
                      domain_reasons, features, refuse_a_line, refuse_empty)
-from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, verdicts
+from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, profiled, verdicts
 from .pull_off import maugis_dugdale_gamma
 from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misfit, misfit_p
-from .table_search import START_MUS, TableStep, cpu, solver_steps, table_bounds
+from .table_search import START_MUS, TableStep, cpu, mu_profile, solver_steps, table_bounds
 
 if TYPE_CHECKING:
     from ..family.table import FamilyTable
@@ -458,7 +458,9 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
                         ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=choice.max_evaluations)
     A = _to_moduli(names)
     d, path = None, f"the solver's curves throughout: {why_not}"
+    profile = None
     if pb.table is not None:
+        profile = mu_profile(pb, res.x, lo, hi)         # mu undetermined: how far the others move with it
         x, x_curve, J, d, path = solver_steps(pb, res.x, lo, hi, A, label, pb.evaluations, cpu() - c0)
     else:
         x = x_curve = res.x
@@ -476,6 +478,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         cov = np.full((m, m), np.nan)
     # to (ln E*, ln w): ln E* = ln w - 1.5 ln mu + const; the table's step a systematic term (table_search.py)
     cov_p = A @ cov @ A.T + (np.outer(d, d) if d is not None else 0.0)
+    cov_p = profiled(cov_p, J, A, d, s2, names, profile)
     var = np.diag(cov_p)
     sd = np.where(np.isfinite(var) & (var >= 0), np.sqrt(np.abs(var)), np.nan)
     out_names = tuple("ln_E_star" if n_ == "ln_mu" else n_ for n_ in names)

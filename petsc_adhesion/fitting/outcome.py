@@ -16,10 +16,10 @@ import numpy as np
 
 from ..tracing.measured import Measured, Missing
 from .domain import MU_BOUNDS
-from .results import BOUND_MARGIN, FitChoice, Instrument, undetermined
+from .results import BOUND_MARGIN, Z95, FitChoice, Instrument, undetermined
 
 __all__ = ["bounds", "verdicts", "instrument_values", "curve_spread", "branch_coordinates", "LawOptimum",
-           "SIGMA_MAX", "INSTRUMENT_FACTOR", "SPREAD_STEPS", "SPREAD_TOL"]
+           "profiled", "SIGMA_MAX", "INSTRUMENT_FACTOR", "SPREAD_STEPS", "SPREAD_TOL"]
 
 #: The largest roughness sigma = rms / eps fitted.
 SIGMA_MAX = 3.0
@@ -66,8 +66,17 @@ def verdicts(pb, choice: FitChoice, x, lo, hi, p: dict, sd: dict, modulus) -> tu
         if name == "ln_mu" or (name == "ln_gamma" and not choice.modulus and
                                 math.log(1e-6) < edge < math.log(100.0)):
             mu_edge = MU_BOUNDS[0] if p["mu"] < 1 else MU_BOUNDS[1]
-            return (f"mu = {p['mu']:.4g} is at the bound {mu_edge:g} of the model's range [{MU_BOUNDS[0]:g}, "
-                    f"{MU_BOUNDS[1]:g}]: the data ask for a mu the model does not reach")
+            where = (f"mu = {p['mu']:.4g} is at the bound {mu_edge:g} of the model's range [{MU_BOUNDS[0]:g}, "
+                     f"{MU_BOUNDS[1]:g}]")
+            e = sd.get("ln_E_star") if name == "ln_mu" else None
+            if name == "ln_mu" and (e is None or undetermined(p["E"], p["E"] * e) is not None):
+                # the bound is where the search stopped, not what the data ask for: the Jacobian's bar there
+                # spans the range (DMT's end, or a contact much stiffer than the lever: the curve hardly moves
+                # with mu)
+                span = "a singular covariance" if e is None else \
+                    f"its 95% interval in ln E* +-{Z95 * e:.3g}, a factor {math.exp(min(Z95 * e, 700.0)):.3g} either way"
+                return f"{where}, where the curve does not determine it ({span}): E* is not measured by this curve"
+            return f"{where}: the data ask for a mu the model does not reach"
         if name == "ln_gamma":
             return f"w = {p['w']:.4g} J/m^2 is at the bound {math.exp(edge):g} J/m^2 of the fit"
         return f"sigma = {p['sigma']:.4g} is at the bound {edge:g} of [0, {SIGMA_MAX:g}]"
@@ -328,3 +337,34 @@ def curve_spread(pb, x, J, JtJ_inv, quantities: dict, A, rules: tuple, lo, hi):
     if not qs:
         return Missing(f"w and E* are undetermined under {reference.label}: no value to spread about")
     return ModelSpread(reference, rules, tuple(qs), tuple(notes), time.perf_counter() - t0, tuple(times))
+
+
+def profiled(cov_p: np.ndarray, J: np.ndarray, A: np.ndarray, d, s2: float, names: tuple,
+             spread: np.ndarray | None) -> np.ndarray:
+    """The reported covariance where the curve hardly determines mu and the table's profile (``spread``,
+    :func:`~petsc_adhesion.fitting.table_search.mu_profile`: each coordinate's largest move over the mu the
+    curve allows) was taken: the others' block with ln mu held, s^2 (J_f^T J_f)^-1 over the other columns
+    J_f, each bar grown by its profile's move / Z95, linearly (a 95% interval then spans the profile's range
+    and the statistical interval about each end), and the table's step d d^T; ln E*'s own variance the full
+    Jacobian's (what its warning quotes), uncorrelated with the rest.  The full inverse lets ln mu move along
+    a direction the curve does not determine far out of the model's range (+-300 at the DMT end) and carries
+    that linearly into the others (w's bar 3% to 16% at mu = 0.015, K = 0.0098, where its move over the mu
+    the curve allows is 0.6%); the profile measures that move on the model's own curves.  Without a profile
+    (no table, or mu determined), ``cov_p`` as it is."""
+    if spread is None or "ln_mu" not in names:
+        return cov_p
+    j = names.index("ln_mu")
+    free = np.arange(len(names)) != j
+    try:
+        sub = np.linalg.inv(J[:, free].T @ J[:, free]) * s2
+    except np.linalg.LinAlgError:
+        return cov_p
+    sd = np.sqrt(np.clip(np.diag(sub), 0.0, None))
+    grow = np.where(sd > 0, (sd + spread[free] / Z95) / np.where(sd > 0, sd, 1.0), 1.0)
+    cov = np.zeros((len(names), len(names)))
+    cov[np.ix_(free, free)] = sub * np.outer(grow, grow)
+    out = A @ cov @ A.T + (np.outer(d, d) if d is not None else 0.0)
+    out[j, :] = 0.0                     # the row of ln E* (A maps ln mu's index to it)
+    out[:, j] = 0.0
+    out[j, j] = cov_p[j, j]
+    return out

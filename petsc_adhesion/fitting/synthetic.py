@@ -15,7 +15,12 @@ sloped by b N/m in z (the virtual deflection: light of the laser scattered by th
 sample, a lever's drift) and the retract's baseline offset by d N (the drag of the
 medium on the moving lever).
 The piezo moves evenly from ``approach`` epsilon before the jump-in (or the start of
-contact) to where the load reaches ``top`` (in 2 pi R w), and back.
+contact) to where the load reaches ``top`` (in 2 pi R w), and back; where the retract's
+jump-off lies farther out than that (a soft lever stretches far before it lets go: at
+K = 0.01 about 1 / K = 100 epsilon behind the contact), the piezo starts ``past``
+epsilon beyond the jump-off instead, as a user sets the range of a curve to see its
+pull-off: a retract that ends still in contact holds no pull-off, and w is then bounded
+from below alone.
 """
 from __future__ import annotations
 
@@ -37,8 +42,9 @@ __all__ = ["Sampling", "forward_curve", "synthetic_curve"]
 @dataclass(frozen=True)
 class Sampling:
     """How a synthetic curve is measured: ``points`` samples on each of approach and retract, Gaussian noise
-    of ``noise`` N (the stream of ``seed``), the piezo from ``approach`` epsilon before the jump-in to the load
-    ``top`` (2 pi R w), the contact point ``z0`` (m), the baseline ``F0`` (N) and the direction of the
+    of ``noise`` N (the stream of ``seed``), the piezo from ``approach`` epsilon before the jump-in, or ``past``
+    epsilon beyond the retract's jump-off where that is farther out, to the load ``top`` (2 pi R w), the contact
+    point ``z0`` (m), the baseline ``F0`` (N) and the direction of the
     approach (+1: z grows towards the surface); the instrument's errors: the true sensitivity ``invols_scale``
     times the one the force was converted with, the baseline's slope ``virtual_deflection`` (N/m) and the
     retract's baseline offset ``drag`` (N)."""
@@ -54,6 +60,7 @@ class Sampling:
     invols_scale: float = 1.0
     virtual_deflection: float = 0.0
     drag: float = 0.0
+    past: float = 10.0
 
 
 def forward_curve(model: Model, K: float, top: float = 2.0, grid=None, solver=None, settings=None,
@@ -84,6 +91,9 @@ def synthetic_curve(bodies: Bodies, spring: Spring, sampling: Sampling = Samplin
     Z_hi = float(np.interp(top, last.F, last.Z)) if last.F[-1] >= top else last.Z_hi
     jumps = fc.jumps[APPROACH]
     Z_lo = (jumps[0] if jumps else fc.pieces[0].Z_hi) - s.approach
+    offs = fc.jumps[RETRACT]
+    if offs:                            # the retract shows its pull-off and the free lever past it
+        Z_lo = min(Z_lo, min(offs) - s.past)
     Z = np.linspace(Z_lo, Z_hi, s.points)
     scale = 2 * math.pi * R * w
     z = s.z0 + s.direction * eps * np.r_[Z, Z[::-1]]

@@ -45,7 +45,7 @@ import numpy as np
 
 from ..family.table import FamilyTable
 
-__all__ = ["TableStep", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
+__all__ = ["TableStep", "bounded_step", "mu_profile", "PROFILE_POINTS", "PROFILE_EVALS", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
            "on_lattice", "table_bounds", "solver_steps"]
 
 #: The solver's curves at most after a search on the table.
@@ -61,6 +61,9 @@ LATTICE_LEVELS = 12
 #: Coarser levels where ln mu is hardly determined (E* at the DMT end): down to a point a decade.
 COARSER = 3
 LATTICE_BARS = 0.5
+#: The profile of ln mu from a bound (mu_profile): points a decade, and the least squares' evaluations at each.
+PROFILE_POINTS = 2
+PROFILE_EVALS = 12
 #: The Tabor parameters the search on the table starts from (the best of them; the solver's search tries 0.1 to 3).
 START_MUS = (0.003, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0)
 
@@ -137,6 +140,23 @@ def on_lattice(x: np.ndarray, names: tuple, sd: np.ndarray, lo: np.ndarray,
     return x, None
 
 
+def bounded_step(J: np.ndarray, r: np.ndarray, x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The Gauss-Newton step dx minimising |r + J dx| with x + dx inside [lo, hi] (bounded-variable least
+    squares, scipy's lsq_linear: a coordinate that would cross its bound is held there and the step solved
+    in the others).  The free step clipped coordinate by coordinate is not this: where two coordinates are
+    correlated (ln mu with ln w at the DMT end, where the curve hardly determines mu) the step in one assumes
+    the other's, and clipping that one leaves the first moved by a step meant for both (a fit of mu = 0.015,
+    K = 0.0098 went from w = 0.0496 to the bound 1e-6 that way, its chi^2 from 449 to 4e6)."""
+    from scipy.optimize import lsq_linear
+
+    scale = np.linalg.norm(J, axis=0)
+    scale = np.where(scale > 0, scale, 1.0)     # columns of one size: the solver's rank test is relative
+    a, b = lo - x, hi - x
+    sol = lsq_linear(J / scale, -r, bounds=(np.minimum(a, 0.0) * scale, np.maximum(b, 0.0) * scale),
+                     method="bvls", tol=1e-12)
+    return np.clip(sol.x / scale, a, b)
+
+
 def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarray, label: str,
                  evaluations: int, seconds: float):
     """From the table's optimum ``x`` to the solver's (module docstring): (the stepped parameters, the point of
@@ -151,7 +171,6 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
         JtJ_inv = np.linalg.inv(J.T @ J)
     except np.linalg.LinAlgError:
         JtJ_inv = np.linalg.pinv(J.T @ J)
-    G = JtJ_inv @ J.T
     dof = max(pb.points - x.size, 1)
     sd_t = np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r_t @ r_t) / dof)
     x, level = on_lattice(x, pb.names, sd_t, lo, hi)
@@ -160,8 +179,8 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
     while True:
         r = pb._all(pb.unpack(x))[0]         # one solver curve (cached for what the fit reads of it)
         curves += 1
-        stepped = np.clip(x - G @ r, lo, hi)
-        dx = stepped - x
+        dx = bounded_step(J, r, x, lo, hi)
+        stepped = x + dx
         sd = np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r @ r) / dof)
         moved = float(np.max(np.abs(dx) / np.where(sd > 0, sd, np.inf))) if dx.size else 0.0
         first = moved if curves == 1 else first
@@ -185,6 +204,81 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
         y[others] = np.clip(x[others] - np.linalg.lstsq(J[:, others], r, rcond=None)[0], lo[others], hi[others])
         x = y
     return stepped, x, J, d, step
+
+
+def mu_profile(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray | None:
+    """Where the curve hardly determines mu at the table's optimum ``x`` (ln mu at a bound, or its linear 95%
+    interval in ln E* wider than 1, as where E* is called undetermined: the DMT end, a lever so soft that the
+    curve shows little but its pull-off): how far the other coordinates move over the mu the curve allows, on
+    the table's profile.  ln mu is stepped from x both ways (inwards alone from a bound), PROFILE_POINTS a
+    decade, the others fitted again at each (warm started, PROFILE_EVALS evaluations at most), until chi^2
+    exceeds its minimum by Z95^2 s^2 (s^2 = chi^2 / (n - p), the bars' own scale: a 95% interval of ln mu
+    alone) or the table ends; the coordinates at that crossing interpolated linearly between the two points
+    about it.  Returns the largest |move| of each coordinate over the points inside (ln mu's own 0), None
+    where ln mu is not fitted or is determined.  The Jacobian's bars cannot give this: along a direction
+    the curve hardly determines, their linear step leaves the model's range (ln mu +-300) and carries w with
+    it (a 3% bar), while w's real move over it is a fraction of that (0.6% at mu = 0.015, K = 0.0098) or,
+    where w is read from a pull-off that moves with mu (DMT's 2 pi R w, 0.8 of it at mu = 0.5), more than
+    the bar held at the optimum's mu (mu = 0.53, K = 1.3e-4: the optimum at the bound 0.001, w 12% low)."""
+    from scipy.optimize import least_squares
+
+    from .results import BOUND_MARGIN, Z95
+
+    if "ln_mu" not in pb.names:
+        return None
+    j = pb.names.index("ln_mu")
+    r0 = pb._all(pb.unpack(x))[0]
+    chi0 = float(r0 @ r0)
+    s2 = chi0 / max(pb.points - x.size, 1)
+    ways = [w for w, edge in ((1.0, x[j] - lo[j]), (-1.0, hi[j] - x[j])) if edge > BOUND_MARGIN]
+    if len(ways) == 2:                  # inside its bounds: profiled where its linear bar is wide
+        J = pb.jacobian(x)
+        try:
+            sd = math.sqrt(abs(np.linalg.inv(J.T @ J)[j, j]) * s2)
+        except np.linalg.LinAlgError:
+            sd = math.inf
+        if Z95 * 1.5 * sd <= 1.0:       # ln E* = ln w - 1.5 ln mu: E*'s interval narrower than its value
+            return None
+    limit = Z95**2 * s2
+    h = math.log(10.0) / PROFILE_POINTS
+    free = np.arange(x.size) != j
+    spread = np.zeros(x.size)
+    ends = []
+    for way in ways:
+        y, before, before_y = x.copy(), 0.0, x.copy()
+
+        def at(z, y=y):
+            full = y.copy()
+            full[free] = z
+            return full
+
+        end = x[j]
+        for k in range(1, int((hi[j] - lo[j]) / h) + 2):
+            y[j] = min(max(x[j] + way * k * h, lo[j]), hi[j])
+            sol = least_squares(lambda z: pb._all(pb.unpack(at(z)))[0], y[free],
+                                jac=lambda z: pb.jacobian(at(z))[:, free], bounds=(lo[free], hi[free]),
+                                method="trf", x_scale="jac", max_nfev=PROFILE_EVALS)
+            y[free] = sol.x
+            rise = 2.0 * float(sol.cost) - chi0
+            if rise > limit:
+                t = (limit - before) / (rise - before)
+                edge = before_y + t * (y - before_y)
+                spread = np.maximum(spread, np.abs(edge - x))
+                end = edge[j]
+                break
+            spread = np.maximum(spread, np.abs(y - x))
+            before, before_y, end = rise, y.copy(), y[j]
+            if y[j] in (lo[j], hi[j]):
+                break
+        ends.append(end)
+    spread[j] = 0.0
+    span = sorted([x[j]] + ends)
+    w = pb.names.index("ln_gamma")
+    pb.notes.append(f"the curve hardly determines mu: the table's profile describes it as well (chi^2 within "
+                    f"{limit:.3g} of its least) from mu = {math.exp(span[0]):.3g} to {math.exp(span[-1]):.3g}, "
+                    f"over which ln w moves by up to {spread[w]:.3g}, added to its bar (the others' bars with mu "
+                    f"held, each grown by its move)")
+    return spread
 
 
 def cpu() -> float:
