@@ -26,9 +26,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from . import paths
+from . import closed_forms, paths
 
-__all__ = ["COVERAGE_MUS", "COVERAGE_SEEDS", "PULL_OFF_MUS", "REAL", "coverage_case", "pull_off_rows", "main"]
+__all__ = ["COVERAGE_MUS", "COVERAGE_SEEDS", "REAL", "coverage_case", "main"]
 
 DOC = os.path.join(paths.DOCS, "fitting.md")
 #: Tabor parameters of the coverage study, each with COVERAGE_SEEDS noise streams.
@@ -37,8 +37,6 @@ COVERAGE_SEEDS = (1, 2, 3)
 #: The synthetic measurement: tip radius (m), epsilon (m), spring constant (N/m), work of adhesion (J/m^2),
 #: the noise (a share of 2 pi R w), points per leg.
 SYNTH = {"radius": 20e-9, "epsilon": 0.3e-9, "spring": 1.0, "gamma": 0.05, "noise_share": 0.01, "points": 300}
-#: Tabor parameters of the pull-off table.
-PULL_OFF_MUS = (0.01, 0.03, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 7.0, 10.0)
 #: The measured curve of tests/data and what is assumed of it (docs/fitting.md).
 REAL = {"file": "tests/data/fmt-igor-fd_SiN_FD_plot.ibw", "spring": 1.18, "radius": 20e-9, "epsilon": 0.3e-9,
         "young1": 250e9, "poisson1": 0.25}
@@ -485,54 +483,6 @@ def table_coverage_section(rows: list, made: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-# -- the closed forms against the model's pull-off ----------------------------------------
-def pull_off_rows() -> list:
-    """For each mu of PULL_OFF_MUS: the model's load-controlled pull-off (best value and bar), and the work of
-    adhesion DMT, JKR and Maugis-Dugdale give from the pull-off force it makes, against the true one."""
-    _init()
-    from ..fitting.pull_off import closed_forms, model_pull_off
-    from ..model.parameters import Model
-    from ..model.physical import Bodies
-
-    rows = []
-    R, eps, w, nu = 1e-6, 0.4e-9, 0.05, 0.3
-    for mu in PULL_OFF_MUS:
-        t = time.perf_counter()
-        e = model_pull_off(Model(mu=mu), error_bars=True)
-        E = w * math.sqrt(R / (mu**3 * eps**3))                 # eq. (9) solved for E*
-        b = Bodies(radius=R, young1=E * (1 - nu**2), poisson1=nu, epsilon=eps, gamma=w)
-        P = abs(e.F) * 2 * math.pi * R * w
-        cf = closed_forms(P, b)
-        rows.append({"mu": mu, "F": e.F, "F_err": e.F_err, "seconds": time.perf_counter() - t,
-                     **{f"{c.name}_ratio": c.gamma / w for c in cf}})
-        print(f"mu = {mu:g}: F = {e.F:.6f}", flush=True)
-    return rows
-
-
-def pull_off_section(rows: list, made: dict) -> str:
-    lines = ["## How far JKR, DMT and Maugis-Dugdale are from the model", "",
-             "<!-- made by: python -m petsc_adhesion.benchmarks.fitting pull_off (data: docs/data/fitting_pull_off.json;"
-             " -table redraws from it) -->", "",
-             "A sphere of the model at Tabor parameter mu pulls off at P = |F_p(mu)| 2 pi R w (load control, the "
-             "smooth half-infinite model, its best value extrapolated over nested grids, with its bar).  Given that "
-             "P, each closed form gives a work of adhesion; the table is its distance from the true w, in per cent "
-             "(DMT: P / 2 pi R; JKR: P / 1.5 pi R; Maugis-Dugdale: solved self-consistently with lambda_MD = "
-             "1.157 mu(w), since mu itself moves with w by eq. 9).  `-fit_pull_off` gives w back from the model's "
-             "own pull-off, to its bar.", "",
-             "| mu | model pull-off F_p (2 pi R w) | DMT w / w - 1 | JKR w / w - 1 | Maugis-Dugdale w / w - 1 |",
-             "|---|---|---|---|---|"]
-    for r in rows:
-        bar = f" +- {r['F_err']:.1e}" if r.get("F_err") else ""
-        lines.append(f"| {r['mu']:g} | {r['F']:.6f}{bar} | {100 * (r['dmt_ratio'] - 1):+.2f}% | "
-                     f"{100 * (r['jkr_ratio'] - 1):+.2f}% | {100 * (r['maugis_dugdale_ratio'] - 1):+.2f}% |")
-    worst = {k: max(rows, key=lambda r: abs(r[f"{k}_ratio"] - 1)) for k in ("dmt", "jkr", "maugis_dugdale")}
-    lines += ["", "Largest distances over the table: " + "; ".join(
-        f"{name} {100 * (worst[k][f'{k}_ratio'] - 1):+.1f}% (mu = {worst[k]['mu']:g})"
-        for k, name in (("dmt", "DMT"), ("jkr", "JKR"), ("maugis_dugdale", "Maugis-Dugdale"))) + "."]
-    return "\n".join(lines) + "\n"
-
-
-
 def main(argv: list[str]) -> int:
     if argv[:1] == ["-case"]:
         print(json.dumps(coverage_case(float(argv[1]), int(argv[2]))))
@@ -556,12 +506,12 @@ def main(argv: list[str]) -> int:
     if "pull_off" in parts:
         if not redraw:
             t = time.perf_counter()
-            rows = pull_off_rows()
+            rows = closed_forms.pull_off_rows()
             with open(_data("pull_off"), "w") as f:
                 json.dump({"made": {"seconds": time.perf_counter() - t, **paths.source()}, "rows": rows}, f, indent=1)
         with open(_data("pull_off")) as f:
             d = json.load(f)
-        text = pull_off_section(d["rows"], d["made"])
+        text = closed_forms.pull_off_section(d["rows"], d["made"])
         paths.write_section(DOC, text)
         print(text)
     for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache, mus), speed_section),

@@ -65,7 +65,7 @@ from .branches import BRANCHES
 from .forward import APPROACH, RETRACT, ForwardCurve, table_choice, table_covers, table_legs
 from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
                      domain_reasons, features, refuse_a_line, refuse_empty)
-from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, profiled, verdicts
+from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, profiled, to_moduli, verdicts
 from .pull_off import maugis_dugdale_gamma
 from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misfit, misfit_p
 from .table_search import START_MUS, TableStep, cpu, mu_profile, solver_steps, table_bounds
@@ -456,7 +456,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     pb.evaluations = 0
     res = least_squares(pb.residuals, x0, jac=pb.jacobian, bounds=(lo, hi), method="trf", x_scale="jac",
                         ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=choice.max_evaluations)
-    A = _to_moduli(names)
+    A = to_moduli(names)
     d, path = None, f"the solver's curves throughout: {why_not}"
     profile = None
     if pb.table is not None:
@@ -526,18 +526,6 @@ def _path_note(path) -> str:
     return path.describe({"ln_E_star": "E*", "ln_gamma": "w", "z0": "z0", "F0": "F0", "sigma": "sigma",
                           "ln_invols": "the sensitivity", "ln_k": "k", "slope": "the virtual deflection",
                           "drag": "the drag"})
-
-
-def _to_moduli(names: tuple) -> np.ndarray:
-    """The linear map of the fitted coordinates to (ln E*, ln w, ...): ln E* = ln w - 1.5 ln mu + const
-    (eq. 9), the others as they are."""
-    m = len(names)
-    A = np.eye(m)
-    if "ln_mu" in names:
-        i, j = names.index("ln_mu"), names.index("ln_gamma")
-        A[i, :] = 0.0
-        A[i, i], A[i, j] = -1.5, 1.0
-    return A
 
 
 def _align(pb: _Problem, x: np.ndarray) -> float:

@@ -19,7 +19,7 @@ from .domain import MU_BOUNDS
 from .results import BOUND_MARGIN, Z95, FitChoice, Instrument, undetermined
 
 __all__ = ["bounds", "verdicts", "instrument_values", "curve_spread", "branch_coordinates", "LawOptimum",
-           "profiled", "SIGMA_MAX", "INSTRUMENT_FACTOR", "SPREAD_STEPS", "SPREAD_TOL"]
+           "profiled", "to_moduli", "SIGMA_MAX", "INSTRUMENT_FACTOR", "SPREAD_STEPS", "SPREAD_TOL"]
 
 #: The largest roughness sigma = rms / eps fitted.
 SIGMA_MAX = 3.0
@@ -368,3 +368,15 @@ def profiled(cov_p: np.ndarray, J: np.ndarray, A: np.ndarray, d, s2: float, name
     out[:, j] = 0.0
     out[j, j] = cov_p[j, j]
     return out
+
+
+def to_moduli(names: tuple) -> np.ndarray:
+    """The linear map of the fitted coordinates to (ln E*, ln w, ...): ln E* = ln w - 1.5 ln mu + const
+    (eq. 9), the others as they are."""
+    m = len(names)
+    A = np.eye(m)
+    if "ln_mu" in names:
+        i, j = names.index("ln_mu"), names.index("ln_gamma")
+        A[i, :] = 0.0
+        A[i, i], A[i, j] = -1.5, 1.0
+    return A
