@@ -20,11 +20,11 @@ import numpy as np
 from ..discretization.contact import edge_level
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
-from .coordinate import NotMonotone, Sampled, sample, width
+from .coordinate import EVENT_KINDS, EventPoint, NotMonotone, Sampled, sample, width
 from .table import FamilyTable
 
 __all__ = ["select", "join", "TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points",
-           "F_MAX", "ROUGHNESS"]
+           "event_points", "F_MAX", "ROUGHNESS"]
 
 #: The load the table's curves end at: the library's default stop (-cont_F_max 2).
 F_MAX = 2.0
@@ -78,6 +78,15 @@ def regrid_points(branch) -> np.ndarray:
     return np.asarray(branch.corrector) == b"regrid"
 
 
+def event_points(curve) -> tuple:
+    """The turning points and F = 0 the solver located on a traced curve (its events of the kinds a sampling
+    takes, :data:`~petsc_adhesion.family.coordinate.EVENT_KINDS`), each on the grid it was located on."""
+    def grid(m):
+        return float(m.grid if m.grid is not None else m.value)
+    return tuple(EventPoint(e.kind, grid(e.lam), grid(e.F), float(e.H0), grid(e.contact_radius))
+                 for e in curve.events if e.kind in EVENT_KINDS and e.contact_radius is not None)
+
+
 def _node(mu: float, sigma: float, tau: np.ndarray, F_max: float):
     """(sampled curve or the reason it is not, seconds) of one node, on this rank alone."""
     from petsc4py import PETSc
@@ -90,7 +99,7 @@ def _node(mu: float, sigma: float, tau: np.ndarray, F_max: float):
             raise ValueError(f"the curve is incomplete: {c.assessment.incomplete[0]}")
         b = c.branch
         out = sample(b.lam, b.F, b.H0, b.contact_radius, edge_level(pressure_law(c.model)), F_max, tau, mu,
-                     regrid_points(b))
+                     regrid_points(b), event_points(c))
     except (NotMonotone, ValueError, RuntimeError) as e:     # said, not raised: the other ranks wait for it
         out = f"mu {mu:g}, sigma {sigma:g}: {str(e).splitlines()[0] if str(e) else type(e).__name__}"
     return out, time.perf_counter() - t0
