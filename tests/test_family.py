@@ -378,3 +378,25 @@ def test_a_sparse_rough_node_is_sampled_as_its_refined_curve(mu, sigma, within):
     assert coarse.shape is not None                       # the spline was not kept: it swung or missed
     assert abs(coarse.F.min() - _solver_events(fine_c)["pull_off"][0][1]) < 1e-4
     assert np.max(np.abs(coarse.F - ref.F)) < within, np.max(np.abs(coarse.F - ref.F))
+
+
+def test_a_joined_table_keeps_the_error_only_where_its_stencils_are_unchanged():
+    """The shipped smooth table cut in two along mu and joined again keeps the error of all its measured
+    midpoints; with its first node's curve changed (by 1e-9 in F), the two midpoints whose four-node stencils
+    take that node (between nodes 0-1 and 1-2) are left to be measured, the others kept as they were."""
+    from dataclasses import replace
+
+    from petsc_adhesion.family.build import join, keep_errors, select
+    from petsc_adhesion.family.table import shipped
+
+    smooth = shipped("smooth")
+    n = smooth.mu.size
+    whole = keep_errors(join([select(smooth, mu=range(9)), select(smooth, mu=range(9, n))]), smooth)
+    assert np.array_equal(whole.err_mu, smooth.err_mu) and whole.errors.keys() == smooth.errors.keys()
+    assert all(np.array_equal(whole.errors[f], smooth.errors[f]) for f in smooth.errors)
+    F = smooth.F.copy()
+    F[0, 0] += 1e-9
+    changed = keep_errors(replace(select(smooth), F=F), smooth)
+    lost = sorted(set(np.round(smooth.err_mu, 12)) - set(np.round(changed.err_mu, 12)))
+    mids = np.sqrt(smooth.mu[1:] * smooth.mu[:-1])
+    assert np.allclose(lost, mids[:2], rtol=1e-9), (lost, mids[:3])
