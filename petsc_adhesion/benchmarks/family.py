@@ -360,10 +360,11 @@ def main(argv=None) -> int:
             return 2
         table.save(args.out)
         if args.command == "join" and table.measured:
-            todo = [f"{m:.4g}" for m, s in midpoints(table) if not np.any(
+            todo = [(m, s) for m, s in midpoints(table) if not np.any(
                 np.isclose(table.err_mu, m, rtol=1e-9) & np.isclose(table.err_sigma, s, rtol=0, atol=1e-12))]
-            said = (f"the error of {table.err_mu.size} midpoints kept from {args.errors_from}; "
-                    f"{len(todo)} to measure (mu {', '.join(todo)})")
+            said = f"the error of {table.err_mu.size} midpoints kept from {args.errors_from}; " + (
+                f"{len(todo)} to measure (mu {', '.join(f'{m:.4g}' for m in sorted({m for m, _ in todo}))}; sigma "
+                f"{', '.join(f'{x:.4g}' for x in sorted({x for _, x in todo}))})" if todo else "none to measure")
         else:
             said = "its error not measured (measure it)"
         print(f"written {args.out} ({os.path.getsize(args.out) / 1e6:.2f} MB): mu {table.mu.size} nodes "
