@@ -316,6 +316,8 @@ def _parser() -> argparse.ArgumentParser:
     j = sub.add_parser("join")
     j.add_argument("--out", required=True)
     j.add_argument("parts", nargs="+", help="tables on the same tau nodes and the same mu (or the same sigma)")
+    j.add_argument("--errors-from", help="a measured table whose error at the midpoints the joined table "
+                   "interpolates from the same nodes is kept (the others are to be measured)")
     s = sub.add_parser("speed")
     s.add_argument("table")
     s.add_argument("--repeats", type=int, default=20)
@@ -333,13 +335,15 @@ def main(argv=None) -> int:
         speed(table, args.repeats)
         return 0
     if args.command in ("spacing", "join"):
-        from ..family.build import join
+        from ..family.build import join, keep_errors
         try:
             if args.command == "join":
                 out_dir = os.path.dirname(os.path.abspath(args.out))
                 if not os.path.isdir(out_dir):
                     raise ValueError(f"--out {args.out}: no folder {out_dir}")
                 table = join([FamilyTable.load(f) for f in args.parts])
+                if args.errors_from:
+                    table = keep_errors(table, FamilyTable.load(args.errors_from))
             else:
                 if not all(K > 0 and math.isfinite(K) for K in args.springs):
                     raise ValueError(f"--springs {args.springs}: expected stiffnesses > 0")
@@ -349,9 +353,17 @@ def main(argv=None) -> int:
             say(f"benchmarks.family: {e}")
             return 2
         table.save(args.out)
+        if args.command == "join" and table.measured:
+            todo = [(m, s) for m, s in midpoints(table) if not np.any(
+                np.isclose(table.err_mu, m, rtol=1e-9) & np.isclose(table.err_sigma, s, rtol=0, atol=1e-12))]
+            said = f"the error of {table.err_mu.size} midpoints kept from {args.errors_from}; " + (
+                f"{len(todo)} to measure (mu {', '.join(f'{m:.4g}' for m in sorted({m for m, _ in todo}))}; sigma "
+                f"{', '.join(f'{x:.4g}' for x in sorted({x for _, x in todo}))})" if todo else "none to measure")
+        else:
+            said = "its error not measured (measure it)"
         print(f"written {args.out} ({os.path.getsize(args.out) / 1e6:.2f} MB): mu {table.mu.size} nodes "
               f"[{table.mu[0]:g}, {table.mu[-1]:g}], sigma {table.sigma.size} [{table.sigma[0]:g}, "
-              f"{table.sigma[-1]:g}], its error not measured (measure it)")
+              f"{table.sigma[-1]:g}], {said}")
         return 0
     from petsc4py import PETSc
 

@@ -20,11 +20,11 @@ import numpy as np
 from ..discretization.contact import edge_level
 from ..model.parameters import Model
 from ..model.pressure import pressure_law
-from .coordinate import NotMonotone, Sampled, sample, width
-from .table import FamilyTable
+from .coordinate import EVENT_KINDS, EventPoint, NotMonotone, Sampled, sample, width
+from .table import ERROR_FIELDS, FamilyTable, lagrange
 
 __all__ = ["select", "join", "TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points",
-           "F_MAX", "ROUGHNESS"]
+           "event_points", "keep_errors", "F_MAX", "ROUGHNESS"]
 
 #: The load the table's curves end at: the library's default stop (-cont_F_max 2).
 F_MAX = 2.0
@@ -78,6 +78,15 @@ def regrid_points(branch) -> np.ndarray:
     return np.asarray(branch.corrector) == b"regrid"
 
 
+def event_points(curve) -> tuple:
+    """The turning points and F = 0 the solver located on a traced curve (its events of the kinds a sampling
+    takes, :data:`~petsc_adhesion.family.coordinate.EVENT_KINDS`), each on the grid it was located on."""
+    def grid(m):
+        return float(m.grid if m.grid is not None else m.value)
+    return tuple(EventPoint(e.kind, grid(e.lam), grid(e.F), float(e.H0), grid(e.contact_radius))
+                 for e in curve.events if e.kind in EVENT_KINDS and e.contact_radius is not None)
+
+
 def _node(mu: float, sigma: float, tau: np.ndarray, F_max: float):
     """(sampled curve or the reason it is not, seconds) of one node, on this rank alone."""
     from petsc4py import PETSc
@@ -90,7 +99,7 @@ def _node(mu: float, sigma: float, tau: np.ndarray, F_max: float):
             raise ValueError(f"the curve is incomplete: {c.assessment.incomplete[0]}")
         b = c.branch
         out = sample(b.lam, b.F, b.H0, b.contact_radius, edge_level(pressure_law(c.model)), F_max, tau, mu,
-                     regrid_points(b))
+                     regrid_points(b), event_points(c))
     except (NotMonotone, ValueError, RuntimeError) as e:     # said, not raised: the other ranks wait for it
         out = f"mu {mu:g}, sigma {sigma:g}: {str(e).splitlines()[0] if str(e) else type(e).__name__}"
     return out, time.perf_counter() - t0
@@ -196,3 +205,38 @@ def join(tables: list) -> FamilyTable:
                    lam=stack("lam"), F=stack("F"), s_lo=stack("s_lo"), s_hi=stack("s_hi"), s0=stack("s0"),
                    delta=stack("delta"), seconds=seconds, springs=np.zeros(0), err_mu=np.zeros(0),
                    err_sigma=np.zeros(0), errors={})
+
+
+def keep_errors(table: FamilyTable, old: FamilyTable) -> FamilyTable:
+    """``table`` with the error ``old`` measured at those of its midpoints whose interpolant is unchanged: the
+    midpoint lies in ``table``'s range and each of the nodes its cubic stencil takes (the four nearest in ln mu
+    and in sigma, :func:`~petsc_adhesion.family.table.lagrange`) is a node of ``old`` with the same curve to the
+    bit (lambda, F and the ends of its coordinate, on the same tau nodes and F_max); the others are left to be
+    measured again (a joined table's nodes that were traced anew, or sampled otherwise)."""
+    if not old.measured or old.tau.shape != table.tau.shape or not np.array_equal(old.tau, table.tau) or \
+            old.F_max != table.F_max or old.roughness != table.roughness:
+        return table
+
+    def same(i: int, j: int) -> bool:
+        a = np.flatnonzero(np.isclose(old.mu, table.mu[i], rtol=1e-12, atol=0))
+        b = np.flatnonzero(np.isclose(old.sigma, table.sigma[j], rtol=0, atol=1e-12))
+        if not (a.size and b.size):
+            return False
+        p, q = int(a[0]), int(b[0])
+        return all(np.array_equal(getattr(old, f)[p, q], getattr(table, f)[i, j])
+                   for f in ("lam", "F", "s_lo", "s_hi", "s0", "delta"))
+
+    keep = []
+    for k, (m, sg) in enumerate(zip(old.err_mu, old.err_sigma)):
+        try:
+            table.check(float(m), float(sg))
+        except ValueError:
+            continue
+        i0, wm = lagrange(np.log(table.mu), math.log(m))
+        j0, ws = lagrange(table.sigma, float(sg))
+        if all(same(i, j) for i in range(i0, i0 + wm.size) for j in range(j0, j0 + ws.size)):
+            keep.append(k)
+    if not keep:
+        return table
+    return table.with_error(old.err_mu[keep], old.err_sigma[keep], old.springs,
+                            {f: old.errors[f][keep] for f in ERROR_FIELDS})

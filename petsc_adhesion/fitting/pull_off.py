@@ -256,7 +256,8 @@ def _table_start(P: float, bodies: Bodies, sigma: float, table, mu_of) -> tuple 
         mu = float(found.mu[0])
         return math.log(float(found.gamma[0])), 1.0 + float(tab.slope(mu, sigma)) / 1.5
     if found.side[0] > 0 and float(tab.mu[-1]) >= MU_RANGE[1] * (1 - 1e-9):
-        raise PullOffFitError(f"P = {P:.4g} N: {found.reasons[0]}, the model's range (-adh_mu)")
+        raise PullOffFitError(f"P = {P:.4g} N needs a work of adhesion where mu is above {tab.mu[-1]:g} (the "
+                              f"pull-off table's inversion), the model's range (-adh_mu)")
     return None
 
 
