@@ -258,3 +258,32 @@ def test_a_curve_without_contact_or_adhesion_is_one_line(F_contact, F_pull, says
     with pytest.raises(CurveFitError) as e:
         fit_curve(_curve(F_contact, F_pull), TIP, Spring(1.0))
     assert str(e.value).startswith(says) and "\n" not in str(e.value)
+
+
+def test_ranks_making_curves_of_their_own_make_the_serial_curves(tmp_path):
+    """Two ranks, each making a different synthetic curve on PETSc.COMM_SELF (as a study dealing its cases to the
+    ranks does), make what one process makes of each: the forces equal to round-off.  Traced on the world
+    communicator, ranks tracing different curves met in each other's collective operations (the coverage
+    study on two ranks ended in 'munmap_chunk(): invalid pointer' inside a Jacobian)."""
+    import subprocess
+
+    import conftest
+
+    mus = (0.1, 0.3)
+    code = ("import sys, numpy as np; import petsc4py; petsc4py.init([]); from petsc4py import PETSc\n"
+            "from petsc_adhesion.fitting.results import Spring\n"
+            "from petsc_adhesion.fitting.synthetic import Sampling, synthetic_curve\n"
+            "from petsc_adhesion.model.physical import Bodies\n"
+            "r = PETSc.COMM_WORLD.getRank(); mu = (%r, %r)[r]; R, eps, w = 20e-9, 0.3e-9, 0.05\n"
+            "b = Bodies(radius=R, young1=w * (R / (mu**3 * eps**3)) ** 0.5, poisson1=0.0, epsilon=eps, gamma=w)\n"
+            "c = synthetic_curve(b, Spring(1.0), Sampling(points=60), comm=PETSc.COMM_SELF)\n"
+            "np.save(sys.argv[1] + '/F%%d.npy' %% r, c.F)\n") % mus
+    proc = subprocess.run([*conftest.mpiexec(2), sys.executable, "-c", code, str(tmp_path)], env=conftest._env(),
+                          cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    R, eps, w = 20e-9, 0.3e-9, 0.05
+    for r, mu in enumerate(mus):
+        b = Bodies(radius=R, young1=w * math.sqrt(R / (mu**3 * eps**3)), poisson1=0.0, epsilon=eps, gamma=w)
+        serial = synthetic_curve(b, Spring(1.0), Sampling(points=60)).F
+        ranked = np.load(tmp_path / f"F{r}.npy")
+        assert ranked.shape == serial.shape and np.allclose(ranked, serial, rtol=0, atol=1e-12 * np.abs(serial).max())

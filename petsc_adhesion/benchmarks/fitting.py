@@ -195,7 +195,7 @@ _CLEAN: dict = {}
 
 
 def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | None, finer: bool,
-               sigma: float = 0.0):
+               sigma: float = 0.0, comm=None):
     """A synthetic curve made by the solver (finer steps than the fit's where ``finer``) at (mu, K) with noise,
     the contact point and baseline drawn from ``seed``; read from ``cache`` where it was made before. (data,
     truth dict, the bodies given to the fit, the spring)."""
@@ -228,7 +228,8 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
         if made_of not in _CLEAN:      # one truth's noiseless curve, traced once: each seed shifts it, adds noise
             _CLEAN[made_of] = synthetic_curve(Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w,
                                                      rms=sigma * eps if sigma > 0 else None),
-                                              Spring(k), Sampling(points=s["points"]), settings=settings)
+                                              Spring(k), Sampling(points=s["points"]), settings=settings,
+                                              comm=comm)
         c = _CLEAN[made_of]            # as synthetic_curve adds them: z0 and F0, then the noise of the seed
         F = c.F + F0 + noise * np.random.default_rng(seed).standard_normal(c.F.size)
         data = MeasuredCurve(z=c.z + z0, F=F, turn=c.turn, direction=1, spring=k, source="synthetic")
@@ -399,7 +400,7 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
             continue
         try:
             data, truth, bodies, spring = _synthetic(case["mu"], case["K"], case["noise_share"], case["seed"],
-                                                     cache, finer=True, sigma=case["sigma"])
+                                                     cache, finer=True, sigma=case["sigma"], comm=PETSc.COMM_SELF)
         except Exception as e:          # the solver's failure to make the truth: said in the row, not fitted
             data, truth = None, {"mu": case["mu"], "K": case["K"], "sigma": case["sigma"],
                                  "error": f"the synthetic curve: {str(e).splitlines()[0] if str(e) else type(e).__name__}"}

@@ -78,15 +78,18 @@ def forward_curve(model: Model, K: float, top: float = 2.0, grid=None, solver=No
 
 
 def synthetic_curve(bodies: Bodies, spring: Spring, sampling: Sampling = Sampling(), model: Model | None = None,
-                    grid=None, settings=None) -> MeasuredCurve:
+                    grid=None, settings=None, comm=None) -> MeasuredCurve:
     """A force curve measured on the model (SI) for ``bodies`` (their R, E by eq. 2, epsilon, gamma and rms)
-    behind ``spring``, sampled as ``sampling`` says; the roughness average and domain of ``model``."""
+    behind ``spring``, sampled as ``sampling`` says; the roughness average and domain of ``model``.  ``comm``:
+    the ranks that trace it together (PETSc's world by default; ``PETSc.COMM_SELF`` where each rank makes a
+    curve of its own, as a study dealing cases to its ranks does: on the world, ranks tracing different curves
+    would meet in each other's collective operations)."""
     R, eps, w, E = bodies.R, bodies.epsilon, bodies.work_of_adhesion, bodies.E
     mu, sigma = bodies.mu, bodies.sigma or 0.0
     K = spring.K(bodies, w)
     s = sampling
     top = s.top
-    fc = forward_curve(replace(model or Model(), mu=mu, sigma=sigma), K, top, grid, settings=settings)
+    fc = forward_curve(replace(model or Model(), mu=mu, sigma=sigma), K, top, grid, settings=settings, comm=comm)
     last = fc.pieces[-1]
     Z_hi = float(np.interp(top, last.F, last.Z)) if last.F[-1] >= top else last.Z_hi
     jumps = fc.jumps[APPROACH]
