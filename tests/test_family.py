@@ -299,6 +299,42 @@ def test_every_damaged_table_file_is_one_line_naming_it(which, tmp_path):
     assert np.array_equal(a.mu, b.mu) and np.array_equal(a.F, b.F) and a.roughness == b.roughness
 
 
+def test_a_family_table_of_the_right_names_but_wrong_arrays_is_one_line(tmp_path):
+    """A family table's arrays are read by position: a file with every array named but one of another shape,
+    order or value (a node curve cut short, mu out of order or at 0, a NaN in F, a coordinate of another grid,
+    an error field shorter than its midpoints) is refused in one line naming the array, where it used to load
+    and fail later inside an interpolation or give another curve's numbers."""
+    from petsc_adhesion.family.table import shipped_path
+
+    src = shipped_path("rough")
+    with np.load(src) as z:
+        good = dict(z)
+    F_nan = good["F"].copy()
+    F_nan[3, 2, 100] = np.nan
+    cases = {
+        "lam": dict(lam=good["lam"][:, :, :-1]),
+        "F": dict(F=F_nan),
+        "mu": dict(mu=good["mu"][::-1].copy()),
+        "sigma": dict(sigma=np.r_[-0.05, good["sigma"][1:]]),
+        "s0": dict(s0=good["s0"][:, :-1]),
+        "F_max": dict(F_max=np.array([2.0, 3.0])),
+        "the measured error": dict(err_jump_Z=good["err_jump_Z"][:-1]),
+    }
+    seen = set()
+    for name, arrays in cases.items():
+        path = str(tmp_path / f"{name.replace(' ', '_')}.npz")
+        np.savez(path, **{**good, **arrays})
+        with pytest.raises(ValueError) as e:
+            FamilyTable.load(path)
+        msg = str(e.value)
+        assert "\n" not in msg and msg.startswith(f"{path}: not a curve family table ({name}: "), msg
+        assert msg.endswith("; rebuild it)"), msg
+        seen.add(msg)
+    assert len(seen) == len(cases)
+    np.savez(str(tmp_path / "same.npz"), **good)               # the same arrays written again read back
+    assert np.array_equal(FamilyTable.load(str(tmp_path / "same.npz")).F, good["F"])
+
+
 def changed_copy(src, tmp_path):
     """``src`` read and written again with numpy (uncompressed): the same arrays in another archive."""
     with np.load(src) as z:

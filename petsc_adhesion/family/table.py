@@ -246,11 +246,48 @@ class FamilyTable:
     def load(cls, path: str) -> FamilyTable:
         """The table in ``path``; ValueError, one line, for a file that is no table of this format version."""
         d = load_npz(path, "curve family table", FORMAT, FORMAT_VERSION, cls._ARRAYS)
+        why = _arrays_wrong(d)
+        if why:
+            raise ValueError(f"{path}: not a curve family table ({why}; rebuild it)")
         errors = {f: d[f"err_{f}"] for f in ERROR_FIELDS} if d["err_mu"].size else {}
         return cls(mu=d["mu"], sigma=d["sigma"], tau=d["tau"], lam=d["lam"], F=d["F"], s_lo=d["s_lo"],
                    s_hi=d["s_hi"], s0=d["s0"], delta=d["delta"], F_max=float(d["F_max"]),
                    roughness=str(d["roughness"]), version=str(d["program_version"]), seconds=d["seconds"],
                    springs=d["springs"], err_mu=d["err_mu"], err_sigma=d["err_sigma"], errors=errors)
+
+
+def _arrays_wrong(d: dict) -> str | None:
+    """What is wrong with a family table's arrays ``d`` as read (None where nothing): the nodes mu (positive) and
+    sigma (not negative) increasing, tau increasing; lam and F finite of shape (mu, sigma, tau); each node's
+    coordinate (s_lo, s_hi, s0, delta) and cost of shape (mu, sigma); F_max a finite number; the measured
+    midpoints err_mu, err_sigma and each error field of one length.  Interpolation reads these by position, so a
+    table of the right names but another shape would give numbers of nobody's curve, or an IndexError deep in a
+    fit."""
+    def vector(name: str, low: float | None) -> str | None:
+        a = d[name]
+        if a.ndim != 1 or a.size < 1 or a.dtype.kind not in "fiu" or not np.all(np.isfinite(a)) \
+                or np.any(np.diff(a) <= 0) or (low is not None and a[0] < low):
+            return f"{name}: expected increasing finite nodes{'' if low is None else f' of at least {low:g}'}"
+        return None
+
+    for name, low in (("mu", 1e-300), ("sigma", 0.0), ("tau", None)):
+        bad = vector(name, low)
+        if bad:
+            return bad
+    nodes = (d["mu"].size, d["sigma"].size)
+    for name in ("lam", "F"):
+        a = d[name]
+        if a.shape != (*nodes, d["tau"].size) or a.dtype.kind != "f" or not np.all(np.isfinite(a)):
+            return f"{name}: expected finite values of shape (mu, sigma, tau) = {(*nodes, d['tau'].size)}"
+    for name in ("s_lo", "s_hi", "s0", "delta", "seconds"):
+        if d[name].shape != nodes:
+            return f"{name}: expected shape (mu, sigma) = {nodes}"
+    if d["F_max"].shape != () or d["F_max"].dtype.kind not in "fiu" or not np.isfinite(d["F_max"]):
+        return "F_max: expected one finite number"
+    n = d["err_mu"].shape
+    if len(n) != 1 or any(d[f"err_{f}"].shape != n for f in ("sigma", *ERROR_FIELDS)):
+        return "the measured error: expected err_mu, err_sigma and each error field of one length"
+    return None
 
 
 @dataclass(frozen=True)
