@@ -268,7 +268,8 @@ def _progress(opts: AppOptions, comm, cap: int):
 
     def update(p: FitProgress) -> None:
         bar.update(p.evaluations / cap, f"fit: {p.evaluations} evaluations of at most {cap} (-fit_max_evals), "
-                                        f"{p.traces} curves traced, best reduced chi^2 {p.best_reduced_chi2:.4g}")
+                                        f"{p.traces} curve{'' if p.traces == 1 else 's'} traced, "
+                                        f"best reduced chi^2 {p.best_reduced_chi2:.4g}")
     return update
 
 

@@ -189,6 +189,11 @@ def _pct(x: float, ref: float) -> str:
     return f"{100 * (x / ref - 1):+.1f}%"
 
 
+def _count(n: int, noun: str) -> str:
+    """``n`` and the noun, singular for one ("1 curve traced", "18 evaluations")."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def _pm(q, scale: float, unit: str, digits: str = ".6g") -> str:
     """``value +- bar unit`` of a Measured in ``unit`` (``scale`` SI per unit); its note where it has no bar;
     ``undetermined`` for a Missing."""
@@ -206,7 +211,7 @@ def report_fit(fit) -> None:
     if hasattr(fit, "closed_forms"):
         P = fit.P
         err = f" +- {P.err * 1e9:.3g}" if P.err else ""
-        out.append(f"fit of the pull-off P = {P.value * 1e9:.6g}{err} nN: {fit.curves} curves traced, "
+        out.append(f"fit of the pull-off P = {P.value * 1e9:.6g}{err} nN: {_count(fit.curves, 'curve')} traced, "
                    f"{fit.wall_time_s:.3g} s")
         F_err = f"{fit.F.err:.1e}" if fit.F.err is not None else "(no bar)"
         out.append(f"  gamma = {_pm(fit.gamma, 1.0, 'J/m^2')}   mu = {fit.mu:.6g}   sigma = {fit.sigma:g}   "
@@ -220,8 +225,9 @@ def report_fit(fit) -> None:
             out += [f"  {line}" for line in spread_lines(fit.spread)]
     else:
         m, f = fit.measured, fit.fitted
-        out.append(f"fit of the curve {fit.data.path or ''}: {fit.data.z.size} points, {fit.traces} curves "
-                   f"traced, {fit.iterations} evaluations, {fit.wall_time_s:.3g} s ({fit.status})")
+        out.append(f"fit of the curve {fit.data.path or ''}: {fit.data.z.size} points, "
+                   f"{_count(fit.traces, 'curve')} traced, {_count(fit.iterations, 'evaluation')}, "
+                   f"{fit.wall_time_s:.3g} s ({fit.status})")
         out.append(f"  gamma = {_pm(fit.gamma, 1.0, 'J/m^2')}   E* = {_pm(fit.E_star, 1e9, 'GPa')}   "
                    f"mu = {fit.mu:.4g}   K = {fit.K:.4g}")
         if fit.rms is not None:
