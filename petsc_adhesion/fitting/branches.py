@@ -161,7 +161,7 @@ class BranchCache:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             c = trace_curve(model, grid, solver, branch_settings(model, f_max),
-                            CurveRequest(error_bars=False, kinds=()), comm=comm)
+                            CurveRequest(error_bars=False, kinds=(), cycles=False), comm=comm)
         self.traced += 1
         branch = SolverBranch.of(c, f_max, time.process_time() - c0)
         if len(self.kept) >= KEEP:
