@@ -65,21 +65,24 @@ def branch_settings(model, f_max: float):
     continuation's norm there, and the quadratic predictor.
 
     Why the units: in units of 1 a branch at mu = 100 took 4878 steps (the continuation's cap is 5000; at mu =
-    1000 it would stop at the cap) where lambda runs over 1000 epsilon: 74 s of CPU.  In units of mu with steps
-    of 0.05 mu, 581 steps and 14 s, the branch read behind K = 0.005 to 0.5 within 7e-5 of 2 pi R w of those
-    dense points away from the jumps (3e-3 within 0.2 epsilon of them, where a fit leaves its points out); with
-    the library's 0.5 mu the far branch's few points missed its force by 0.03 (a spline between them).  Below
-    mu = 20 the steps stay at 0.5: at mu = 10 a bound of 1 put a second jump-in behind K = 0.005.  Why the
-    predictor: Newton starts nearer the corrected point (the tracer takes it itself in a soft sphere's frame of
-    the edge from mu = 20): the same points to the solver's tolerance, at mu = 1 and 10 the branch read behind
-    K = 0.005 to 0.5 within 4e-5 of the linear predictor's, in about 0.8 of its CPU (docs/fitting.md, "The
-    speed of a curve fit")."""
+    1000 it would stop at the cap) where lambda runs over 1000 epsilon: 104 s of CPU.  In units of mu with steps
+    of 0.05 mu, 578 steps and 14 s: read behind K = 0.005 and 0.048 within 1.5e-4 of 2 pi R w of those dense
+    points beyond 0.1 epsilon of the jumps, behind a stiff K = 0.5 within 8e-4 on the approach and 4e-3 (0.4 of 1%
+    noise) on the retract, beyond 0.2 epsilon of the jumps.  Steps of 0.025 mu (1047 steps, 21 s) are not
+    better: 5e-4 and 1.7e-3 there, and a second jump-in 0.025 epsilon before the first behind K = 0.005; with the
+    library's 0.5 mu the far branch's few points were 0.03 off (a spline between them).  Below mu = 20 the steps
+    stay at 0.5: at mu = 10 a bound of 1 put a second jump-in behind K = 0.005.
+
+    Why the predictor: Newton starts nearer the corrected point (the tracer takes it itself in a soft sphere's
+    frame of the edge from mu = 20): the same points to the solver's tolerance, at mu = 1 and 10 the branch read
+    behind K = 0.005 to 0.5 within 4e-5 of the linear predictor's, in about 0.8 of its CPU (docs/fitting.md,
+    "What a branch costs")."""
     from ..discretization.problem import step_scale
     from ..tracing.trace import curve_settings
 
     scale = step_scale(model)
     s = curve_settings(scale, observable_max=f_max, observable_step=STEP_F, predictor="quadratic")
-    return s if scale == 1.0 else replace(s, ds_max=DS_MAX_PER_MU * scale)
+    return s if scale == 1.0 else replace(s, ds=min(s.ds, DS_MAX_PER_MU * scale), ds_max=DS_MAX_PER_MU * scale)
 
 
 @dataclass(frozen=True)
