@@ -48,7 +48,12 @@ def test_a_branch_behind_a_spring_jumps_where_the_spring_traced_curve_does(mu, K
         (b_s, a_s), = spring.jump_forces(leg)
         assert abs(before - e.F.value) <= max(2 * abs(e.F.grid - e.F.value), 3 * e.F.err) + 5e-4
         assert abs(after - a_s) <= 5e-4
-        Z = np.linspace(legs.jumps[RETRACT][0] - 20.0, spring.pieces[-1].Z_hi, 1500)
+        # up to the branch's end (a load of the ladder past the 2.5 asked for; beyond it the contact is continued
+        # linearly, as past any traced curve's end, while the spring's curve runs on to 4)
+        (branch,) = cache.kept.values()
+        end = float(branch.curve.lam[-1] + branch.curve.F[-1] / K)
+        assert branch.curve.F[-1] >= 2.5
+        Z = np.linspace(legs.jumps[RETRACT][0] - 20.0, min(spring.pieces[-1].Z_hi, end), 1500)
         near = np.zeros(Z.size, bool)
         for z in legs.jumps[leg] + spring.jumps[leg]:
             near |= np.abs(Z - z) < max(allowed, 0.02)
@@ -130,3 +135,23 @@ def test_the_step_from_the_lattice_point_matches_the_fit_at_the_optimum(monkeypa
     assert off.path.curves == 1 and 0.4 < off.path.first < 0.8, off.path
     for a, b in ((at.gamma, off.gamma), (at.E_star, off.E_star)):
         assert abs(a.value - b.value) <= 0.1 * a.err and a.err <= b.err <= 1.2 * a.err, (a, b)
+
+
+def test_a_branch_traced_without_its_cycles_holds_the_same_points_and_says_the_energy_is_missing():
+    """CurveRequest(cycles=False), as a fit's branch is traced: the same points bit for bit as the curve traced
+    with its cycles (the energy is computed after the trace, from its points), the rigid cycle's energy Missing
+    with its reason instead of a number, the events kinds=() leaves out not made (mu = 1: a hysteresis loop, whose
+    energy the curve with its cycles gives, positive)."""
+    from petsc_adhesion.fitting.branches import branch_settings
+    from petsc_adhesion.tracing.measured import Missing
+    from petsc_adhesion.tracing.results import NO_CYCLE
+
+    m = Model(mu=1.0)
+    s = branch_settings(m, 2.0)
+    full = trace_curve(m, GridChoice(), SolverChoice(), s, CurveRequest(error_bars=False, kinds=()))
+    bare = trace_curve(m, GridChoice(), SolverChoice(), s, CurveRequest(error_bars=False, kinds=(), cycles=False))
+    for key in ("lam", "F", "H0", "contact_radius"):
+        assert np.array_equal(np.asarray(getattr(full.branch, key)), np.asarray(getattr(bare.branch, key))), key
+    assert full.rigid.energy.value > 0 and full.rigid.loops >= 1
+    assert isinstance(bare.rigid.energy, Missing) and bare.rigid.energy.reason == NO_CYCLE and bare.rigid.loops is None
+    assert bare.events == () and bare.pull_off is None

@@ -59,6 +59,7 @@ class EdgeFrameProblem:
         self.plumbing = Plumbing(A, 1, self)     # owns A from here on
         self.comm, self._mpi, self.layout, self.jacobian = \
             self.plumbing.comm, self.plumbing.mpi, self.plumbing.layout, self.plumbing.jacobian
+        self._serial = self._mpi.Get_size() == 1
         self.law = pressure_law(model)
         self.level = edge_level(self.law)
         self.c = model.coupling
@@ -86,11 +87,19 @@ class EdgeFrameProblem:
         n1 = int(self.last)
         return PETSc.Vec().createMPI((self.nloc + n1, self.rho.size + 1), comm=self.comm)
 
+    def _reduce(self, value, op=None):
+        """``value`` reduced over the ranks by ``op`` (MPI.SUM by default); on one rank the value itself, as the
+        reduction returns it: mpi4py's pickling reduction cost 70 us a call, 2 of a branch's 11 s of CPU at
+        mu = 10 (about 27,000 calls; docs/fitting.md, "The speed of a curve fit")."""
+        if self._serial:
+            return value
+        return self._mpi.allreduce(value, op=MPI.SUM if op is None else op)
+
     def _split(self, x: np.ndarray, pinned: bool = False):
         """(local H, a, and with ``pinned`` H(1)): one reduction."""
         h = x[:self.nloc]
         parts = np.array([x[self.nloc] if self.last else 0.0, self._pin_local @ h if pinned else 0.0])
-        a, h1 = self._mpi.allreduce(parts)
+        a, h1 = self._reduce(parts)
         return h, a, h1
 
     def separation(self, x: np.ndarray) -> np.ndarray:
@@ -152,7 +161,7 @@ class EdgeFrameProblem:
         ddot, adot, _ = self._split(xdot)
         pressure, dpressure = self.law(d + a * a * self.half_rho2)
         hdot = ddot + 2 * a * adot * self.half_rho2
-        S, dS = self._mpi.allreduce(np.array([self.q @ pressure, self.q @ (dpressure * hdot)]))
+        S, dS = self._reduce(np.array([self.q @ pressure, self.q @ (dpressure * hdot)]))
         F, dF = a * a * S, 2 * a * adot * S + a * a * dS
         if self.model.farfield:                 # beyond r_m = a rho_m (problem.Problem.observe)
             rm = a * self.rho[-1]
@@ -169,7 +178,7 @@ class EdgeFrameProblem:
     def inside(self, x: np.ndarray) -> bool:
         """Every gap open and the contact radius positive, on all ranks."""
         d, a, _ = self._split(x)
-        return self._mpi.allreduce(bool(np.all(d + a * a * self.half_rho2 > self.law.wall)), op=MPI.LAND) and a > 0
+        return self._reduce(bool(np.all(d + a * a * self.half_rho2 > self.law.wall)), MPI.LAND) and a > 0
 
     def step_fraction(self, x: np.ndarray, y: np.ndarray) -> float:
         """Largest fraction of x -> x - y that covers at most TO_WALL of the way to the wall,
@@ -182,7 +191,7 @@ class EdgeFrameProblem:
         alpha = float(np.min(TO_WALL * room[toward] / yh[toward], initial=1.0))
         if ya > 0:
             alpha = min(alpha, 0.5 * a / ya)
-        return self._mpi.allreduce(alpha, op=MPI.MIN)
+        return self._reduce(alpha, MPI.MIN)
 
     def record_guard(self) -> None:
         """Count a Newton step the domain guard shortened (:meth:`step_fraction` below 1)."""

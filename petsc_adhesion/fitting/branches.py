@@ -4,7 +4,7 @@ branches a process has traced kept for its later fits (docs/fitting.md, "The sol
 In units of 2 pi R w and epsilon the load-approach branch depends on (mu, sigma) (and the model's law and
 domain) alone; a cantilever of stiffness K only maps it to its base position Z = lambda + F / K, its jumps at
 the turning points of Z.  So the solver traces the branch once, with a rigid machine, to a load of the ladder
-F_max = 2, 4, 8, ... past what the data reach (the contact continued linearly beyond, as past any traced
+F_max = 2, 2.83, 4, 5.66, ... past what the data reach (the contact continued linearly beyond, as past any traced
 curve's end), and every spring a fit asks for (its K moves with w and the spring constant) reads the same
 branch: along the family's coordinate s = a^2 / 2 - H(0), monotone through the folds
 (:mod:`~petsc_adhesion.family.coordinate`, stretched about the contact's forming), by
@@ -37,19 +37,52 @@ from ..family.legs import Legs
 from ..family.table import FamilyCurve
 from ..tracing.measured import Missing
 
-__all__ = ["SolverBranch", "BranchCache", "BRANCHES", "STEP_F", "f_level"]
+__all__ = ["SolverBranch", "BranchCache", "BRANCHES", "STEP_F", "f_level", "branch_settings"]
 
 #: The branch's largest step in F (units 2 pi R w; the continuation's observable_step).
 STEP_F = 0.05
-#: The loads the branches are traced to: F_LADDER[0] times powers of 2.
+#: The branch's largest continuation step in units of mu where its curve is traced in those units (mu >= 20).
+DS_MAX_PER_MU = 0.05
+#: The loads the branches are traced to: F_LADDER times powers of 2, RUNGS of them an octave (2, 2.83, 4, 5.66, ...):
+#: a branch is traced at most 41% past the load the data need (100% with one rung an octave: at mu = 1 and 10 the
+#: synthetic curves of docs/fitting.md need 2.7 to 2.9, and the stretch from there to 4 took 17 of 144 and about
+#: 30 of 420 steps).
 F_LADDER = 2.0
+RUNGS = 2
 #: Branches kept by a process (the oldest dropped first).
 KEEP = 256
 
 
 def f_level(needed: float) -> float:
-    """The load of the ladder a branch is traced to: the first of 2, 4, 8, ... at or past ``needed``."""
-    return F_LADDER * 2.0 ** max(0, math.ceil(math.log2(max(needed, 1e-300) / F_LADDER) - 1e-12))
+    """The load of the ladder a branch is traced to: the first of 2, 2 sqrt 2, 4, ... at or past ``needed``."""
+    return F_LADDER * 2.0 ** (max(0, math.ceil(RUNGS * math.log2(max(needed, 1e-300) / F_LADDER) - 1e-12)) / RUNGS)
+
+
+def branch_settings(model, f_max: float):
+    """The continuation's settings of a branch: the library's curve's in its units
+    (:func:`~petsc_adhesion.discretization.problem.step_scale`: mu from 20 on, as the table's curves are traced)
+    to the load ``f_max``, with steps of at most STEP_F in F and of at most DS_MAX_PER_MU times mu in the
+    continuation's norm there, and the quadratic predictor.
+
+    Why the units: in units of 1 a branch at mu = 100 took 4878 steps (the continuation's cap is 5000; at mu =
+    1000 it would stop at the cap) where lambda runs over 1000 epsilon: 104 s of CPU.  In units of mu with steps
+    of 0.05 mu, 578 steps and 14 s: read behind K = 0.005 and 0.048 within 1.5e-4 of 2 pi R w of those dense
+    points beyond 0.1 epsilon of the jumps, behind a stiff K = 0.5 within 8e-4 on the approach and 4e-3 (0.4 of 1%
+    noise) on the retract, beyond 0.2 epsilon of the jumps.  Steps of 0.025 mu (1047 steps, 21 s) are not
+    better: 5e-4 and 1.7e-3 there, and a second jump-in 0.025 epsilon before the first behind K = 0.005; with the
+    library's 0.5 mu the far branch's few points were 0.03 off (a spline between them).  Below mu = 20 the steps
+    stay at 0.5: at mu = 10 a bound of 1 put a second jump-in behind K = 0.005.
+
+    Why the predictor: Newton starts nearer the corrected point (the tracer takes it itself in a soft sphere's
+    frame of the edge from mu = 20): the same points to the solver's tolerance, at mu = 1 and 10 the branch read
+    behind K = 0.005 to 0.5 within 4e-5 of the linear predictor's, in about 0.8 of its CPU (docs/fitting.md,
+    "What a branch costs")."""
+    from ..discretization.problem import step_scale
+    from ..tracing.trace import curve_settings
+
+    scale = step_scale(model)
+    s = curve_settings(scale, observable_max=f_max, observable_step=STEP_F, predictor="quadratic")
+    return s if scale == 1.0 else replace(s, ds=min(s.ds, DS_MAX_PER_MU * scale), ds_max=DS_MAX_PER_MU * scale)
 
 
 @dataclass(frozen=True)
@@ -120,7 +153,7 @@ class BranchCache:
         now); the branch None where it cannot be read.  Collective on ``comm`` when it traces."""
         import time
 
-        from ..tracing.trace import CurveRequest, curve_settings, trace_curve
+        from ..tracing.trace import CurveRequest, trace_curve
 
         model = replace(model, bodies=None)
         f_max = f_level(needed)
@@ -130,8 +163,8 @@ class BranchCache:
         c0 = time.process_time()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            c = trace_curve(model, grid, solver, curve_settings(observable_max=f_max, observable_step=STEP_F),
-                            CurveRequest(error_bars=False, kinds=()), comm=comm)
+            c = trace_curve(model, grid, solver, branch_settings(model, f_max),
+                            CurveRequest(error_bars=False, kinds=(), cycles=False), comm=comm)
         self.traced += 1
         branch = SolverBranch.of(c, f_max, time.process_time() - c0)
         if len(self.kept) >= KEEP:

@@ -285,27 +285,39 @@ def _energy(loop, fold, event_of_found, levels) -> Measured:
     return Measured(loop.energy, bound, note=note)
 
 
-def curve(segments, estimates: dict, profiles: bool = False, tracer=None) -> Traced:
+#: The energy of a cycle not asked for (:class:`~.trace.CurveRequest` ``cycles`` False).
+NO_CYCLE = "not computed: the curve was traced without its cycles' energies (CurveRequest cycles False)"
+
+
+def curve(segments, estimates: dict, profiles: bool = False, tracer=None, cycles: bool = True,
+          kept=None) -> Traced:
     """The traced curve (its segments, in order) as values: its branch, its events with their bars
     (``estimates``: the :class:`~.error_bars.Estimate` of each located event by ``id`` of its ``Found``,
     Missing where it failed; none asked for: absent), the pull-off, its cycles (``tracer``: the one that
     traced the segments, for the energy's levels; None, or no estimates: the energy's bar from the events').
 
     Collective.  ``profiles`` (rank 0, else empty): the nodes and the pressure of
-    every point, for the resolution check.
+    every point, for the resolution check.  Without ``cycles`` each cycle's energy is Missing (NO_CYCLE), and
+    the events whose kind ``kept(kind)`` refuses are not made into values (the cycles' bars were all that
+    read them): a fit's branch, read behind springs, needs neither (at mu = 10 the cycle's energy alone took
+    a tenth of the branch's CPU).
     """
     found = [(seg, f) for seg in segments for f in seg.finder.found]
+    if not cycles and kept is not None:
+        found = [(seg, f) for seg, f in found if kept(f.label)]
     events = [event_of(seg.problem, f, estimates.get(id(f)), profiles) for seg, f in found]
     pts = [p for seg in segments for p in seg.cont.points]
     radii = [contact_radius(seg.problem, p.x) for seg in segments for p in seg.cont.points]
     by_found = {id(f): e for (_, f), e in zip(found, events)}
     last = segments[-1].cont
     why = unclosed(segments, stop_reason(last.stop, last.set))
-    cycles = {}
+    cycles_ = {}
     for fold in (e for e in segments[0].finder.events if isinstance(e, Fold)):
         levels = None if tracer is None or not estimates else \
             (lambda loop, fold=fold: error_bars.energy_levels(tracer, loop, fold, lambda f: estimates.get(id(f))))
-        cycles["spring" if fold.weight else "rigid"] = _cycle(segments, fold, lambda f: by_found[id(f)], why, levels)
+        cycle = _cycle(segments, fold, lambda f: by_found[id(f)], why, levels) if cycles else \
+            Cycle(Missing(NO_CYCLE), None, 1.0 / fold.weight if fold.weight else None)
+        cycles_["spring" if fold.weight else "rigid"] = cycle
     states = []
     for seg in segments:
         pb = seg.problem
@@ -315,11 +327,11 @@ def curve(segments, estimates: dict, profiles: bool = False, tracer=None) -> Tra
                 states.append((r, H, pb.law(H)[0]))
     mins = [e for e in events if e.kind == "F_min"]
     lowest = min(float(seg.problem.separation(p.x).min()) for seg in segments for p in seg.cont.points)
-    spring = cycles.get("spring")
+    spring = cycles_.get("spring")
     return Traced(
         branch=Branch.from_points(pts, radii, None if spring is None else spring.K),
         found=tuple(f for _, f in found), events=tuple(events),
-        pull_off=min(mins, key=lambda e: e.F.value) if mins else None, rigid=cycles["rigid"], spring=spring,
+        pull_off=min(mins, key=lambda e: e.F.value) if mins else None, rigid=cycles_["rigid"], spring=spring,
         wall_gap=segments[-1].problem.comm.tompi4py().allreduce(lowest, op=MPI.MIN) - segments[-1].problem.law.wall,
         steps=sum(len(seg.cont.points) - 1 for seg in segments),
         rejected_steps=sum(seg.cont.rejected for seg in segments),

@@ -152,7 +152,9 @@ class CurveRequest:
     given; ``profiles``: H(r) and P(r) at every event; ``kinds``: the event kinds reported (None: all; the
     others are left out, unestimated); ``spring``: the stiffness K of a spring the approach is driven
     through (an AFM cantilever, units 2 pi R gamma / epsilon; None: a rigid machine), whose base
-    Z = lambda + F / K jumps at its turning points (events jump_in, jump_off).
+    Z = lambda + F / K jumps at its turning points (events jump_in, jump_off); ``cycles``: the energy each cycle
+    dissipates (False: Missing, said so, and the events ``kinds`` leaves out not made into values: a fit's
+    branch, :mod:`~petsc_adhesion.fitting.branches`, reads neither).
     """
 
     lambda_start: float | None = None
@@ -163,6 +165,7 @@ class CurveRequest:
     profiles: bool = False
     kinds: tuple | None = None
     spring: float | None = None
+    cycles: bool = True
 
     def __post_init__(self):
         if self.spring is not None and not (self.spring > 0 and math.isfinite(self.spring)):
@@ -377,7 +380,7 @@ def trace_curve(model, grid_choice: GridChoice = GridChoice(), solver: SolverCho
                 est = error_bars.event_errors(tracer, seg, found, request.target_error)
                 estimates[id(found)] = Missing(results.NO_BAR) if est is None else est
             errors_wall = spent["errors"] + time.perf_counter() - t1
-        traced = results.curve(segments, estimates, request.profiles, tracer)
+        traced = results.curve(segments, estimates, request.profiles, tracer, request.cycles, kept)
         mpi = comm.tompi4py()
         law = tracer.segments[0].problem.law
         grid_warning = mpi.bcast(resolution.check(model, law, traced.states, traced.folds)
