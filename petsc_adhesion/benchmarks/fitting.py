@@ -201,7 +201,9 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
     truth dict, the bodies given to the fit, the spring)."""
     from ..fitting.data import MeasuredCurve
     from ..fitting.results import Spring
-    from ..fitting.synthetic import Sampling, synthetic_curve
+    from ..discretization.problem import step_scale
+    from ..fitting.synthetic import Sampling, synthetic_curve, truth_settings
+    from ..model.parameters import Model
     from ..model.physical import Bodies
     from ..tracing.trace import curve_settings
 
@@ -223,7 +225,10 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
             data = MeasuredCurve(z=z["z"], F=z["F"], turn=int(z["turn"]), direction=1, spring=k, source="synthetic")
     else:
         c0 = time.process_time()
-        settings = curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1) if finer else None
+        # finer: steps half the fit's; from mu = 20 on in units of mu, where units of 1 would pass the
+        # continuation's cap of 5000 steps above mu of about 100 (fitting/synthetic.py truth_settings)
+        settings = None if not finer else curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1) \
+            if step_scale(Model(mu=mu)) == 1.0 else truth_settings(Model(mu=mu), 2.0, finer=2.0)
         made_of = (mu, K, R, finer, sigma)
         if made_of not in _CLEAN:      # one truth's noiseless curve, traced once: each seed shifts it, adds noise
             _CLEAN[made_of] = synthetic_curve(Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w,

@@ -63,16 +63,37 @@ class Sampling:
     past: float = 10.0
 
 
+def truth_settings(model: Model, top: float, finer: float = 1.0):
+    """The continuation's settings of a curve made to be measured (:func:`forward_curve`) to the load ``top``:
+    below mu = MU_SOFT the library's curve's (units of 1); from MU_SOFT on a fit's branch's
+    (:func:`~petsc_adhesion.fitting.branches.branch_settings`: units of mu, steps of at most 0.05 mu and 0.05
+    in F), their largest steps divided by ``finer``.
+
+    Why: in units of 1 a curve at mu = 60 took 45 CPU s (lambda runs over some 600 epsilon in steps of at most
+    0.5), and above mu of about 100 the continuation's cap of 5000 steps would cut it short; a fit's branch at
+    mu = 100 in units of mu reads within 1.5e-4 of 2 pi R w of the dense one behind K = 0.005 and 0.048
+    (docs/fitting.md, "What a branch costs")."""
+    from ..discretization.problem import step_scale
+    from ..tracing.trace import curve_settings
+    from .branches import branch_settings
+
+    if step_scale(model) == 1.0:
+        return curve_settings(observable_max=top)
+    s = branch_settings(model, top)
+    return replace(s, ds=s.ds / finer, ds_max=s.ds_max / finer, observable_step=s.observable_step / finer)
+
+
 def forward_curve(model: Model, K: float, top: float = 2.0, grid=None, solver=None, settings=None,
                   comm=None) -> ForwardCurve:
     """The force of ``model`` (its mu and sigma) against the base position behind a spring of stiffness ``K``
-    (units of 2 pi R w / eps), traced to the load ``top`` (no error bars)."""
-    from ..tracing.trace import CurveRequest, GridChoice, SolverChoice, curve_settings, trace_curve
+    (units of 2 pi R w / eps), traced to the load ``top`` (no error bars), with ``settings`` or
+    :func:`truth_settings`."""
+    from ..tracing.trace import CurveRequest, GridChoice, SolverChoice, trace_curve
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         c = trace_curve(replace(model, bodies=None), grid or GridChoice(), solver or SolverChoice(),
-                        settings or curve_settings(observable_max=top),
+                        settings or truth_settings(model, top),
                         CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=K), comm=comm)
     return ForwardCurve(c, K)
 
