@@ -74,7 +74,8 @@ def test_a_later_fit_reads_the_branch_and_gives_the_same_numbers():
     again = fit_curve(data, tip, Spring(1.0))
     BRANCHES.clear()
     fresh = fit_curve(data, tip, Spring(1.0))
-    assert isinstance(first.path, TableStep) and first.traces == first.path.curves >= 1 and first.path.shared == 0
+    assert isinstance(first.path, TableStep) and first.path.curves >= 1 and first.path.shared == 0
+    assert first.traces == first.path.curves + first.path.differenced
     assert again.traces == 0 and again.path.shared == again.path.curves == first.path.curves
     assert math.isfinite(first.path.lattice_mu)
     for f in (again, fresh):
