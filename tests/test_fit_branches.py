@@ -79,7 +79,8 @@ def test_a_later_fit_reads_the_branch_and_gives_the_same_numbers():
     again = fit_curve(data, tip, Spring(1.0))
     BRANCHES.clear()
     fresh = fit_curve(data, tip, Spring(1.0))
-    assert isinstance(first.path, TableStep) and first.traces == first.path.curves >= 1 and first.path.shared == 0
+    assert isinstance(first.path, TableStep) and first.path.curves >= 1 and first.path.shared == 0
+    assert first.traces == first.path.curves + first.path.differenced
     assert again.traces == 0 and again.path.shared == again.path.curves == first.path.curves
     assert math.isfinite(first.path.lattice_mu)
     for f in (again, fresh):
@@ -115,7 +116,9 @@ def test_the_lattice_point_is_within_half_a_bar_and_the_levels_nest():
 def test_the_step_from_the_lattice_point_matches_the_fit_at_the_optimum(monkeypatch):
     """At mu = 1 the first curve half a bar of ln mu away from the table's optimum (the lattice's largest offset)
     and one step: w and E* within 0.1 of their bars of the fit whose curve is traced at the optimum itself
-    (0.006 and 0.014 measured, docs/fitting.md), the bars at most 1.2 times as wide (the step added to them: 1.16 measured for E*)."""
+    (0.006 and 0.014 measured, docs/fitting.md), the bars at most 1.2 times as wide (the step added to them: 1.16 measured for E*)
+    and at least 0.98 times: each is its own curve's Jacobian's, the solver's at that curve (w's 0.3% narrower
+    half a bar of ln mu away, measured)."""
     data, _ = _curve(1.0, 1)
     tip = Bodies(radius=R, young1=None, poisson1=None, epsilon=EPS)
 
@@ -134,7 +137,7 @@ def test_the_step_from_the_lattice_point_matches_the_fit_at_the_optimum(monkeypa
     at, off = fits
     assert off.path.curves == 1 and 0.4 < off.path.first < 0.8, off.path
     for a, b in ((at.gamma, off.gamma), (at.E_star, off.E_star)):
-        assert abs(a.value - b.value) <= 0.1 * a.err and a.err <= b.err <= 1.2 * a.err, (a, b)
+        assert abs(a.value - b.value) <= 0.1 * a.err and 0.98 * a.err <= b.err <= 1.2 * a.err, (a, b)
 
 
 def test_a_branch_traced_without_its_cycles_holds_the_same_points_and_says_the_energy_is_missing():

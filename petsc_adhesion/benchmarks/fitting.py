@@ -267,6 +267,7 @@ def _fit_row(data, truth, bodies, spring, table, rough: bool = False, comm=None)
         row["search_cpu_s"] = fit.path.seconds
         row["curves"] = fit.path.curves
         row["shared"] = fit.path.shared
+        row["differenced"] = fit.path.differenced     # the curves of the solver's Jacobian's branch columns
         row["lattice_mu"] = fit.path.lattice_mu
         row["step_bars"] = {c: float(b) for c, b in zip(fit.path.coordinates, fit.path.bars)}
         row["table_share"] = {c: float(v) for c, v in zip(fit.path.coordinates, fit.path.contribution)}
