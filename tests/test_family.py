@@ -188,6 +188,73 @@ def test_spring_legs_are_forward_py_s_on_the_same_curve():
         assert np.max(np.abs(mine.predict(Z[away], leg) - truth.predict(Z[away], leg))) < 2e-3, leg
 
 
+def _tanh_legs(A: float, w: float, K: float):
+    """The legs behind K of F = -1/2 - A tanh(x / w), x = lambda + 1 (lambda from -3 to 1), sampled densely."""
+    x = np.linspace(-2.0, 2.0, 4001)
+    return spring_legs(x, x - 1.0, -0.5 - A * np.tanh(x / w), K)
+
+
+def test_a_loop_one_side_lacks_counts_as_its_extent():
+    """Behind K, F = -1/2 - A tanh(x / w) is steeper than the spring where sech^2(x / w) > K w / A: with A > K w a
+    hysteresis loop between x = -x* (the approach's jump) and x* (the retract's), x* = w arccosh(sqrt(A / (K w))),
+    Z = lambda + F / K, so the loop is Z(-x*) - Z(x*) = 2 (A tanh(x* / w) / K - x*) wide; the approach's jump
+    lands at x_l > x* where Z(x_l) = Z(-x*), a jump in F of A (tanh(x* / w) + tanh(x_l / w)), and the retract's
+    the same by symmetry.  Against the curve with A = 0.9 K w (no loop), the measurement counts the loop one side
+    lacks as that width and that jump, whichever side has it; an extra jump without a partner on the other leg
+    (no loop) stays an error of unknown size."""
+    from scipy.optimize import brentq
+
+    from petsc_adhesion.benchmarks.family import _leg_jumps
+
+    K, w = 0.5, 0.2
+    A = 1.2 * K * w
+    xs = w * math.acosh(math.sqrt(A / (K * w)))
+    Z = (lambda x: x - 1.0 + (-0.5 - A * math.tanh(x / w)) / K)
+    width = Z(-xs) - Z(xs)
+    xl = brentq(lambda x: Z(x) - Z(-xs), xs, 2.0)
+    jump = A * (math.tanh(xs / w) + math.tanh(xl / w))
+    assert 0.02 < width < 0.03 and 0.1 < jump < 0.2          # narrow in Z, large in F: a loop about its cusp
+    loop, none = _tanh_legs(A, w, K), _tanh_legs(0.9 * K * w, w, K)
+    assert len(loop.jumps["approach"]) == len(loop.jumps["retract"]) == 1 and not none.jumps["approach"]
+    for leg in ("approach", "retract"):
+        for mine, truth in ((loop, none), (none, loop)):
+            eZ, eJ = _leg_jumps(mine, truth, leg)
+            assert abs(eZ - width) < 1e-6 * width and abs(eJ - jump) < 1e-4 * jump, (leg, eZ, width, eJ, jump)
+        assert _leg_jumps(loop, loop, leg) == (0.0, 0.0)
+
+    class OneJump:                      # a jump on the approach alone: no loop it could belong to
+        jumps = {"approach": [-2.0], "retract": []}
+
+        def jump_forces(self, leg):
+            return [(-0.5, -0.7)] if leg == "approach" else []
+
+    assert _leg_jumps(OneJump(), none, "approach") == (math.inf, math.inf)
+
+
+def test_the_solver_s_legs_keep_the_loop_it_located():
+    """At (mu 0.237, sigma 0.225) behind K = 0.5 the default curve locates a pair of jumps within one step (35
+    points), and its legs, made from the points' stability, had left the loop out (the table, which holds it,
+    was counted as missing a jump).  The measurement's solver curve is traced again with shorter steps until its
+    legs keep what it located: the loop is then the one a curve with steps 1/10 as long has, to 1e-4."""
+    from petsc_adhesion.benchmarks.family import _truth
+    from petsc_adhesion.discretization.problem import step_scale
+    from petsc_adhesion.fitting.forward import ForwardCurve
+    from petsc_adhesion.model.parameters import Model
+    from petsc_adhesion.tracing.trace import CurveRequest, curve_settings, trace_curve
+
+    mu, sigma, K = 0.23713737, 0.225, 0.5
+    model = Model(mu=mu, sigma=sigma)
+    request = CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=K)
+    first = trace_curve(model, settings=curve_settings(step_scale(model), observable_max=2.3), request=request)
+    assert {e.kind for e in first.events} >= {"jump_in", "jump_off"} and not ForwardCurve(first, K).jumps["approach"]
+    fine = ForwardCurve(trace_curve(model, settings=curve_settings(0.1 * step_scale(model), observable_max=2.3),
+                                    request=request), K)
+    _, truth = _truth(mu, sigma, K, 2.0)
+    for leg in ("approach", "retract"):
+        assert len(truth.jumps[leg]) == len(fine.jumps[leg]) == 1
+        assert abs(truth.jumps[leg][0] - fine.jumps[leg][0]) < 1e-4, (leg, truth.jumps[leg], fine.jumps[leg])
+
+
 def test_the_table_s_legs_at_a_node_are_the_solver_s(table):
     """At a node, the table's curve behind a spring against the solver's traced behind it: its error there is
     the sampling's alone, below the error measured between nodes."""
