@@ -1,6 +1,7 @@
 """The curve family table against the solver: a small table built here (mu 0.1 to 0.8, sigma 0 to 0.1), its
 nodes reproducing the solver's sampled curves to round-off, its off-node curves within the error it measured,
 its legs behind a spring against fitting/forward.py's on the same curve, its refusals and its file."""
+import dataclasses
 import math
 import re
 
@@ -222,13 +223,45 @@ def test_a_loop_one_side_lacks_counts_as_its_extent():
             assert abs(eZ - width) < 1e-6 * width and abs(eJ - jump) < 1e-4 * jump, (leg, eZ, width, eJ, jump)
         assert _leg_jumps(loop, loop, leg) == (0.0, 0.0)
 
-    class OneJump:                      # a jump on the approach alone: no loop it could belong to
-        jumps = {"approach": [-2.0], "retract": []}
+    # a jump with no turning point at the other end of its unstable stretch (no loop): of unknown size
+    bare = type("Bare", (), dict(K=K, jumps={"approach": [-2.0], "retract": []}, chains={"approach": ([0], [-2.0])},
+                                  pieces=[dataclasses.replace(loop.pieces[0], end=None)],
+                                  jump_forces=lambda self, leg: [(-0.5, -0.7)] if leg == "approach" else []))()
+    assert _leg_jumps(bare, none, "approach") == (math.inf, math.inf)
 
-        def jump_forces(self, leg):
-            return [(-0.5, -0.7)] if leg == "approach" else []
 
-    assert _leg_jumps(OneJump(), none, "approach") == (math.inf, math.inf)
+def test_a_loop_the_approach_passes_by_counts_as_its_extent_on_the_retract():
+    """Two steps, F = -1/2 - A1 tanh((x + 1) / w) - A2 (tanh((x - 1) / w) + 1), x = lambda + 1, both steeper than
+    K: the first's loop is so deep (A1 = 24 K w) that the approach's jump lands beyond the second step, whose loop
+    (A2 = 1.2 K w) the retract alone passes, as a shallow wiggle about a rough curve's pull-off behind a soft
+    spring.  Against the same curve with A2 = 0.9 K w (no second loop, the first the same to the bit), the extra
+    jump of the retract counts as the second loop's width, 2 (A2 tanh(x* / w) / K - x*) with x* = w arccosh(sqrt(A2
+    / (K w))), and its jump in F, A2 (tanh(x* / w) + tanh(|x_l - 1| / w)) to the landing x_l where Z(x_l) is the
+    jump's Z; the approach's one jump is the same on both."""
+    from scipy.optimize import brentq
+
+    from petsc_adhesion.benchmarks.family import _leg_jumps
+
+    K, w = 0.5, 0.05
+    A1 = 24 * K * w
+
+    def legs(A2):
+        x = np.linspace(-3.0, 3.0, 12001)
+        F = -0.5 - A1 * np.tanh((x + 1) / w) - A2 * (np.tanh((x - 1) / w) + 1)
+        return spring_legs(x, x - 1.0, F, K)
+
+    A2 = 1.2 * K * w
+    xs = w * math.acosh(math.sqrt(A2 / (K * w)))
+    Z = (lambda u: u + (-A2 * math.tanh(u / w)) / K)          # about x = 1, but for a constant
+    width = Z(-xs) - Z(xs)
+    ul = brentq(lambda u: Z(u) - Z(xs), -0.5, -xs)
+    jump = A2 * (math.tanh(xs / w) + math.tanh(abs(ul) / w))
+    two, one = legs(A2), legs(0.9 * K * w)
+    assert len(two.jumps["approach"]) == len(one.jumps["approach"]) == 1
+    assert len(two.jumps["retract"]) == 2 and len(one.jumps["retract"]) == 1
+    assert _leg_jumps(two, one, "approach") == (0.0, 0.0)
+    eZ, eJ = _leg_jumps(two, one, "retract")
+    assert abs(eZ - width) < 1e-6 * width and abs(eJ - jump) < 1e-4 * jump, (eZ, width, eJ, jump)
 
 
 def test_the_solver_s_legs_keep_the_loop_it_located():
@@ -496,8 +529,9 @@ def test_the_rough_table_refuses_what_it_was_not_built_for():
     top = float(rough.mu[-1])
     with pytest.raises(OutOfRange, match=rf"^mu {2 * top!r}: the table holds mu in \[0\.001, {top:g}\]$"):
         rough.curve(2 * top, 1.0)
-    with pytest.raises(OutOfRange, match=r"^sigma 0\.5: the table holds sigma in \[0, 0\.2\]$"):
-        rough.curve(0.1, 0.5)
+    top_s = float(rough.sigma[-1])
+    with pytest.raises(OutOfRange, match=rf"^sigma {top_s + 0.5!r}: the table holds sigma in \[0, {top_s:g}\]$"):
+        rough.curve(0.1, top_s + 0.5)
 
 
 def test_the_shape_preserving_cubic_keeps_a_step_monotone_and_a_smooth_curve_to_fourth_order():
@@ -576,3 +610,19 @@ def test_a_joined_table_keeps_the_error_only_where_its_stencils_are_unchanged():
     lost = sorted(set(np.round(smooth.err_mu, 12)) - set(np.round(changed.err_mu, 12)))
     mids = np.sqrt(smooth.mu[1:] * smooth.mu[:-1])
     assert np.allclose(lost, mids[:2], rtol=1e-9), (lost, mids[:3])
+
+
+def test_a_node_the_default_steps_leave_incomplete_is_traced_with_shorter_ones():
+    """At mu 3.16, sigma 0.2 the default curve is incomplete (a computed point more tensile than the located
+    pull-off: the load varies faster than the steps resolve), and `build` wrote nothing; the node is traced again
+    with steps a quarter as long (FINER) and tabulated, its pull-off the one the default curve had located, to
+    1e-4 (a trace with other steps: the two agree where the coarse one resolved its minimum)."""
+    from petsc_adhesion.family.build import FINER
+
+    mu, sigma = 10 ** 0.5, 0.2
+    coarse = trace_node(mu, sigma)
+    assert not coarse.complete and "faster than the steps resolve" in coarse.assessment.incomplete[0]
+    node = build(TableGrid(mu=(mu,), sigma=(sigma,), n_tau=150))
+    (pl, pF), = [(e.lam.value, e.F.value) for e in node.curve(mu, sigma).events() if e.kind == "pull_off"]
+    want = _solver_events(coarse)["pull_off"][0][1]
+    assert FINER == 0.25 and abs(pF - want) < 1e-4, (pF, want)

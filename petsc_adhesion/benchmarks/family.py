@@ -33,6 +33,7 @@ not a test: the machine's load is printed with it.
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import os
 import sys
@@ -77,48 +78,51 @@ def _nearest(a: list[float], b: list[float]) -> float:
     return max(min(abs(x - y) for y in short) for x in long)
 
 
-def _unmatched(a: list[float], b: list[float]) -> list[int]:
-    """The indices of ``a``'s elements left when each of ``b``'s takes the nearest of ``a``'s not yet taken (in
-    the order of their distance: the closest pairs first)."""
-    pairs = sorted((abs(x - y), i, j) for i, x in enumerate(a) for j, y in enumerate(b))
-    left, taken = set(range(len(a))), set()
-    for _, i, j in pairs:
-        if i in left and j not in taken:
-            left.discard(i)
-            taken.add(j)
-    return sorted(left)
+def _loop(legs, leg: str, k: int) -> tuple[float, float]:
+    """(width in Z, span in F) of the hysteresis loop the ``k``-th jump of ``leg`` belongs to: the unstable stretch
+    of the branch between the turning point it jumps at and the one at the other end of that stretch (the next
+    piece's start after an approach's jump_in, the previous piece's end before a retract's jump_off); inf where
+    the branch has no such turning point."""
+    chain, _ = legs.chains[leg]
+    i = chain[k]
+    p = legs.pieces
+    a, b = (p[i].end, p[i + 1].start if i + 1 < len(p) else None) if leg == APPROACH else \
+        (p[i - 1].end if i >= 1 else None, p[i].start)
+    if a is None or b is None:
+        return math.inf, math.inf
+    return abs(a.Z(legs.K) - b.Z(legs.K)), abs(a.F - b.F)
 
 
 def _leg_jumps(mine, truth, leg: str) -> tuple[float, float]:
     """(jump Z error, jump F error) of the legs ``mine`` against ``truth`` (two :class:`Legs` behind one spring) on
     ``leg``: each of the two's jumps against the other's nearest.  Where one of them has jumps the other lacks,
-    each such jump is counted as the hysteresis loop it belongs to: about the cusp where a loop is born (the
-    spring as stiff as the curve is steep, |dF/d lambda| = K) a loop narrow in Z exists on one side alone, and what a
-    fit could be off by there is the loop's extent, its width in Z (this jump to its partner, the extra jump of
-    the other leg on the same side nearest to it) and its jump in F (the larger of the two jumps' F before less
-    F after), not an unbounded error.  An extra jump without such a partner (no loop) is an error of unknown
-    size: inf."""
+    each such jump is counted as the hysteresis loop it belongs to (:func:`_loop`): about the cusp where a loop is
+    born (the spring as stiff as the curve is steep, |dF/d lambda| = K) a loop narrow in Z exists on one side
+    alone, and what a fit could be off by there is the loop's extent, its width in Z and its jump in F (the larger
+    of the jump's F before less F after and the loop's span in F), not an unbounded error.  A loop the other leg
+    does not visit counts alike (behind a soft spring a shallow wiggle about the pull-off is a loop the retract
+    alone passes: the approach has jumped in before it).  An extra jump with no turning point at the other end
+    of its unstable stretch (no loop) is an error of unknown size: inf."""
     js, jt = truth.jumps[leg], mine.jumps[leg]
-    other = RETRACT if leg == APPROACH else APPROACH
     eZ = eJ = 0.0
-    for side, this, those in ((mine, jt, js), (truth, js, jt)):
-        if len(this) <= len(those):
-            continue
-        extra = _unmatched(this, those)
-        opp_this, opp_those = side.jumps[other], (truth if side is mine else mine).jumps[other]
-        partners = [opp_this[k] for k in _unmatched(opp_this, opp_those)]
-        if not partners:
-            return math.inf, math.inf
+    keep_s, keep_t = list(range(len(js))), list(range(len(jt)))
+    if len(js) != len(jt):
+        side, this, those, keep = (mine, jt, js, keep_t) if len(jt) > len(js) else (truth, js, jt, keep_s)
+
+        def cost(extra: tuple) -> float:
+            # the extra jumps are the ones that leave the smallest error: a loop one side lacks is the narrow one
+            # about its cusp (by Z alone, the pull-off's jump to the far branch was taken for the extra one where
+            # a wiggle's narrow loop lay beside it, and counted as the whole hysteresis loop)
+            rest = [this[k] for k in range(len(this)) if k not in extra]
+            return max([_loop(side, leg, k)[0] for k in extra] + [_nearest(rest, those)])
+
+        extra = min(itertools.combinations(range(len(this)), len(this) - len(those)), key=cost)
         forces = side.jump_forces(leg)
-        opp_forces = side.jump_forces(other)
         for k in extra:
-            zp = min(partners, key=lambda z: abs(z - this[k]))
-            eZ = max(eZ, abs(this[k] - zp))
-            fp = opp_forces[opp_this.index(zp)]
-            eJ = max(eJ, abs(forces[k][0] - forces[k][1]), abs(fp[0] - fp[1]))
+            width, span = _loop(side, leg, k)
+            eZ, eJ = max(eZ, width), max(eJ, span, abs(forces[k][0] - forces[k][1]))
+            keep.remove(k)
     # the jumps both have, each with the other's nearest
-    keep_s = [k for k in range(len(js)) if len(js) <= len(jt) or k not in _unmatched(js, jt)]
-    keep_t = [k for k in range(len(jt)) if len(jt) <= len(js) or k not in _unmatched(jt, js)]
     zs, zt = [js[k] for k in keep_s], [jt[k] for k in keep_t]
     eZ = max(eZ, _nearest(zs, zt))
     if zs and zt:
@@ -238,11 +242,12 @@ def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[floa
 
 
 def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: float = math.inf,
-            mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> FamilyTable:
+            mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf), infinite: bool = False) -> FamilyTable:
     """The table with its interpolation error measured at its midpoints from ``mu_min`` up to ``mu_max`` and
-    with sigma in ``sigma_range`` (module docstring), kept with the midpoints the table had measured outside
-    that range (so that a table can be measured in parts); about the others the table's error is Missing, not
-    measured; collective."""
+    with sigma in ``sigma_range`` (module docstring; ``infinite``: of those, only the ones whose error the table
+    holds as infinite, measured again), kept with the midpoints the table had measured outside that range (so
+    that a table can be measured in parts); about the others the table's error is Missing, not measured;
+    collective."""
     from petsc4py import PETSc
 
     if table.measured and not np.allclose(table.springs, springs):
@@ -265,6 +270,10 @@ def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: fl
         return row
 
     cases = [c for c in midpoints(table) if mu_min <= c[0] <= mu_max and sigma_range[0] <= c[1] <= sigma_range[1]]
+    if infinite:
+        bad = [k for k in range(table.err_mu.size) if not all(math.isfinite(table.errors[f][k]) for f in ERROR_FIELDS)]
+        cases = [c for c in cases if any(math.isclose(table.err_mu[k], c[0], rel_tol=1e-9) and
+                                         math.isclose(table.err_sigma[k], c[1], abs_tol=1e-12) for k in bad)]
     rows = spread(cases, work, lambda c: node_cost(c) * (1 + len(springs)), comm)
     if out is not None:
         out("| mu | sigma | F at Z | jump Z | jump F | event lambda | event F | solver (s) |")
@@ -378,6 +387,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="measure the midpoints from this mu alone (those measured before kept)")
     m.add_argument("--sigma-range", nargs=2, type=float, default=(0.0, math.inf),
                    help="measure the midpoints with sigma in this range alone")
+    m.add_argument("--infinite", action="store_true",
+                   help="measure again only the midpoints whose error the table holds as infinite")
     sp = sub.add_parser("spacing")
     sp.add_argument("table")
     sp.add_argument("--keep", nargs="+", type=float, required=True, help="the sigma nodes the coarser table keeps")
@@ -447,7 +458,7 @@ def main(argv=None) -> int:
             say(f"benchmarks.family: {e}")
             return 2
         return _measured(table, args.springs, args.table, tell, rank, time.perf_counter(), args.mu_max, args.mu_min,
-                         tuple(args.sigma_range))
+                         tuple(args.sigma_range), args.infinite)
     try:
         lo, hi = args.mu
         grid = TableGrid(mu=log_nodes(lo, hi, args.per_decade) if hi > lo else (lo,), sigma=tuple(args.sigma),
@@ -481,13 +492,13 @@ def main(argv=None) -> int:
 
 
 def _measured(table: FamilyTable, springs, out: str, tell, rank: int, t1: float, mu_max: float = math.inf,
-              mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> int:
+              mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf), infinite: bool = False) -> int:
     """The table's error measured (at the midpoints from ``mu_min`` up to ``mu_max``) and the table written with it
     to ``out``; 3 where a midpoint's is infinite."""
     from petsc4py import PETSc
 
     try:
-        table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max, mu_min, sigma_range)
+        table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max, mu_min, sigma_range, infinite)
     except ValueError as e:
         say(f"benchmarks.family: {e}")
         return 2
