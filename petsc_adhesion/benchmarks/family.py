@@ -24,6 +24,8 @@ are compared (the midpoints spread over the ranks too):
   :func:`_truth`); a loop one side lacks (about the cusp where it is born) counts as
   its extent, its width in Z and its jump in F (:func:`_leg_jumps`).
 
+``measure TABLE`` measures (again) a built table's midpoints, in parts by ``--mu-min``,
+``--mu-max``, ``--sigma-range``, or only those it holds as infinite (``--infinite``).
 The table is written with these errors (``FamilyTable.with_error``), all or nothing, and
 the report gives the cost per node and the error per midpoint.  ``speed`` times what a
 fit will call per evaluation: the interpolated curve at (mu, sigma), behind a spring, F at
