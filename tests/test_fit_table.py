@@ -156,13 +156,13 @@ def test_the_error_is_measured_on_the_piece_each_point_is_on():
     assert eF < 1e-3 and eZ < 1e-3 and eJ < 1e-3, (eF, eZ, eJ)
 
 
-@pytest.mark.parametrize("mu, sigma", [(0.2, 0.12), (0.5, 0.73)])
+@pytest.mark.parametrize("mu, sigma", [(0.2, 0.12), (0.2, 0.25)])
 def test_a_rough_curve_fitted_through_the_rough_table_recovers_w_and_E(mu, sigma):
-    """A curve the solver made on a rough surface (mu = 0.2, sigma = 0.12 and mu = 0.5, sigma = 0.73, each between
-    the rough table's nodes), its roughness held at the truth, searched on the shipped rough table: w and E*
-    within their 95% intervals, the path the table's and one to three solver curves after it.  (A fitted
-    roughness is refused by a table that does not hold sigma from 0 to 3, the search's range: it would leave the
-    table mid-fit.)"""
+    """A curve the solver made on a rough surface (mu = 0.2 between the rough table's nodes; sigma = 0.12 between
+    them, and 0.25, above the earlier table's 0.2), its roughness held at the truth, searched on the shipped rough
+    table: w and E* within their 95% intervals, the path the table's and one to three solver curves after it.  (A
+    fitted roughness is refused by a table that does not hold sigma from 0 to 3, the search's range: it would
+    leave the table mid-fit.)"""
     E = W * math.sqrt(R / (mu**3 * EPS**3))
     truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=EPS, gamma=W, rms=sigma * EPS)
     data = synthetic_curve(truth, Spring(1.0), Sampling(noise=0.01 * 2 * math.pi * R * W, points=300, z0=3e-9,
