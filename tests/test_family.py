@@ -1,6 +1,7 @@
 """The curve family table against the solver: a small table built here (mu 0.1 to 0.8, sigma 0 to 0.1), its
 nodes reproducing the solver's sampled curves to round-off, its off-node curves within the error it measured,
 its legs behind a spring against fitting/forward.py's on the same curve, its refusals and its file."""
+import dataclasses
 import math
 import re
 
@@ -186,6 +187,105 @@ def test_spring_legs_are_forward_py_s_on_the_same_curve():
         Z = np.linspace(b.Z.min() - 1.0, b.Z.max(), 600)
         away = np.all([np.abs(Z - z) > 0.02 for z in truth.jumps[leg]], axis=0)
         assert np.max(np.abs(mine.predict(Z[away], leg) - truth.predict(Z[away], leg))) < 2e-3, leg
+
+
+def _tanh_legs(A: float, w: float, K: float):
+    """The legs behind K of F = -1/2 - A tanh(x / w), x = lambda + 1 (lambda from -3 to 1), sampled densely."""
+    x = np.linspace(-2.0, 2.0, 4001)
+    return spring_legs(x, x - 1.0, -0.5 - A * np.tanh(x / w), K)
+
+
+def test_a_loop_one_side_lacks_counts_as_its_extent():
+    """Behind K, F = -1/2 - A tanh(x / w) is steeper than the spring where sech^2(x / w) > K w / A: with A > K w a
+    hysteresis loop between x = -x* (the approach's jump) and x* (the retract's), x* = w arccosh(sqrt(A / (K w))),
+    Z = lambda + F / K, so the loop is Z(-x*) - Z(x*) = 2 (A tanh(x* / w) / K - x*) wide; the approach's jump
+    lands at x_l > x* where Z(x_l) = Z(-x*), a jump in F of A (tanh(x* / w) + tanh(x_l / w)), and the retract's
+    the same by symmetry.  Against the curve with A = 0.9 K w (no loop), the measurement counts the loop one side
+    lacks as that width and that jump, whichever side has it; an extra jump without a partner on the other leg
+    (no loop) stays an error of unknown size."""
+    from scipy.optimize import brentq
+
+    from petsc_adhesion.benchmarks.family import _leg_jumps
+
+    K, w = 0.5, 0.2
+    A = 1.2 * K * w
+    xs = w * math.acosh(math.sqrt(A / (K * w)))
+    Z = (lambda x: x - 1.0 + (-0.5 - A * math.tanh(x / w)) / K)
+    width = Z(-xs) - Z(xs)
+    xl = brentq(lambda x: Z(x) - Z(-xs), xs, 2.0)
+    jump = A * (math.tanh(xs / w) + math.tanh(xl / w))
+    assert 0.02 < width < 0.03 and 0.1 < jump < 0.2          # narrow in Z, large in F: a loop about its cusp
+    loop, none = _tanh_legs(A, w, K), _tanh_legs(0.9 * K * w, w, K)
+    assert len(loop.jumps["approach"]) == len(loop.jumps["retract"]) == 1 and not none.jumps["approach"]
+    for leg in ("approach", "retract"):
+        for mine, truth in ((loop, none), (none, loop)):
+            eZ, eJ = _leg_jumps(mine, truth, leg)
+            assert abs(eZ - width) < 1e-6 * width and abs(eJ - jump) < 1e-4 * jump, (leg, eZ, width, eJ, jump)
+        assert _leg_jumps(loop, loop, leg) == (0.0, 0.0)
+
+    # a jump with no turning point at the other end of its unstable stretch (no loop): of unknown size
+    bare = type("Bare", (), dict(K=K, jumps={"approach": [-2.0], "retract": []}, chains={"approach": ([0], [-2.0])},
+                                  pieces=[dataclasses.replace(loop.pieces[0], end=None)],
+                                  jump_forces=lambda self, leg: [(-0.5, -0.7)] if leg == "approach" else []))()
+    assert _leg_jumps(bare, none, "approach") == (math.inf, math.inf)
+
+
+def test_a_loop_the_approach_passes_by_counts_as_its_extent_on_the_retract():
+    """Two steps, F = -1/2 - A1 tanh((x + 1) / w) - A2 (tanh((x - 1) / w) + 1), x = lambda + 1, both steeper than
+    K: the first's loop is so deep (A1 = 24 K w) that the approach's jump lands beyond the second step, whose loop
+    (A2 = 1.2 K w) the retract alone passes, as a shallow wiggle about a rough curve's pull-off behind a soft
+    spring.  Against the same curve with A2 = 0.9 K w (no second loop, the first the same to the bit), the extra
+    jump of the retract counts as the second loop's width, 2 (A2 tanh(x* / w) / K - x*) with x* = w arccosh(sqrt(A2
+    / (K w))), and its jump in F, A2 (tanh(x* / w) + tanh(|x_l - 1| / w)) to the landing x_l where Z(x_l) is the
+    jump's Z; the approach's one jump is the same on both."""
+    from scipy.optimize import brentq
+
+    from petsc_adhesion.benchmarks.family import _leg_jumps
+
+    K, w = 0.5, 0.05
+    A1 = 24 * K * w
+
+    def legs(A2):
+        x = np.linspace(-3.0, 3.0, 12001)
+        F = -0.5 - A1 * np.tanh((x + 1) / w) - A2 * (np.tanh((x - 1) / w) + 1)
+        return spring_legs(x, x - 1.0, F, K)
+
+    A2 = 1.2 * K * w
+    xs = w * math.acosh(math.sqrt(A2 / (K * w)))
+    Z = (lambda u: u + (-A2 * math.tanh(u / w)) / K)          # about x = 1, but for a constant
+    width = Z(-xs) - Z(xs)
+    ul = brentq(lambda u: Z(u) - Z(xs), -0.5, -xs)
+    jump = A2 * (math.tanh(xs / w) + math.tanh(abs(ul) / w))
+    two, one = legs(A2), legs(0.9 * K * w)
+    assert len(two.jumps["approach"]) == len(one.jumps["approach"]) == 1
+    assert len(two.jumps["retract"]) == 2 and len(one.jumps["retract"]) == 1
+    assert _leg_jumps(two, one, "approach") == (0.0, 0.0)
+    eZ, eJ = _leg_jumps(two, one, "retract")
+    assert abs(eZ - width) < 1e-6 * width and abs(eJ - jump) < 1e-4 * jump, (eZ, width, eJ, jump)
+
+
+def test_the_solver_s_legs_keep_the_loop_it_located():
+    """At (mu 0.237, sigma 0.225) behind K = 0.5 the default curve locates a pair of jumps within one step (35
+    points), and its legs, made from the points' stability, had left the loop out (the table, which holds it,
+    was counted as missing a jump).  The measurement's solver curve is traced again with shorter steps until its
+    legs keep what it located: the loop is then the one a curve with steps 1/10 as long has, to 1e-4."""
+    from petsc_adhesion.benchmarks.family import _truth
+    from petsc_adhesion.discretization.problem import step_scale
+    from petsc_adhesion.fitting.forward import ForwardCurve
+    from petsc_adhesion.model.parameters import Model
+    from petsc_adhesion.tracing.trace import CurveRequest, curve_settings, trace_curve
+
+    mu, sigma, K = 0.23713737, 0.225, 0.5
+    model = Model(mu=mu, sigma=sigma)
+    request = CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=K)
+    first = trace_curve(model, settings=curve_settings(step_scale(model), observable_max=2.3), request=request)
+    assert {e.kind for e in first.events} >= {"jump_in", "jump_off"} and not ForwardCurve(first, K).jumps["approach"]
+    fine = ForwardCurve(trace_curve(model, settings=curve_settings(0.1 * step_scale(model), observable_max=2.3),
+                                    request=request), K)
+    _, truth = _truth(mu, sigma, K, 2.0)
+    for leg in ("approach", "retract"):
+        assert len(truth.jumps[leg]) == len(fine.jumps[leg]) == 1
+        assert abs(truth.jumps[leg][0] - fine.jumps[leg][0]) < 1e-4, (leg, truth.jumps[leg], fine.jumps[leg])
 
 
 def test_the_table_s_legs_at_a_node_are_the_solver_s(table):
@@ -407,7 +507,8 @@ def test_parts_join_into_one_table_and_a_coarser_one_is_selected():
     from petsc_adhesion.family.build import join, select
 
     rough = _rough()
-    whole = join([select(rough, sigma=[0, 1, 2]), select(rough, sigma=[2, 3, 4])])
+    half = rough.sigma.size // 2
+    whole = join([select(rough, sigma=range(half + 1)), select(rough, sigma=range(half, rough.sigma.size))])
     assert np.array_equal(whole.sigma, rough.sigma) and np.array_equal(whole.F, rough.F) and not whole.measured
     whole = join([select(rough, mu=[5, 6, 7]), select(rough, mu=[0, 1, 2, 3, 4, 5])])
     assert np.array_equal(whole.mu, rough.mu[:8]) and np.array_equal(whole.lam, rough.lam[:8])
@@ -465,8 +566,9 @@ def test_the_rough_table_refuses_what_it_was_not_built_for():
     top = float(rough.mu[-1])
     with pytest.raises(OutOfRange, match=rf"^mu {2 * top!r}: the table holds mu in \[0\.001, {top:g}\]$"):
         rough.curve(2 * top, 1.0)
-    with pytest.raises(OutOfRange, match=r"^sigma 0\.5: the table holds sigma in \[0, 0\.2\]$"):
-        rough.curve(0.1, 0.5)
+    top_s = float(rough.sigma[-1])
+    with pytest.raises(OutOfRange, match=rf"^sigma {top_s + 0.5!r}: the table holds sigma in \[0, {top_s:g}\]$"):
+        rough.curve(0.1, top_s + 0.5)
 
 
 def test_the_shape_preserving_cubic_keeps_a_step_monotone_and_a_smooth_curve_to_fourth_order():
@@ -545,3 +647,19 @@ def test_a_joined_table_keeps_the_error_only_where_its_stencils_are_unchanged():
     lost = sorted(set(np.round(smooth.err_mu, 12)) - set(np.round(changed.err_mu, 12)))
     mids = np.sqrt(smooth.mu[1:] * smooth.mu[:-1])
     assert np.allclose(lost, mids[:2], rtol=1e-9), (lost, mids[:3])
+
+
+def test_a_node_the_default_steps_leave_incomplete_is_traced_with_shorter_ones():
+    """At mu 3.16, sigma 0.2 the default curve is incomplete (a computed point more tensile than the located
+    pull-off: the load varies faster than the steps resolve), and `build` wrote nothing; the node is traced again
+    with steps a quarter as long (FINER) and tabulated, its pull-off the one the default curve had located, to
+    1e-4 (a trace with other steps: the two agree where the coarse one resolved its minimum)."""
+    from petsc_adhesion.family.build import FINER
+
+    mu, sigma = 10 ** 0.5, 0.2
+    coarse = trace_node(mu, sigma)
+    assert not coarse.complete and "faster than the steps resolve" in coarse.assessment.incomplete[0]
+    node = build(TableGrid(mu=(mu,), sigma=(sigma,), n_tau=150))
+    (pl, pF), = [(e.lam.value, e.F.value) for e in node.curve(mu, sigma).events() if e.kind == "pull_off"]
+    want = _solver_events(coarse)["pull_off"][0][1]
+    assert FINER == 0.25 and abs(pF - want) < 1e-4, (pF, want)

@@ -158,12 +158,13 @@ def test_the_error_is_measured_on_the_piece_each_point_is_on():
     assert eF < 1e-3 and eZ < 1e-3 and eJ < 1e-3, (eF, eZ, eJ)
 
 
-def test_a_rough_curve_fitted_through_the_rough_table_recovers_w_and_E():
-    """A curve the solver made on a rough surface (mu = 0.2, sigma = 0.12, both between the rough table's nodes),
-    its roughness held at the truth, searched on the shipped rough table: w and E* within their 95% intervals,
-    the path the table's and one to three solver curves after it.  (A fitted roughness is refused by a table
-    that does not hold sigma from 0 to 3, the search's range: it would leave the table mid-fit.)"""
-    mu, sigma = 0.2, 0.12
+@pytest.mark.parametrize("mu, sigma", [(0.2, 0.12), (0.2, 0.25)])
+def test_a_rough_curve_fitted_through_the_rough_table_recovers_w_and_E(mu, sigma):
+    """A curve the solver made on a rough surface (mu = 0.2 between the rough table's nodes; sigma = 0.12 between
+    them, and 0.25, above the earlier table's 0.2), its roughness held at the truth, searched on the shipped rough
+    table: w and E* within their 95% intervals, the path the table's and one to three solver curves after it.  (A
+    fitted roughness is refused by a table that does not hold sigma from 0 to 3, the search's range: it would
+    leave the table mid-fit.)"""
     E = W * math.sqrt(R / (mu**3 * EPS**3))
     truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=EPS, gamma=W, rms=sigma * EPS)
     data = synthetic_curve(truth, Spring(1.0), Sampling(noise=0.01 * 2 * math.pi * R * W, points=300, z0=3e-9,
@@ -182,6 +183,7 @@ def test_the_default_takes_the_rough_table_where_its_range_holds_the_fit():
     model's, [1e-3, 1e3]); else the smooth one, whose refusal of a roughness sends the fit to the solver with
     its reason.  The rough table holds a held roughness of the default model inside its range, and refuses a
     fitted one unless it holds sigma 0 to 3."""
+    from petsc_adhesion.family.build import select
     from petsc_adhesion.family.table import default_table
     from petsc_adhesion.fitting.domain import MU_BOUNDS
 
@@ -193,6 +195,9 @@ def test_the_default_takes_the_rough_table_where_its_range_holds_the_fit():
     assert default_table(top + 0.1, False, inside) == "smooth"
     assert default_table(0.1, False, MU_BOUNDS) == ("rough" if rough.mu[-1] >= MU_BOUNDS[1] else "smooth")
     assert table_covers(rough, Model(sigma=0.1), 150.0, False, 0.1) is None
-    assert table_covers(rough, Model(), 150.0, True, 0.1) == \
-        f"the roughness is fitted over [0, 3] and the table holds sigma in [0, {top:g}]"
+    # a fitted roughness needs the search's whole sigma range, [0, 3]
+    assert table_covers(rough, Model(), 150.0, True, 0.1) == (None if top >= 3 else
+                                                              f"the roughness is fitted over [0, 3] and the table holds sigma in [0, {top:g}]")
+    assert table_covers(select(rough, sigma=range(rough.sigma.size - 1)), Model(), 150.0, True, 0.1) == \
+        f"the roughness is fitted over [0, 3] and the table holds sigma in [0, {rough.sigma[-2]:g}]"
     assert table_covers(rough, Model(roughness="weibull"), 150.0, False, 0.1).startswith("the roughness law is")

@@ -19,8 +19,13 @@ are compared (the midpoints spread over the ranks too):
   interpolation on its side) up to where the table ends (F_max), leaving out the Z within
   twice the jumps' error of a jump of either (there a vertical jump makes any difference
   in Z one of O(1) in F); the jumps' Z and the force at their turning points (the
-  library's located events).
+  library's located events).  The solver's curve is traced again with shorter steps
+  where its legs leave out a jump it located (a loop narrower than a step,
+  :func:`_truth`); a loop one side lacks (about the cusp where it is born) counts as
+  its extent, its width in Z and its jump in F (:func:`_leg_jumps`).
 
+``measure TABLE`` measures (again) a built table's midpoints, in parts by ``--mu-min``,
+``--mu-max``, ``--sigma-range``, or only those it holds as infinite (``--infinite``).
 The table is written with these errors (``FamilyTable.with_error``), all or nothing, and
 the report gives the cost per node and the error per midpoint.  ``speed`` times what a
 fit will call per evaluation: the interpolated curve at (mu, sigma), behind a spring, F at
@@ -30,6 +35,7 @@ not a test: the machine's load is printed with it.
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import os
 import sys
@@ -74,6 +80,61 @@ def _nearest(a: list[float], b: list[float]) -> float:
     return max(min(abs(x - y) for y in short) for x in long)
 
 
+def _loop(legs, leg: str, k: int) -> tuple[float, float]:
+    """(width in Z, span in F) of the hysteresis loop the ``k``-th jump of ``leg`` belongs to: the unstable stretch
+    of the branch between the turning point it jumps at and the one at the other end of that stretch (the next
+    piece's start after an approach's jump_in, the previous piece's end before a retract's jump_off); inf where
+    the branch has no such turning point."""
+    chain, _ = legs.chains[leg]
+    i = chain[k]
+    p = legs.pieces
+    a, b = (p[i].end, p[i + 1].start if i + 1 < len(p) else None) if leg == APPROACH else \
+        (p[i - 1].end if i >= 1 else None, p[i].start)
+    if a is None or b is None:
+        return math.inf, math.inf
+    return abs(a.Z(legs.K) - b.Z(legs.K)), abs(a.F - b.F)
+
+
+def _leg_jumps(mine, truth, leg: str) -> tuple[float, float]:
+    """(jump Z error, jump F error) of the legs ``mine`` against ``truth`` (two :class:`Legs` behind one spring) on
+    ``leg``: each of the two's jumps against the other's nearest.  Where one of them has jumps the other lacks,
+    each such jump is counted as the hysteresis loop it belongs to (:func:`_loop`): about the cusp where a loop is
+    born (the spring as stiff as the curve is steep, |dF/d lambda| = K) a loop narrow in Z exists on one side
+    alone, and what a fit could be off by there is the loop's extent, its width in Z and its jump in F (the larger
+    of the jump's F before less F after and the loop's span in F), not an unbounded error.  A loop the other leg
+    does not visit counts alike (behind a soft spring a shallow wiggle about the pull-off is a loop the retract
+    alone passes: the approach has jumped in before it).  An extra jump with no turning point at the other end
+    of its unstable stretch (no loop) is an error of unknown size: inf."""
+    js, jt = truth.jumps[leg], mine.jumps[leg]
+    eZ = eJ = 0.0
+    keep_s, keep_t = list(range(len(js))), list(range(len(jt)))
+    if len(js) != len(jt):
+        side, this, those, keep = (mine, jt, js, keep_t) if len(jt) > len(js) else (truth, js, jt, keep_s)
+
+        def cost(extra: tuple) -> float:
+            # the extra jumps are the ones that leave the smallest error: a loop one side lacks is the narrow one
+            # about its cusp (by Z alone, the pull-off's jump to the far branch was taken for the extra one where
+            # a wiggle's narrow loop lay beside it, and counted as the whole hysteresis loop)
+            rest = [this[k] for k in range(len(this)) if k not in extra]
+            return max([_loop(side, leg, k)[0] for k in extra] + [_nearest(rest, those)])
+
+        extra = min(itertools.combinations(range(len(this)), len(this) - len(those)), key=cost)
+        forces = side.jump_forces(leg)
+        for k in extra:
+            width, span = _loop(side, leg, k)
+            eZ, eJ = max(eZ, width), max(eJ, span, abs(forces[k][0] - forces[k][1]))
+            keep.remove(k)
+    # the jumps both have, each with the other's nearest
+    zs, zt = [js[k] for k in keep_s], [jt[k] for k in keep_t]
+    eZ = max(eZ, _nearest(zs, zt))
+    if zs and zt:
+        fs, ft = truth.jump_forces(leg), mine.jump_forces(leg)
+        for k in keep_s:
+            j = min(keep_t, key=lambda i: abs(js[k] - jt[i]))
+            eJ = max(eJ, abs(fs[k][0] - ft[j][0]))
+    return eZ, eJ
+
+
 def _events(table: FamilyTable, mu: float, sigma: float, solver) -> tuple[float, float]:
     """(largest error in lambda, in F) of the snap-on, snap-off and pull-off of the table against ``solver``'s
     traced curve."""
@@ -115,20 +176,44 @@ def _pairs(t: list, s: list) -> list:
     return out if long is t else [(b, a) for a, b in out]
 
 
-def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[float, float, float]:
-    """(F at fixed Z, jump Z, jump F) errors of the table's legs behind K against the solver's."""
+#: How often the solver's curve behind a spring is traced again with steps a quarter as long, where its legs left out
+#: a turning point it located (:func:`_truth`).
+REFINE = 2
+
+
+def _truth(mu: float, sigma: float, K: float, F_max: float):
+    """(the solver's curve behind K, its legs as :class:`~petsc_adhesion.fitting.forward.ForwardCurve`), traced
+    with the default steps, and again with steps a quarter as long (at most ``REFINE`` times) while its legs leave
+    out a turning point the solver located.  A hysteresis loop narrower than a step has no point on its unstable
+    part, and the legs, made from the points' stability, leave it out (tracing/legs.py notes it): measured so, a
+    table that holds the loop was counted as missing a jump the solver lacked.  At (mu 0.237, sigma 0.225) behind
+    K = 0.5 the default curve (35 points) located the pair of jumps and its legs had none; with steps a quarter as
+    long (75 points) the legs hold the loop at Z = -1.7419 and -1.7676 (and the same to 1e-12 with steps 1/10 and
+    1/25 as long), the table's at -1.7358 and -1.7741 (docs/family.md)."""
     from petsc4py import PETSc
 
     from ..discretization.problem import step_scale
-    from ..fitting.forward import ForwardCurve
+    from ..fitting.forward import ForwardCurve, curve_jumps
     from ..model.parameters import Model
     from ..tracing.trace import CurveRequest, curve_settings, trace_curve
 
     model = Model(mu=mu, sigma=sigma)
-    c = trace_curve(model, settings=curve_settings(step_scale(model), observable_max=table.F_max + 0.3),
-                    request=CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=K),
-                    comm=PETSc.COMM_SELF)
-    truth = ForwardCurve(c, K)
+    scale = step_scale(model)
+    for _ in range(REFINE + 1):
+        c = trace_curve(model, settings=curve_settings(scale, observable_max=F_max + 0.3),
+                        request=CurveRequest(error_bars=False, kinds=("jump_in", "jump_off"), spring=K),
+                        comm=PETSc.COMM_SELF)
+        truth = ForwardCurve(c, K)
+        kept = sum(p.start is not None for p in truth.pieces) + sum(p.end is not None for p in truth.pieces)
+        if kept == len(curve_jumps(c, "jump_in")) + len(curve_jumps(c, "jump_off")):
+            break
+        scale /= 4.0
+    return c, truth
+
+
+def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[float, float, float]:
+    """(F at fixed Z, jump Z, jump F) errors of the table's legs behind K against the solver's (:func:`_truth`)."""
+    c, truth = _truth(mu, sigma, K, table.F_max)
     mine = table.curve(mu, sigma).behind(K)
     b = c.branch
     own = ~regrid_points(b)
@@ -144,13 +229,8 @@ def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[floa
     eF = eZ = eJ = 0.0
     for leg in (APPROACH, RETRACT):
         js, jt = truth.jumps[leg], mine.legs.jumps[leg]
-        dz = _nearest(js, jt)
-        eZ = max(eZ, dz)
-        if math.isfinite(dz) and js:
-            fs, ft = truth.jump_forces(leg), mine.legs.jump_forces(leg)
-            for k, z in enumerate(js):
-                j = int(np.argmin([abs(z - y) for y in jt]))
-                eJ = max(eJ, abs(fs[k][0] - ft[j][0]))
+        dz, dj = _leg_jumps(mine.legs, truth, leg)
+        eZ, eJ = max(eZ, dz), max(eJ, dj)
         # the solver's own points on the pieces this leg follows (no interpolation on its side), away from
         # the jumps of either
         piece = truth.assign(Z, leg)
@@ -164,11 +244,12 @@ def _spring(table: FamilyTable, mu: float, sigma: float, K: float) -> tuple[floa
 
 
 def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: float = math.inf,
-            mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> FamilyTable:
+            mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf), infinite: bool = False) -> FamilyTable:
     """The table with its interpolation error measured at its midpoints from ``mu_min`` up to ``mu_max`` and
-    with sigma in ``sigma_range`` (module docstring), kept with the midpoints the table had measured outside
-    that range (so that a table can be measured in parts); about the others the table's error is Missing, not
-    measured; collective."""
+    with sigma in ``sigma_range`` (module docstring; ``infinite``: of those, only the ones whose error the table
+    holds as infinite, measured again), kept with the midpoints the table had measured outside that range (so
+    that a table can be measured in parts); about the others the table's error is Missing, not measured;
+    collective."""
     from petsc4py import PETSc
 
     if table.measured and not np.allclose(table.springs, springs):
@@ -191,6 +272,10 @@ def measure(table: FamilyTable, springs=SPRINGS, comm=None, out=None, mu_max: fl
         return row
 
     cases = [c for c in midpoints(table) if mu_min <= c[0] <= mu_max and sigma_range[0] <= c[1] <= sigma_range[1]]
+    if infinite:
+        bad = [k for k in range(table.err_mu.size) if not all(math.isfinite(table.errors[f][k]) for f in ERROR_FIELDS)]
+        cases = [c for c in cases if any(math.isclose(table.err_mu[k], c[0], rel_tol=1e-9) and
+                                         math.isclose(table.err_sigma[k], c[1], abs_tol=1e-12) for k in bad)]
     rows = spread(cases, work, lambda c: node_cost(c) * (1 + len(springs)), comm)
     if out is not None:
         out("| mu | sigma | F at Z | jump Z | jump F | event lambda | event F | solver (s) |")
@@ -216,13 +301,8 @@ def _legs_error(mine, truth, K: float) -> tuple[float, float, float]:
     eF = eZ = eJ = 0.0
     for leg in (APPROACH, RETRACT):
         js, jt = b.legs.jumps[leg], a.legs.jumps[leg]
-        dz = _nearest(js, jt)
-        eZ = max(eZ, dz)
-        if math.isfinite(dz) and js:
-            fs, ft = b.legs.jump_forces(leg), a.legs.jump_forces(leg)
-            for k, z in enumerate(js):
-                j = int(np.argmin([abs(z - y) for y in jt]))
-                eJ = max(eJ, abs(fs[k][0] - ft[j][0]))
+        dz, dj = _leg_jumps(a.legs, b.legs, leg)
+        eZ, eJ = max(eZ, dz), max(eJ, dj)
         on = np.ones(Z.size, dtype=bool)
         w = 2.0 * (dz if math.isfinite(dz) else 0.0) + 1e-9
         for z in js + jt:
@@ -309,6 +389,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="measure the midpoints from this mu alone (those measured before kept)")
     m.add_argument("--sigma-range", nargs=2, type=float, default=(0.0, math.inf),
                    help="measure the midpoints with sigma in this range alone")
+    m.add_argument("--infinite", action="store_true",
+                   help="measure again only the midpoints whose error the table holds as infinite")
     sp = sub.add_parser("spacing")
     sp.add_argument("table")
     sp.add_argument("--keep", nargs="+", type=float, required=True, help="the sigma nodes the coarser table keeps")
@@ -378,7 +460,7 @@ def main(argv=None) -> int:
             say(f"benchmarks.family: {e}")
             return 2
         return _measured(table, args.springs, args.table, tell, rank, time.perf_counter(), args.mu_max, args.mu_min,
-                         tuple(args.sigma_range))
+                         tuple(args.sigma_range), args.infinite)
     try:
         lo, hi = args.mu
         grid = TableGrid(mu=log_nodes(lo, hi, args.per_decade) if hi > lo else (lo,), sigma=tuple(args.sigma),
@@ -412,13 +494,13 @@ def main(argv=None) -> int:
 
 
 def _measured(table: FamilyTable, springs, out: str, tell, rank: int, t1: float, mu_max: float = math.inf,
-              mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf)) -> int:
+              mu_min: float = 0.0, sigma_range: tuple = (0.0, math.inf), infinite: bool = False) -> int:
     """The table's error measured (at the midpoints from ``mu_min`` up to ``mu_max``) and the table written with it
     to ``out``; 3 where a midpoint's is infinite."""
     from petsc4py import PETSc
 
     try:
-        table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max, mu_min, sigma_range)
+        table = measure(table, tuple(springs), PETSc.COMM_WORLD, tell, mu_max, mu_min, sigma_range, infinite)
     except ValueError as e:
         say(f"benchmarks.family: {e}")
         return 2

@@ -24,7 +24,7 @@ from .coordinate import EVENT_KINDS, EventPoint, NotMonotone, Sampled, sample, w
 from .table import ERROR_FIELDS, FamilyTable, lagrange
 
 __all__ = ["select", "join", "TableGrid", "trace_node", "spread", "build", "node_cost", "log_nodes", "regrid_points",
-           "event_points", "keep_errors", "F_MAX", "ROUGHNESS"]
+           "event_points", "keep_errors", "F_MAX", "ROUGHNESS", "FINER"]
 
 #: The load the table's curves end at: the library's default stop (-cont_F_max 2).
 F_MAX = 2.0
@@ -63,13 +63,18 @@ class TableGrid:
         return [(float(m), float(s)) for m in self.mu for s in self.sigma]
 
 
-def trace_node(mu: float, sigma: float, F_max: float = F_MAX, comm=None):
-    """The default curve of (mu, sigma), no error bars, traced past ``F_max`` (a Curve; collective on comm)."""
+#: The steps a node is traced again with where its default curve is incomplete, as a fraction of the default's.
+FINER = 0.25
+
+
+def trace_node(mu: float, sigma: float, F_max: float = F_MAX, comm=None, step: float = 1.0):
+    """The default curve of (mu, sigma), no error bars, traced past ``F_max`` (a Curve; collective on comm);
+    ``step``: its steps (first, largest and the events' unit) as a fraction of the default's."""
     from ..discretization.problem import step_scale
     from ..tracing.trace import CurveRequest, curve_settings, trace_curve
 
     model = Model(mu=mu, sigma=sigma, roughness=ROUGHNESS)
-    return trace_curve(model, settings=curve_settings(step_scale(model), observable_max=F_max + _PAST),
+    return trace_curve(model, settings=curve_settings(step * step_scale(model), observable_max=F_max + _PAST),
                        request=CurveRequest(error_bars=False), comm=comm)
 
 
@@ -96,7 +101,12 @@ def _node(mu: float, sigma: float, tau: np.ndarray, F_max: float):
     try:
         c = trace_node(mu, sigma, F_max, PETSc.COMM_SELF)
         if not c.complete:
-            raise ValueError(f"the curve is incomplete: {c.assessment.incomplete[0]}")
+            # a load that varies faster than the default steps resolve (mu 3.16, sigma 0.2: "a computed point
+            # is a load minimum more tensile than the located pull-off"): the same curve with shorter steps
+            c = trace_node(mu, sigma, F_max, PETSc.COMM_SELF, FINER)
+        if not c.complete:
+            raise ValueError(f"the curve is incomplete with the default steps and with {FINER:g} of them: "
+                             f"{c.assessment.incomplete[0]}")
         b = c.branch
         out = sample(b.lam, b.F, b.H0, b.contact_radius, edge_level(pressure_law(c.model)), F_max, tau, mu,
                      regrid_points(b), event_points(c))
