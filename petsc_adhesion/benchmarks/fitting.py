@@ -55,9 +55,10 @@ TABLE_COVERAGE_SEED = 3434
 NOISE_SHARES = (0.003, 0.01, 0.03)
 #: The largest roughness sigma = rms / eps drawn; the version of the cases and of the synthetic curves (a
 #: journal's or the data file's rows of another version are not this study's: the retract reaching its
-#: pull-off since version 2).
+#: pull-off since version 2; version 3: the fit's steps and bars on the solver's Jacobian, the rebuilt tables,
+#: the truths from mu = 20 on in units of mu).
 SIGMA_TOP = 2.0
-TABLE_COVERAGE_VERSION = 2
+TABLE_COVERAGE_VERSION = 3
 #: In the order the cases run: one rough case after every ROUGH_EVERY smooth ones.
 ROUGH_EVERY = 4
 
@@ -371,7 +372,7 @@ def _journal_rows(cache: str | None) -> dict:
 
 
 def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made_only: bool = False,
-                        collect: bool = False) -> list:
+                        collect: bool = False, only: str | None = None) -> list:
     """The first ``n`` cases of :func:`table_cases`, the cheapest first (the smooth by mu, a rough one after
     every ROUGH_EVERY of them), dealt to the
     MPI ranks in turn: each a curve made by the solver (finer steps than the fit's), fitted through the default
@@ -380,7 +381,7 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
     data file) not run again: a kill or a next session continues.  Returns every finished case's row on rank 0
     (``make_only``: the curves made into the cache only, no rows; ``made_only``: the cases whose curve is in
     the cache alone; ``collect``: none run, the journaled rows gathered into the data file, as while another
-    run goes on), None on the others."""
+    run goes on), None on the others.  ``only``: "smooth" or "rough", those cases alone."""
     _init()
     from petsc4py import PETSc
 
@@ -389,7 +390,8 @@ def table_coverage_rows(n: int, cache: str | None, make_only: bool = False, made
     done = _journal_rows(cache)
     # the cheapest first among the cases left: the smooth by mu (through the table), one rough case (its
     # roughness fitted on the solver's curves, a hundred times the CPU at low mu) after every ROUGH_EVERY
-    left = [] if collect else [c for c in table_cases(n) if c["case"] not in done]
+    left = [] if collect else [c for c in table_cases(n) if c["case"] not in done and
+                               (only is None or (c["sigma"] > 0) == (only == "rough"))]
     smooth = sorted((c for c in left if c["sigma"] == 0), key=lambda c: c["mu"])
     rough = sorted((c for c in left if c["sigma"] > 0), key=lambda c: c["mu"])
     todo = sorted(smooth + rough, key=lambda c: (smooth.index(c) if c in smooth else
@@ -494,7 +496,11 @@ def main(argv: list[str]) -> int:
     if argv[:1] == ["-case"]:
         print(json.dumps(coverage_case(float(argv[1]), int(argv[2]))))
         return 0
-    value = {a: argv[i + 1] for i, a in enumerate(argv[:-1]) if a in ("-cache", "-cases", "-mus")}
+    value = {a: argv[i + 1] for i, a in enumerate(argv[:-1]) if a in ("-cache", "-cases", "-mus", "-only")}
+    if value.get("-only", "smooth") not in ("smooth", "rough"):
+        print(f"-only {value['-only']}: expected smooth or rough (the cases of sigma = 0, or the others)",
+              file=sys.stderr)
+        return 2
     try:
         mus = None if "-mus" not in value else tuple(float(m) for m in value["-mus"].split(","))
     except ValueError:
@@ -524,7 +530,7 @@ def main(argv: list[str]) -> int:
     for part, rows_of, section in (("speed", lambda: speed_rows("-before" in argv, cache, mus), speed_section),
                                    ("table_coverage", lambda: table_coverage_rows(int(value.get("-cases", 60)), cache,
                                                                     "-make_only" in argv, "-made_only" in argv,
-                                                                    "-collect" in argv),
+                                                                    "-collect" in argv, value.get("-only")),
                                     table_coverage_section)):
         if part not in parts:
             continue
