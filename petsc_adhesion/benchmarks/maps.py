@@ -99,6 +99,9 @@ def run(n: int) -> dict:
     return {"n": n, "pixels": n * n, "ranks": r.ranks, "make_s": made, "wall_s": wall, "cpu_s_by_rank": cpus,
             "pixels_per_s": n * n / wall, "cpu_s_per_pixel": None if cpus is None else sum(cpus) / (n * n),
             "ok": r.count("ok"), "flagged": n * n - r.count("ok"), "covered_95": covered,
+            # each pixel not ok with why: its place, its status and its reasons (a map's flag is its own account)
+            "flagged_pixels": [{"ix": p.entry.ix, "iy": p.entry.iy, "status": p.status, "reasons": list(p.reasons)}
+                               for p in r.pixels if p.status != "ok"],
             "solver_curves_traced": sum(p.traces for p in r.pixels),
             "fit_cpu_s_median": float(np.median(each)) if each.size else None,
             "fit_cpu_s_median_found": float(np.median(each[~traced])) if (~traced).any() else None,
