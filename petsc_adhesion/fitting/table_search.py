@@ -168,6 +168,14 @@ def bounded_step(J: np.ndarray, r: np.ndarray, x: np.ndarray, lo: np.ndarray, hi
     return np.clip(sol.x / scale, a, b)
 
 
+def _normal_inverse(J: np.ndarray) -> np.ndarray:
+    """(J^T J)^-1, the pseudo-inverse where J^T J is singular (a coordinate the residuals do not move)."""
+    try:
+        return np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        return np.linalg.pinv(J.T @ J)
+
+
 def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarray, label: str,
                  evaluations: int, seconds: float):
     """From the table's optimum ``x`` to the solver's (module docstring): (the stepped parameters, the point of
@@ -178,10 +186,7 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
     r_t = pb._all(pb.unpack(x))[0]          # the table's residuals at its optimum: ln mu's bar there
     pb.table = None
     pb.cache.clear()
-    try:
-        JtJ_inv = np.linalg.inv(J.T @ J)
-    except np.linalg.LinAlgError:
-        JtJ_inv = np.linalg.pinv(J.T @ J)
+    JtJ_inv = _normal_inverse(J)
     dof = max(pb.points - x.size, 1)
     sd_t = np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r_t @ r_t) / dof)
     x, level = on_lattice(x, pb.names, sd_t, lo, hi)
@@ -199,10 +204,7 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
         before = pb.traces
         J = pb.jacobian(x)
         differenced += pb.traces - before
-        try:
-            JtJ_inv = np.linalg.inv(J.T @ J)
-        except np.linalg.LinAlgError:
-            JtJ_inv = np.linalg.pinv(J.T @ J)
+        JtJ_inv = _normal_inverse(J)
         dx = bounded_step(J, r, x, lo, hi)
         stepped = x + dx
         sd = np.sqrt(np.abs(np.diag(JtJ_inv)) * float(r @ r) / dof)
@@ -212,12 +214,11 @@ def solver_steps(pb, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, A: np.ndarra
             break
         # the linearisation not trusted beyond its bar: a curve at the step, on the lattice but for the last
         x = on_lattice(stepped, pb.names, sd_t, lo, hi)[0] if curves < SOLVER_CURVES - 1 else stepped
-    shared = found
     d = A @ dx
     sd_out = np.sqrt(np.abs(np.diag(A @ JtJ_inv @ A.T)) * float(r @ r) / dof)
     bars = np.abs(d) / np.where(sd_out > 0, sd_out, np.inf)
     names = tuple("ln_E_star" if n == "ln_mu" else n for n in pb.names)
-    step = TableStep(label, evaluations, seconds, curves, names, d, bars, np.abs(d), first, lattice_mu, shared,
+    step = TableStep(label, evaluations, seconds, curves, names, d, bars, np.abs(d), first, lattice_mu, found,
                      differenced)
     # what is reported of the curve (chi^2, residuals, events) is read on the last curve's branch (its mu and
     # sigma) with the others at their best for it, one Gauss-Newton step in them alone: at the curve's own
