@@ -20,6 +20,7 @@ from petsc4py import PETSc
 
 from ..errors import InputError, collective, printable, say
 from ..fitting.curve_fit import CurveFitError, FitProgress, OutsideDomain, fit_curve, predict_curve
+from ..fitting.table_search import TABLE_CAP
 from ..fitting.data import CurveFileError, MeasuredCurve, NeedsInstrument, read_curve
 from ..fitting.forward import open_table
 from ..fitting.pull_off import PullOffCurveError, PullOffFitError, fit_pull_off
@@ -267,9 +268,11 @@ def _progress(opts: AppOptions, comm, cap: int):
         return None
 
     def update(p: FitProgress) -> None:
-        bar.update(p.evaluations / cap, f"fit: {p.evaluations} evaluations of at most {cap} (-fit_max_evals), "
-                                        f"{p.traces} curve{'' if p.traces == 1 else 's'} traced, "
-                                        f"best reduced chi^2 {p.best_reduced_chi2:.4g}")
+        at_most = p.cap or cap         # the search's own: TABLE_EVALS times -fit_max_evals on a rough table
+        bar.update(min(1.0, p.evaluations / at_most),
+                   f"fit: {p.evaluations} evaluations of at most {at_most} (-fit_max_evals"
+                   f"{'' if at_most == cap else TABLE_CAP}), {p.traces} curve{'' if p.traces == 1 else 's'} traced, "
+                   f"best reduced chi^2 {p.best_reduced_chi2:.4g}")
     return update
 
 

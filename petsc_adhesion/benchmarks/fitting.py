@@ -56,9 +56,11 @@ NOISE_SHARES = (0.003, 0.01, 0.03)
 #: The largest roughness sigma = rms / eps drawn; the version of the cases and of the synthetic curves (a
 #: journal's or the data file's rows of another version are not this study's: the retract reaching its
 #: pull-off since version 2; version 3: the fit's steps and bars on the solver's Jacobian, the rebuilt tables,
-#: the truths from mu = 20 on in units of mu).
+#: the truths from mu = 20 on in units of mu; version 4: a rough truth's and a rough branch's bends bounded
+#: (-cont_dF_bend), a rough fit searched on the rough table first and from several sigma, a search on a table
+#: allowed 5 times the cap on evaluations).
 SIGMA_TOP = 2.0
-TABLE_COVERAGE_VERSION = 3
+TABLE_COVERAGE_VERSION = 4
 #: In the order the cases run: one rough case after every ROUGH_EVERY smooth ones.
 ROUGH_EVERY = 4
 
@@ -203,7 +205,7 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
     from ..fitting.data import MeasuredCurve
     from ..fitting.results import Spring
     from ..discretization.problem import step_scale
-    from ..fitting.synthetic import Sampling, synthetic_curve, truth_settings
+    from ..fitting.synthetic import Sampling, rough_truth, synthetic_curve, truth_settings
     from ..model.parameters import Model
     from ..model.physical import Bodies
     from ..tracing.trace import curve_settings
@@ -228,8 +230,10 @@ def _synthetic(mu: float, K: float, noise_share: float, seed: int, cache: str | 
         c0 = time.process_time()
         # finer: steps half the fit's; from mu = 20 on in units of mu, where units of 1 would pass the
         # continuation's cap of 5000 steps above mu of about 100 (fitting/synthetic.py truth_settings)
-        settings = None if not finer else curve_settings(observable_max=2.0, ds_max=0.2, observable_step=0.1) \
-            if step_scale(Model(mu=mu)) == 1.0 else truth_settings(Model(mu=mu), 2.0, finer=2.0)
+        settings = None if not finer else rough_truth(curve_settings(observable_max=2.0, ds_max=0.2,
+                                                                     observable_step=0.1), Model(mu=mu, sigma=sigma),
+                                                      2.0) \
+            if step_scale(Model(mu=mu)) == 1.0 else truth_settings(Model(mu=mu, sigma=sigma), 2.0, finer=2.0)
         made_of = (mu, K, R, finer, sigma)
         if made_of not in _CLEAN:      # one truth's noiseless curve, traced once: each seed shifts it, adds noise
             _CLEAN[made_of] = synthetic_curve(Bodies(radius=R, young1=E, poisson1=0.0, epsilon=eps, gamma=w,

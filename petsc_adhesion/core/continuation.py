@@ -70,6 +70,7 @@ class Settings:
     natural_fallback: float = 0.1   # natural corrector as fallback only while |pdot| >= this
     observable: str | None = None   # the observable bounded per step and stopped on
     observable_step: float = 0.2    # its largest change in one step, relative above magnitude 1
+    observable_bend: float = math.inf  # its largest distance in one step from its tangent's line (absolute)
     observable_max: float = math.inf  # stop when the observable reaches this
     observable_max_label: str = ""  # what set that stop, as the stop's message names it ("": the caller's default)
     p_max: float = math.inf         # stop when the parameter reaches this
@@ -84,6 +85,8 @@ class Settings:
     @classmethod
     def from_state(cls, d: dict) -> Settings:
         """The settings of ``asdict(settings)`` as a checkpoint kept them; ValueError for what are not settings."""
+        if isinstance(d, dict) and "observable_bend" not in d:
+            d = {**d, "observable_bend": math.inf}     # a checkpoint kept before the bound was: none
         if not isinstance(d, dict) or set(d) != {f.name for f in fields(cls)}:
             raise ValueError("settings that are not the continuation's")
         for f in fields(cls):
@@ -335,7 +338,17 @@ class Continuation:
         # the observable is what users read: resolve the curve in it too
         if s.observable is not None and abs(b.values[s.observable] - a.values[s.observable]) > self._observable_bound(a):
             return None
+        # and its bends: a kink in the load (a rough sphere stopped by the roughness rule's outermost wall turns
+        # dF/dlambda from 0 to 50 within 0.02 epsilon) is small in the state's norm but rounded off by a spline
+        # through points farther apart; the distance from the tangent's line grows as ds^2 times the bend
+        if s.observable is not None and self._bend(a, b, ds) > s.observable_bend:
+            return None
         return b
+
+    def _bend(self, a: Point, b: Point, ds: float) -> float:
+        """The observable at b less its value on a's tangent line at the step ds."""
+        o = self.set.observable
+        return abs(b.values[o] - a.values[o] - ds * a.rates.get(o, 0.0)) if o in a.rates else 0.0
 
     def done(self, b: Point) -> tuple[str, float] | None:
         """The stop criterion b meets, as (reason, value), or None."""
@@ -413,7 +426,7 @@ class Continuation:
         s = self.set
         easy = b.deviation < s.grow_margin * s.max_deviation and (
             s.observable is None or abs(b.values[s.observable] - a.values[s.observable])
-            < s.grow_margin * self._observable_bound(a))
+            < s.grow_margin * self._observable_bound(a) and self._bend(a, b, ds) < s.grow_margin * s.observable_bend)
         if b.newton_its < s.newton_target and easy:
             return min(s.grow * ds, s.ds_max)
         if b.newton_its > s.newton_target:

@@ -62,13 +62,13 @@ from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
 from .data import MeasuredCurve
 from .branches import BRANCHES
-from .forward import APPROACH, RETRACT, ForwardCurve, table_choice, table_covers, table_legs
+from .forward import APPROACH, RETRACT, ForwardCurve, rough_first, table_choice, table_covers, table_legs
 from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
                      domain_reasons, features, refuse_a_line, refuse_empty)
 from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, profiled, to_moduli, verdicts
 from .pull_off import maugis_dugdale_gamma
 from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misfit, misfit_p
-from .table_search import START_MUS, TableStep, cpu, mu_profile, solver_steps, table_bounds
+from .table_search import START_MUS, START_SIGMAS, TABLE_CAP, TABLE_EVALS, TableStep, start_gamma, cpu, mu_profile, solver_steps, table_bounds
 
 if TYPE_CHECKING:
     from ..family.table import FamilyTable
@@ -86,13 +86,14 @@ EDGE_POINTS = 3
 JUMP_TAIL = 0.25
 @dataclass(frozen=True)
 class FitProgress:
-    """How far a fit has gone: least-squares ``evaluations``, curves ``traces``d, the best reduced chi^2 so far
-    and the seconds ``elapsed``."""
+    """How far a fit has gone: least-squares ``evaluations``, curves ``traced``, the best reduced chi^2, the seconds
+    ``elapsed`` and the search's ``cap`` on evaluations (TABLE_EVALS times the fit's on a rough fit's table)."""
 
     evaluations: int
     traces: int
     best_reduced_chi2: float
     elapsed: float
+    cap: int = 0
 
 
 @dataclass
@@ -297,8 +298,8 @@ class _Problem:
         self.best_chi2 = min(self.best_chi2, float(r @ r))
         if self.progress is not None:
             dof = max(self.points - len(self.names), 1)
-            self.progress(FitProgress(self.evaluations, self.traces, self.best_chi2 / dof,
-                                      time.perf_counter() - self.t0))
+            cap = self.choice.max_evaluations * (TABLE_EVALS if self.table is not None and self.choice.roughness else 1)
+            self.progress(FitProgress(self.evaluations, self.traces, self.best_chi2 / dof, time.perf_counter() - self.t0, cap))
         return r
 
     def jacobian(self, x, columns=None) -> np.ndarray:
@@ -365,6 +366,11 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     """
     from scipy.optimize import least_squares
 
+    if table == "default":                # a rough fit: the rough table where it holds mu, else the solver
+        first = rough_first(lambda t: fit_curve(data, bodies, spring, choice, model, grid, solver, comm, progress,
+                                                spread_rules, t), choice or FitChoice(), model, bodies, MU_BOUNDS)
+        if first is not None:
+            return first
     from ..tracing.trace import GridChoice, SolverChoice
 
     t0 = time.perf_counter()
@@ -420,14 +426,14 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     names = pb.names
     reach = MU_BOUNDS if pb.table is None else (float(pb.table.mu[0]), float(pb.table.mu[-1]))
 
-    def start(E: float) -> tuple[np.ndarray, float]:
+    def start(E: float, sigma: float = sigma0) -> tuple[np.ndarray, float]:
         w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
         mu = min(max(tabor(R, w, E, eps), reach[0] * 1.01), reach[1] * 0.99)
         if pb.table is not None and "ln_gamma" in names:     # a held modulus: w's start, too, where the
             w = math.sqrt(mu**3 * E**2 * eps**3 / R)           # table holds mu (eq. 9 inverted)
         # the baseline's start: the far approach's median, or with its slope fitted its line at the contact point
         sloped = choice.virtual_deflection
-        given = {"ln_mu": math.log(mu), "ln_gamma": math.log(w), "sigma": sigma0, "z0": 0.0,
+        given = {"ln_mu": math.log(mu), "ln_gamma": math.log(w), "sigma": sigma, "z0": 0.0,
                  "F0": (base[0] + base[1] * feat.pull_off_z_m if sloped else feat.F0_N) / noise,
                  "ln_invols": math.log(choice.invols_scale), "ln_k": 0.0, "slope": base[1] * eps / noise,
                  "drag": base[2] / noise}
@@ -445,7 +451,9 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         w_guess = bodies.gamma or P / (1.75 * math.pi * R)
         mus = (0.1, 0.3, 1.0, 3.0) if pb.table is None else \
             [m for m in START_MUS if reach[0] <= m <= reach[1]] or [math.sqrt(reach[0] * reach[1])]
-        tries = [start(w_guess * math.sqrt(R / (m**3 * eps**3))) for m in mus]
+        sigmas = START_SIGMAS if pb.table is not None and choice.roughness else (sigma0,)
+        tries = [start((start_gamma(P, R, m, s_, w_guess) if s_ > 0 else w_guess) * math.sqrt(R / (m**3 * eps**3)),
+                       s_) for m in mus for s_ in sigmas]
         x0 = min(tries, key=lambda t: t[1])[0]
     pb.leave_out_edges(x0)
     lo, hi = bounds(pb, choice, modulus)
@@ -454,8 +462,9 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         pb.upper = hi
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo if np.all(np.isfinite(hi - lo)) else 1), hi - 1e-9)
     pb.evaluations = 0
+    cap = choice.max_evaluations * (TABLE_EVALS if pb.table is not None and choice.roughness else 1)
     res = least_squares(pb.residuals, x0, jac=pb.jacobian, bounds=(lo, hi), method="trf", x_scale="jac",
-                        ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=choice.max_evaluations)
+                        ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=cap)
     A = to_moduli(names)
     d, path = None, f"the solver's curves throughout: {why_not}"
     profile = None
@@ -495,8 +504,8 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     if feat.noise_note and choice.noise is None:
         warned.append(feat.noise_note)
     if res.status == 0:
-        warned.append(f"the fit stopped at its cap of {choice.max_evaluations} evaluations (-fit_max_evals) before "
-                      f"it converged: its numbers are where it stopped, not an optimum")
+        warned.append(f"the fit stopped at its cap of {cap} evaluations (-fit_max_evals{TABLE_CAP * (cap > choice.max_evaluations)})"
+                      f" before it converged: its numbers are where it stopped, not an optimum")
     if choice.invols_fitted:            # the indentation and the contact at the fitted scale
         fitted = (p["F0"] - p["slope"] * p["z0"], p["slope"], p["drag"])
         reasons += [why for why in domain_reasons(data, feat, bodies, Spring(p["k"]), choice, fitted, p["c"])

@@ -65,9 +65,11 @@ def verdicts(pb, choice: FitChoice, x, lo, hi, p: dict, sd: dict, modulus) -> tu
         edge = at[name]
         if name == "ln_mu" or (name == "ln_gamma" and not choice.modulus and
                                 math.log(1e-6) < edge < math.log(100.0)):
-            mu_edge = MU_BOUNDS[0] if p["mu"] < 1 else MU_BOUNDS[1]
-            where = (f"mu = {p['mu']:.4g} is at the bound {mu_edge:g} of the model's range [{MU_BOUNDS[0]:g}, "
-                     f"{MU_BOUNDS[1]:g}]")
+            # the search's range: the model's, or a table's that holds less of it (the rough one: mu to 1)
+            rng = MU_BOUNDS if getattr(pb, "table", None) is None else (float(pb.table.mu[0]), float(pb.table.mu[-1]))
+            whose = "the model's" if rng == MU_BOUNDS else "the table's"
+            mu_edge = rng[0] if p["mu"] < math.sqrt(rng[0] * rng[1]) else rng[1]
+            where = f"mu = {p['mu']:.4g} is at the bound {mu_edge:g} of {whose} range [{rng[0]:g}, {rng[1]:g}]"
             e = sd.get("ln_E_star") if name == "ln_mu" else None
             if name == "ln_mu" and (e is None or undetermined(p["E"], p["E"] * e) is not None):
                 # the bound is where the search stopped, not what the data ask for: the Jacobian's bar there

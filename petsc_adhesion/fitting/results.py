@@ -72,7 +72,8 @@ class Spring:
 class FitChoice:
     """What a curve fit fits: the modulus (else held at the bodies'), the roughness (else held at the bodies'
     rms, smooth without one); ``noise`` the measurement's stated noise (N, one standard deviation; None: the
-    far baseline's); ``max_evaluations`` of the least squares."""
+    far baseline's); ``max_evaluations`` of the least squares (on the curve family table with the roughness
+    fitted TABLE_EVALS times it: :mod:`~petsc_adhesion.fitting.table_search`)."""
 
     modulus: bool = True
     roughness: bool = False

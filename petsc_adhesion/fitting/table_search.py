@@ -54,7 +54,7 @@ import numpy as np
 
 from ..family.table import FamilyTable
 
-__all__ = ["TableStep", "bounded_step", "mu_profile", "PROFILE_POINTS", "PROFILE_EVALS", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
+__all__ = ["TableStep", "bounded_step", "mu_profile", "PROFILE_POINTS", "PROFILE_EVALS", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "START_SIGMAS", "TABLE_EVALS", "TABLE_CAP", "start_gamma", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
            "on_lattice", "table_bounds", "solver_steps"]
 
 #: The solver's curves at most after a search on the table.
@@ -75,6 +75,16 @@ PROFILE_POINTS = 2
 PROFILE_EVALS = 12
 #: The Tabor parameters the search on the table starts from (the best of them; the solver's search tries 0.1 to 3).
 START_MUS = (0.003, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0)
+#: The roughness sigma a search on the table starts from where it is fitted, with each of START_MUS and w from
+#: the measured pull-off at each (:func:`start_gamma`): from sigma = 0.3 alone with the smooth sphere's w, a fit
+#: at mu = 0.0055, sigma = 1 (K = 0.19, 0.3% noise) ended at the bounds w = 1e-6 J/m^2, mu = 0.001, sigma = 0.
+START_SIGMAS = (0.0, 0.3, 0.7, 1.2, 2.0)
+#: A search on a table with the roughness fitted may take TABLE_EVALS times the fit's cap on evaluations
+#: (-fit_max_evals), an evaluation on it costing a millisecond against a solver curve's second: its valley is
+#: long (sigma and w trade along it) and the search took 74 (mu = 0.0055, sigma = 1), where the cap of 40 left w
+#: 8 bars and sigma 12 bars from where it went on to.
+TABLE_EVALS = 5
+TABLE_CAP = f" times {TABLE_EVALS} on the table with the roughness fitted"
 
 
 @dataclass(frozen=True)
@@ -115,6 +125,23 @@ class TableStep:
                 + ": chi^2, "
                 f"the residuals and the events are the solver's last curve's, the parameters one Gauss-Newton step "
                 f"from it on the solver's Jacobian (the bars its), the step added to each bar ({share})")
+
+
+def start_gamma(pull_off_N: float, R: float, mu: float, sigma: float, fallback: float) -> float:
+    """The w whose load-controlled pull-off at (mu, sigma), 2 pi R w |F_po| (the pull-off table,
+    :mod:`~petsc_adhesion.family.pull_off`), is the measured ``pull_off_N``: a rough search's start at each of its
+    START_SIGMAS (``fallback`` where the table does not hold (mu, sigma)).  Why: the pull-off falls by orders of
+    magnitude with sigma (0.03 of the smooth sphere's at sigma = 1), and w from it as from a smooth sphere lay
+    30 times too low at such a start."""
+    from ..family.pull_off import PullOffTable
+
+    try:
+        t = PullOffTable.default()
+    except FileNotFoundError:
+        return fallback
+    if not bool(t.covers(mu, sigma)) or not pull_off_N > 0:
+        return fallback
+    return pull_off_N / (2.0 * math.pi * R * math.exp(float(t.ln_pull_off(mu, sigma))))
 
 
 def table_bounds(table: FamilyTable, names: tuple, lo: np.ndarray, hi: np.ndarray, modulus: float | None,

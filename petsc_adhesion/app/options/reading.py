@@ -571,7 +571,7 @@ def read_settings(opts: AppOptions, model: Model | None = None):
     return curve_settings(1.0 if model is None else step_scale(model), corrector=opts.choice("cont_type"), ds=opts.real("cont_ds"), ds_min=opts.real("cont_ds_min"),
                           ds_max=opts.real("cont_ds_max"), newton_target=opts.int("cont_newton_target"),
                           max_deviation=opts.real("cont_max_deviation"), max_folds=opts.int("cont_max_folds"),
-                          observable_step=dF, observable_max=stop, observable_max_label=label,
+                          observable_step=dF, observable_bend=opts.real("cont_dF_bend"), observable_max=stop, observable_max_label=label,
                           p_max=math.inf if lam_max is None else lam_max, max_steps=opts.int("cont_max_steps"),
                           pc_reuse_its=opts.int("adh_pc_reuse_its"), monitor=opts.flag("cont_monitor"))
 

@@ -170,6 +170,9 @@ TABLE = {o.name: o for o in [
     Option("cont_max_steps", "int", _S.max_steps, "stop after this many accepted steps", 1, 10**7),
     Option("cont_dF_max", "real", _S.observable_step, "largest change of the load in one step, relative above "
            "|F| = 1", 0.0, 1e6, lo_open=True),
+    Option("cont_dF_bend", "real", _S.observable_bend, "largest distance of the load in one step from its "
+           "tangent's line (absolute; resolves a kink such as a rough sphere meeting the roughness rule's wall)",
+           0.0, _INF, lo_open=True, hi_open=True),
     Option("cont_max_folds", "int", _S.max_folds, "stop after more than this many turning points (a grid that "
            "traps the contact edge makes dozens)", 0, 10**6),
     Option("cont_ds", "real", _S.ds, "first arclength step", 0.0, 1e3, lo_open=True),
@@ -265,8 +268,9 @@ TABLE = {o.name: o for o in [
                                                                                             "retract")),
     Option("fit_z_range", "reals", (), "fit: the piezo range of -fit_curve fitted, two positions lo,hi (m, in "
            "the file's z)", -1.0, 1.0),
-    Option("fit_max_evals", "int", 40, "fit: the cap on the least squares' evaluations of -fit_curve; reached, "
-           "the fit ends with a WARNING and exit status 3", 1, 10**6),
+    Option("fit_max_evals", "int", 40, "fit: the cap on the least squares' evaluations of -fit_curve (a search on "
+           "the curve family table with the roughness fitted, whose evaluations cost milliseconds, 5 times it); reached, the fit ends with a "
+           "WARNING and exit status 3", 1, 10**6),
     Option("fit_table", "string", "default", "fit: the curve family table -fit_curve searches on where it holds the "
            "model (then one solver curve at its optimum): default (the package's: the rough table where the fit has a "
            "roughness and its range holds the fit, else the smooth sphere's, mu 1e-3 to 1e3), smooth or rough (a "
