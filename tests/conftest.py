@@ -109,6 +109,23 @@ def run_cli(*args, np=1, cwd=None, timeout=600):
     return subprocess.run(cmd, cwd=cwd or ROOT, env=_env(), capture_output=True, text=True, timeout=timeout)
 
 
+def in_process(*args, cwd=None):
+    """petsc-adhesion's ``main`` run in this process with ``args`` (its own options; PETSc is initialised once,
+    above), in the folder ``cwd`` (default: this one), and a CompletedProcess of its exit status and what it
+    wrote to Python's stdout and stderr: the program without the start of a process of its own (about 1 CPU s:
+    python -m petsc_adhesion -help took 0.98), for tests that run many cheap curves or set-ups.  Call it from
+    the main thread (main sets signal handlers), one run at a time."""
+    import contextlib
+    import io
+
+    from petsc_adhesion.app.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.chdir(cwd or os.getcwd()), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = main(["petsc-adhesion", *map(str, args)])
+    return subprocess.CompletedProcess(list(args), status, out.getvalue(), err.getvalue())
+
+
 def drawn_figure(path):
     """The first figure the plot of the result file ``path`` makes (``io/plot/curve.py``'s ``curve_figure``,
     drawn to nowhere), for a test to read its panels."""

@@ -22,7 +22,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import in_process, run_cli
 from petsc_adhesion.discretization.grid import load_weights
 from petsc_adhesion.discretization.influence import influence_rows
 from petsc_adhesion.model.reference.rigid import RIGID_EQUILIBRIUM, load_beyond, rigid_load
@@ -81,7 +81,8 @@ def workdir(tmp_path_factory):
 
 
 def run_many(workdir, jobs: dict) -> dict:
-    """{name: (args, ranks[, exit status])} -> {name: Run}: two processes at a time, each run once per module.
+    """{name: (args, ranks[, exit status])} -> {name: Run}, each run once per module: one rank's runs by main() in
+    this process (conftest.in_process), one after the other; two ranks' under mpiexec, two at a time.
 
     The exit status is 0 unless given: 3 is a result written that is not the
     whole curve asked for (natural continuation stops at a fold; a staircase).
@@ -96,15 +97,21 @@ def run_many(workdir, jobs: dict) -> dict:
             args, nranks = key
             folder = os.path.join(str(workdir), hashlib.sha1(repr(key).encode()).hexdigest()[:16])
             os.makedirs(folder, exist_ok=True)
-            proc = run_cli(*args, "-summary", os.path.join(folder, "summary.json"),
-                           "-out", os.path.join(folder, "result.h5"), np=nranks)
+            files = ("-summary", os.path.join(folder, "summary.json"), "-out", os.path.join(folder, "result.h5"))
+            # one rank: main() in this process, one run after the other (a process of its own adds about 1 CPU s
+            # to start Python and PETSc); two ranks under mpiexec, two at a time
+            proc = in_process(*args, *files) if nranks == 1 else run_cli(*args, *files, np=nranks)
             return Run(args, nranks, proc, folder)
 
+        runs = {key: one(key) for key in todo if key[1] == 1}     # in the main thread: main() sets signal handlers
+        there = [key for key in todo if key[1] > 1]
         with ThreadPoolExecutor(max_workers=2) as pool:
-            for key, run in zip(todo, pool.map(one, todo)):
-                assert run.proc.returncode == todo[key], (
-                    f"petsc-adhesion {' '.join(key[0])} (np={key[1]}) failed:\n{run.proc.stderr}")
-                _DONE[key] = run
+            runs |= dict(zip(there, pool.map(one, there)))
+        for key in todo:
+            run = runs[key]
+            assert run.proc.returncode == todo[key], (
+                f"petsc-adhesion {' '.join(key[0])} (np={key[1]}) failed:\n{run.proc.stderr}")
+            _DONE[key] = run
     return {name: _DONE[(tuple(map(str, spec[0])), spec[1])] for name, spec in jobs.items()}
 
 

@@ -74,11 +74,13 @@ def test_a_flat_pull_off_gets_its_bar(tmp_path):
     """mu = 3, sigma = 0.2: F is so flat about the pull-off (2e-6 over 0.01 in lambda) that on the finer
     levels its lambda lies 0.024 back, behind the first point of the step that found it.  Its levels'
     traces start a step further back: it has a bar (before: none, 'not found again'), and the bars cover
-    a run refined to 1e-6 (measured: lambda 2.7e-3 off with a bar of 6.8e-3, F 1.1e-6 with 2.8e-6)."""
+    a run refined to 1e-5 (measured: lambda 2.7e-3 off with a bar of 6.8e-3, F 1.1e-6 with 2.8e-6, each 0.40
+    of the two bars summed; the reference's bars 9.7e-6 and 1.2e-8, its values within 3.9e-6 and 2.2e-9 of a run
+    refined to 1e-6, which took 50 CPU s where this takes 21; the grid's values 2500 of its bars off)."""
     args = ("-adh_mu", 3, "-adh_sigma", 0.2, "-cont_F_max", 0, "-adh_model_spread", "false")
     po, ref = (summary(tmp_path, name, *args, *extra)["pull_off"]
-               for name, extra in (("run", ()), ("refined", ("-target_error", 1e-6))))
-    assert "error_note" not in po and ref["lambda_err"] <= 1e-6 and ref["F_err"] <= 1e-6
+               for name, extra in (("run", ()), ("refined", ("-target_error", 1e-5))))
+    assert "error_note" not in po and ref["lambda_err"] <= 1e-5 and ref["F_err"] <= 1e-5
     for q in ("lambda", "F"):
         assert abs(po[q] - ref[q]) <= po[f"{q}_err"] + ref[f"{q}_err"], (q, po[q], ref[q], po[f"{q}_err"])
         assert abs(po[f"{q}_grid"] - ref[q]) > ref[f"{q}_err"]         # a grid value that needs its bar

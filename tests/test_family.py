@@ -649,17 +649,27 @@ def test_a_joined_table_keeps_the_error_only_where_its_stencils_are_unchanged():
     assert np.allclose(lost, mids[:2], rtol=1e-9), (lost, mids[:3])
 
 
-def test_a_node_the_default_steps_leave_incomplete_is_traced_with_shorter_ones():
+def test_a_node_the_default_steps_leave_incomplete_is_traced_with_shorter_ones(monkeypatch):
     """At mu 3.16, sigma 0.2 the default curve is incomplete (a computed point more tensile than the located
     pull-off: the load varies faster than the steps resolve), and `build` wrote nothing; the node is traced again
     with steps a quarter as long (FINER) and tabulated, its pull-off the one the default curve had located, to
-    1e-4 (a trace with other steps: the two agree where the coarse one resolved its minimum)."""
+    1e-4 (a trace with other steps: the two agree where the coarse one resolved its minimum).  The default curve
+    is the one `build` traced first, kept as it passes (the same call as trace_node(mu, sigma) on one rank):
+    traced once, not again here."""
+    from petsc_adhesion.family import build as building
     from petsc_adhesion.family.build import FINER
 
     mu, sigma = 10 ** 0.5, 0.2
-    coarse = trace_node(mu, sigma)
-    assert not coarse.complete and "faster than the steps resolve" in coarse.assessment.incomplete[0]
+    traced, trace = [], building.trace_node
+
+    def kept(*args, **kw):
+        traced.append(trace(*args, **kw))
+        return traced[-1]
+    monkeypatch.setattr(building, "trace_node", kept)
     node = build(TableGrid(mu=(mu,), sigma=(sigma,), n_tau=150))
+    coarse, finer = traced                                # the default steps, then FINER's
+    assert not coarse.complete and "faster than the steps resolve" in coarse.assessment.incomplete[0]
+    assert finer.complete
     (pl, pF), = [(e.lam.value, e.F.value) for e in node.curve(mu, sigma).events() if e.kind == "pull_off"]
     want = _solver_events(coarse)["pull_off"][0][1]
     assert FINER == 0.25 and abs(pF - want) < 1e-4, (pF, want)

@@ -295,27 +295,3 @@ def test_a_map_curve_named_is_read(tmp_path):
     name = _map(tmp_path)
     p = run_cli("-fit_curve", name, *TIP, "-fit_curve_index", "1", "-help", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-
-
-def test_the_roughness_laws_spread_points_to_the_law_the_curve_was_made_with():
-    """A rough curve (sigma = 0.5) made by the solver under the truncated Gaussian at K = 3, fitted under the
-    default Gauss-Hermite rule with E* and the rms held: that fit's w is far from the truth (the rule's
-    outermost node sets it), and the model spread, the optimum of truncated_gaussian:3's residuals sought from
-    the fit's (fitting/outcome.py LawOptimum), gives the true w back to 10% (0.0534 for 0.05, after six steps
-    in ln w of -0.032, -0.62, -0.20, -0.092, -0.012, -0.0004; the default rule's fit says 0.140): the spread is
-    the distance to what the other law would fit, not a number of its own; it warns."""
-    from petsc_adhesion.model.parameters import Model
-    from petsc_adhesion.tracing.model_spread import Rule
-
-    sigma = 0.5
-    law = Rule("truncated_gaussian", 3.0)
-    truth = Bodies(radius=R, young1=E_TRUE, poisson1=0.0, epsilon=EPS, gamma=W, rms=sigma * EPS)
-    held = Bodies(radius=R, young1=E_TRUE, poisson1=0.0, epsilon=EPS, rms=sigma * EPS)
-    d = synthetic_curve(truth, Spring(K_SPRING), Sampling(noise=NOISE, points=100, z0=Z0, seed=3),
-                        model=law.model(Model()))
-    f = fit_curve(d, held, Spring(K_SPRING), FitChoice(modulus=False), model=Model(), spread_rules=(law,))
-    (q,) = f.spread.quantities
-    (moved,) = q.values
-    assert abs(f.gamma.value / W - 1) > 0.5                     # the default rule's fit: far from the truth
-    assert moved.value == pytest.approx(W, rel=0.1)
-    assert q.warning and q.spread == pytest.approx(abs(f.gamma.value - moved.value))

@@ -12,7 +12,7 @@ import matplotlib
 import matplotlib.image
 import pytest
 
-from conftest import ROOT, _env, run_cli
+from conftest import ROOT, _env, in_process
 
 matplotlib.use("Agg")
 TINY = ("-grid_type", "uniform", "-grid_n", "101")
@@ -32,9 +32,9 @@ def files(tmp_path_factory):
             "physical": (*TINY, *PHYS, "-cont_F_max", 0, "-profiles"), "solve": (*TINY, "-adh_mu", 0.5,
                                                                                   "-adh_lambda", -3),
             "study": (*TINY, "-study_mu", "0.1,0.5", "-study_compute", "pull_off", "-study_plot", "pull_off")}
-    for name, args in runs.items():
+    for name, args in runs.items():           # main() in this process: the files are what is plotted here
         fast = () if name == "solve" else ("-cont_error_estimate", "false")
-        proc = run_cli(*args, *fast, "-out", d / f"{name}.h5")
+        proc = in_process(*args, *fast, "-out", d / f"{name}.h5")
         assert proc.returncode == 0, proc.stderr
     return d
 

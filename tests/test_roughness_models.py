@@ -12,7 +12,8 @@ import h5py
 import numpy as np
 import pytest
 
-from test_cli import plain_error, run_all
+from conftest import in_process
+from test_cli import plain_error
 
 GRID = ("-adh_mu", "1", "-grid_type", "uniform", "-grid_n", "201", "-adh_rmax", "10", "-cont_F_max", "0.2",
         "-cont_error_estimate", "false", "-adh_model_spread", "false")
@@ -43,10 +44,13 @@ def runs(tmp_path_factory):
     for s in ("0.01", "0.02"):
         jobs[f"tg_{s}"] = ["-adh_sigma", s, *TG]
         jobs[f"wb_{s}"] = ["-adh_sigma", s, "-adh_roughness", "weibull"]
-    procs = run_all({k: ([*GRID, *a, "-summary", str(d / f"{k}.json"), "-out", str(d / f"{k}.h5")], {})
-                     for k, a in jobs.items()})
+    # the program's main() in this process, one run after the other: a run is 0.5 to 1 CPU s, and a process of
+    # its own would add about 1 s more to start Python and PETSc, 22 times (the command line's process itself is
+    # the business of tests/test_cli.py and test_hostile.py; main() given its own options each run is what
+    # tests/test_fuzz.py's worker does a hundred times)
     out = {}
-    for k, p in procs.items():
+    for k, a in jobs.items():
+        p = in_process(*GRID, *a, "-summary", d / f"{k}.json", "-out", d / f"{k}.h5")
         assert p.returncode == 0, (k, p.stderr)
         out[k] = {"summary": json.load(open(d / f"{k}.json")), "h5": str(d / f"{k}.h5")}
     return out
