@@ -68,7 +68,7 @@ from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines,
 from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, profiled, to_moduli, verdicts
 from .pull_off import maugis_dugdale_gamma
 from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misfit, misfit_p
-from .table_search import START_MUS, START_SIGMAS, TABLE_CAP, TABLE_EVALS, TableStep, start_gamma, cpu, mu_profile, solver_steps, table_bounds
+from .table_search import START_MUS, START_SIGMAS, TABLE_CAP, TableStep, search_cap, start_gamma, cpu, mu_profile, solver_steps, table_bounds
 
 if TYPE_CHECKING:
     from ..family.table import FamilyTable
@@ -298,8 +298,8 @@ class _Problem:
         self.best_chi2 = min(self.best_chi2, float(r @ r))
         if self.progress is not None:
             dof = max(self.points - len(self.names), 1)
-            cap = self.choice.max_evaluations * (TABLE_EVALS if self.table is not None and self.choice.roughness else 1)
-            self.progress(FitProgress(self.evaluations, self.traces, self.best_chi2 / dof, time.perf_counter() - self.t0, cap))
+            self.progress(FitProgress(self.evaluations, self.traces, self.best_chi2 / dof, time.perf_counter() - self.t0,
+                                      search_cap(self.choice, self.table)))
         return r
 
     def jacobian(self, x, columns=None) -> np.ndarray:
@@ -462,7 +462,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         pb.upper = hi
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo if np.all(np.isfinite(hi - lo)) else 1), hi - 1e-9)
     pb.evaluations = 0
-    cap = choice.max_evaluations * (TABLE_EVALS if pb.table is not None and choice.roughness else 1)
+    cap = search_cap(choice, pb.table)
     res = least_squares(pb.residuals, x0, jac=pb.jacobian, bounds=(lo, hi), method="trf", x_scale="jac",
                         ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=cap)
     A = to_moduli(names)

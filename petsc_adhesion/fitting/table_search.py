@@ -54,7 +54,7 @@ import numpy as np
 
 from ..family.table import FamilyTable
 
-__all__ = ["TableStep", "bounded_step", "mu_profile", "PROFILE_POINTS", "PROFILE_EVALS", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "START_SIGMAS", "TABLE_EVALS", "TABLE_CAP", "start_gamma", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
+__all__ = ["TableStep", "bounded_step", "mu_profile", "PROFILE_POINTS", "PROFILE_EVALS", "SOLVER_CURVES", "STEP_BARS", "START_MUS", "START_SIGMAS", "TABLE_EVALS", "TABLE_CAP", "search_cap", "start_gamma", "LATTICE", "LATTICE_BARS", "LATTICE_LEVELS", "COARSER",
            "on_lattice", "table_bounds", "solver_steps"]
 
 #: The solver's curves at most after a search on the table.
@@ -85,6 +85,12 @@ START_SIGMAS = (0.0, 0.3, 0.7, 1.2, 2.0)
 #: 8 bars and sigma 12 bars from where it went on to.
 TABLE_EVALS = 5
 TABLE_CAP = f" times {TABLE_EVALS} on the table with the roughness fitted"
+
+
+def search_cap(choice, table) -> int:
+    """The least squares' cap on evaluations: ``choice.max_evaluations``, TABLE_EVALS times it on a ``table`` with
+    the roughness fitted."""
+    return choice.max_evaluations * (TABLE_EVALS if table is not None and choice.roughness else 1)
 
 
 @dataclass(frozen=True)
