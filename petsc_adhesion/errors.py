@@ -6,7 +6,7 @@ check's refusal every rank's, so that no rank is left waiting in a collective ca
 import os
 import sys
 
-__all__ = ["InputError", "Interrupted", "say", "first_line", "printable", "collective", "tell"]
+__all__ = ["InputError", "Interrupted", "interrupted_in", "say", "first_line", "printable", "collective", "tell"]
 
 
 def say(text: str, stream=None) -> None:
@@ -65,6 +65,23 @@ class Interrupted(BaseException):
     def resumable(self, path: str) -> None:
         """Name the checkpoint saved before the signal, the one to go on from (-cont_restart)."""
         self.restart = path
+
+
+def interrupted_in(exc: BaseException) -> Interrupted | None:
+    """The :class:`Interrupted` that ``exc`` is, or that it was raised from or while handling; None if none.
+
+    A signal's exception can reach a handler inside another: Python 3.11 raises RuntimeError("Error calling
+    __set_name__ ...") from any exception raised while a class is made, and a signal that comes during an
+    import is one (a SIGTERM while matplotlib was imported for a result's figure ended a run with that line
+    and status 1, not 143: found by tests/test_kill.py)."""
+    seen: set[int] = set()
+    at: BaseException | None = exc
+    while at is not None and id(at) not in seen:
+        if isinstance(at, Interrupted):
+            return at
+        seen.add(id(at))
+        at = at.__cause__ or at.__context__
+    return None
 
 
 def printable(text) -> str:

@@ -11,6 +11,16 @@ launcher is left alone, and other MPI libraries ignore Open MPI's variables.
 Processes this one starts inherit the variables (harmless on one machine;
 :mod:`petsc_adhesion.benchmarks.leaveout` strips them before its own ``mpiexec``).
 
+Open MPI 4 gives every isolated singleton the same session folder
+(``<tmp>/ompi.<host>.<uid>/jf.0/1/0``): a process that ends removes it while
+another that starts is making it, and that one's MPI_Init aborts with
+"orte_session_dir failed" (``python -m petsc_adhesion.benchmarks.singleton``:
+11 of 1,200 starts failed, eight at a time, and none with a folder each; a CI
+run of the test suite lost two runs to it).  Each singleton therefore
+gets a session folder of its own, named by its process id (:func:`session_folder`);
+a folder named so for another process (inherited from the process that started
+this one) is replaced, one the user named is kept.
+
 :func:`surroundings` says, before MPI_Init, what in the process's surroundings would make Open MPI's
 start-up fail with its page of text and an abort (the command line and the library's start ask it).
 """
@@ -19,8 +29,8 @@ from __future__ import annotations
 import os
 from collections.abc import MutableMapping
 
-__all__ = ["OPENMPI_SINGLETON", "launched", "singleton_defaults", "surroundings", "SHARED_MEMORY_VARIABLES",
-           "SHARED_MEMORY_DEFAULT"]
+__all__ = ["OPENMPI_SINGLETON", "SESSION_VARIABLE", "launched", "session_folder", "singleton_defaults",
+           "surroundings", "SHARED_MEMORY_VARIABLES", "SHARED_MEMORY_DEFAULT"]
 
 #: Open MPI's variables for a process that talks to no other
 OPENMPI_SINGLETON = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_ess_singleton_isolated": "1"}
@@ -34,11 +44,39 @@ def launched(environ: MutableMapping[str, str] = os.environ) -> bool:
     return any(v in environ for v in _LAUNCHER_VARIABLES)
 
 
-def singleton_defaults(environ: MutableMapping[str, str] = os.environ) -> None:
-    """Before MPI_Init: :data:`OPENMPI_SINGLETON` where not launched and not set by the user."""
-    if not launched(environ):
-        for k, v in OPENMPI_SINGLETON.items():
-            environ.setdefault(k, v)
+#: Open MPI 4's variable that places a job family's session folder (an isolated singleton's whole one)
+SESSION_VARIABLE = "OMPI_MCA_orte_jobfam_session_dir"
+#: The start of the name of a session folder this module chose (the process id follows)
+_SESSION_NAME = "petsc-adhesion-singleton."
+
+
+def session_folder(environ: MutableMapping[str, str], pid: int) -> str:
+    """The session folder of the isolated singleton ``pid``: in the folder Open MPI would use for its
+    sessions (``OMPI_MCA_orte_tmpdir_base``, else TMPDIR, else /tmp), ``ompi.<uid>/petsc-adhesion-singleton.<pid>``.
+    Open MPI makes it (with its parents) in MPI_Init and removes it in MPI_Finalize; no two live processes
+    share a process id, so no two share the folder."""
+    base = environ.get("OMPI_MCA_orte_tmpdir_base") or environ.get("TMPDIR") or "/tmp"
+    return os.path.join(base, f"ompi.{os.getuid()}", f"{_SESSION_NAME}{pid}")
+
+
+def _ours_for_another(path: str, pid: int) -> bool:
+    """Whether ``path`` is a session folder this module chose for a process other than ``pid``."""
+    name = os.path.basename(path)
+    return name.startswith(_SESSION_NAME) and name != f"{_SESSION_NAME}{pid}"
+
+
+def singleton_defaults(environ: MutableMapping[str, str] = os.environ, pid: int | None = None) -> None:
+    """Before MPI_Init: :data:`OPENMPI_SINGLETON` where not launched and not set by the user, and, for an
+    isolated singleton, a session folder of its own (:func:`session_folder`; ``pid``: this process's id)."""
+    if launched(environ):
+        return
+    for k, v in OPENMPI_SINGLETON.items():
+        environ.setdefault(k, v)
+    if environ.get("OMPI_MCA_ess_singleton_isolated") != "1":
+        return          # Open MPI's daemon gives the process a folder named by its id itself
+    pid = os.getpid() if pid is None else pid
+    if SESSION_VARIABLE not in environ or _ours_for_another(environ[SESSION_VARIABLE], pid):
+        environ[SESSION_VARIABLE] = session_folder(environ, pid)
 
 
 #: Where Open MPI's shared-memory transport keeps its segments, the variable that moves it (Open MPI 4's vader,

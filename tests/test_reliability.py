@@ -216,6 +216,33 @@ def test_signal_ends_cleanly(tmp_path, signum):
     assert sorted(os.listdir(tmp_path)) == ["r.h5", "r.json"]
 
 
+def test_a_signal_python_wraps_ends_the_run_as_the_signal(tmp_path, monkeypatch):
+    """A signal that comes while a class is made (an import: matplotlib's, for the figure, in the writing) is
+    raised by Python 3.11 as RuntimeError("Error calling __set_name__ ...") from the signal's exception: the
+    run still ends as interrupted (status 128 + 15, its one line), and the earlier set stays whole.  The
+    signal is raised where its handler would raise it, inside a class's __set_name__."""
+    from petsc_adhesion.errors import Interrupted
+    from petsc_adhesion.io.plot import curve as plot_curve
+
+    out = ("-out", "r.h5", "-summary", "r.json")
+    assert conftest.in_process(*CURVE, *out, cwd=tmp_path).returncode == 0
+    before = _set(tmp_path)
+
+    class SignalHere:
+        def __set_name__(self, owner, name):
+            raise Interrupted(signal.SIGTERM)
+
+    def drawn_while_imported(*args):
+        type("Figure", (), {"patch": SignalHere()})
+
+    monkeypatch.setattr(plot_curve, "curve_figure", drawn_while_imported)
+    proc = conftest.in_process(*CURVE, *out, "-plot", "r.png", cwd=tmp_path)
+    assert (proc.returncode, proc.stderr.strip()) == (128 + signal.SIGTERM,
+                                                      f"{PREFIX}interrupted by SIGTERM; nothing written")
+    assert _set(tmp_path) == before
+    assert sorted(os.listdir(tmp_path)) == ["r.h5", "r.json"]
+
+
 def test_journal_of_a_killed_commit_is_finished_by_the_next_run(tmp_path):
     """A run killed between the journal and its renames: the next run writing those names completes
     the set it was committing (roll forward) and removes dead runs' temporaries."""

@@ -1,13 +1,14 @@
 """Open MPI singleton defaults (petsc_adhesion/singleton.py): a plain run gets them, a launched one does
 not, a user's setting wins, and MPI works either way."""
 import json
+import os
 import shutil
 import subprocess
 import sys
 
 import pytest
 
-from petsc_adhesion.singleton import OPENMPI_SINGLETON, singleton_defaults
+from petsc_adhesion.singleton import OPENMPI_SINGLETON, SESSION_VARIABLE, session_folder, singleton_defaults
 
 from conftest import ROOT, _env
 
@@ -36,9 +37,10 @@ def _probe(cmd, env):
 
 
 def test_user_setting_and_launcher_win():
-    env = {"OMPI_MCA_pml": "ucx"}
-    singleton_defaults(env)
-    assert env == {"OMPI_MCA_pml": "ucx", "OMPI_MCA_ess_singleton_isolated": "1"}
+    env = {"OMPI_MCA_pml": "ucx", "TMPDIR": "/scratch"}
+    singleton_defaults(env, pid=17)
+    assert env == {"OMPI_MCA_pml": "ucx", "OMPI_MCA_ess_singleton_isolated": "1", "TMPDIR": "/scratch",
+                   SESSION_VARIABLE: f"/scratch/ompi.{os.getuid()}/petsc-adhesion-singleton.17"}
     for launcher in ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "SLURM_PROCID"):
         env = {launcher: "0"}
         singleton_defaults(env)
@@ -58,3 +60,35 @@ def test_process_under_mpiexec_is_left_alone():
     assert len(outs) == 2
     for out in outs:
         assert out == {"size": 2, "sum": 3, "env": {k: None for k in OPENMPI_SINGLETON}}
+
+
+def test_each_isolated_singleton_has_a_session_folder_of_its_own():
+    """Open MPI 4 puts every isolated singleton's session in one folder, which one process removes while
+    another makes it (MPI_Init aborts: benchmarks/singleton.py).  Two processes get two folders; a folder
+    chosen for another process (inherited from the one that started this) is replaced, one the user named is
+    kept, and a singleton with its daemon (not isolated) is left to Open MPI's folder named by its id."""
+    a, b = {}, {}
+    singleton_defaults(a, pid=101)
+    singleton_defaults(b, pid=102)
+    assert a[SESSION_VARIABLE] != b[SESSION_VARIABLE]
+    inherited = dict(a)
+    singleton_defaults(inherited, pid=103)
+    assert inherited[SESSION_VARIABLE] == session_folder(a, 103)
+    users = {SESSION_VARIABLE: "/scratch/mine"}
+    singleton_defaults(users, pid=104)
+    assert users[SESSION_VARIABLE] == "/scratch/mine"
+    daemon = {"OMPI_MCA_ess_singleton_isolated": "0"}
+    singleton_defaults(daemon, pid=105)
+    assert SESSION_VARIABLE not in daemon
+
+
+def test_open_mpi_keeps_the_session_in_the_folder_and_removes_it(tmp_path):
+    """The folder named is the one Open MPI makes in MPI_Init and removes in MPI_Finalize (read from the
+    file system, not from the variable): a session folder the variable did not move would be the shared one."""
+    code = ("import os, json, petsc_adhesion; from mpi4py import MPI; MPI.COMM_WORLD.Get_size(); "
+            "d = os.environ['%s']; print(json.dumps({'folder': d, 'during': sorted(os.listdir(d))}))" % SESSION_VARIABLE)
+    env = _clean_env(TMPDIR=str(tmp_path))
+    (out,) = _probe([sys.executable, "-c", code], env)
+    assert out["folder"].startswith(str(tmp_path / f"ompi.{os.getuid()}" / "petsc-adhesion-singleton."))
+    assert out["during"], "Open MPI made nothing in the folder"
+    assert not os.path.exists(out["folder"]), "the session folder outlived the process"

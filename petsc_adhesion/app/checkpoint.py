@@ -42,7 +42,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..errors import InputError, Interrupted, collective, first_line, printable
+from ..errors import InputError, collective, first_line, interrupted_in, printable
 from ..io.inputs import check_input
 from ..io.resultset import ResultSet, atomic_write, check_targets
 from ..io.values import decode, encode
@@ -375,9 +375,10 @@ class Checkpoint:
         the block: the command line's last word says how to go on."""
         try:
             yield
-        except Interrupted as e:
-            if self.exists():
-                e.resumable(self.path)
+        except BaseException as e:
+            signal_ = interrupted_in(e)     # a signal during an import inside the block comes wrapped
+            if signal_ is not None and self.exists():
+                signal_.resumable(self.path)
             raise
 
     def exists(self) -> bool:

@@ -19,7 +19,7 @@ import sys
 import time
 from contextlib import nullcontext
 
-from ..errors import Interrupted, first_line, printable, say, tell
+from ..errors import Interrupted, first_line, interrupted_in, printable, say, tell
 from ..io.resultset import said_after
 from ..singleton import surroundings
 from .optionsfile import environment_error, file_error, named_file_error, options_files, stray_word
@@ -100,6 +100,14 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         for s, handler in old.items():
             signal.signal(s, handler)
+
+
+def _signal_within(e: BaseException) -> None:
+    """Raise the signal's :class:`Interrupted` that ``e`` wraps (:func:`~petsc_adhesion.errors.interrupted_in`),
+    for :func:`main` to end the run as interrupted, not failed."""
+    signal_ = interrupted_in(e)
+    if signal_ is not None:
+        raise signal_ from None
 
 
 def _undecodable(argv: list[str]) -> str | None:
@@ -214,11 +222,13 @@ def _main(argv: list[str]) -> int:
         _say(str(why) if isinstance(why, InputError) else why)
         return EXIT_INPUT if isinstance(why, InputError) else EXIT_FAILED
     except (RuntimeError, FloatingPointError, OSError) as e:
+        _signal_within(e)
         what = f"cannot write '{e.filename}': {e.strerror}" if isinstance(e, OSError) and e.filename \
             else first_line(e)
         _say(what)
         return EXIT_FAILED
     except Exception as e:                                  # a defect: still one line, no hang
+        _signal_within(e)
         say(f"internal error on rank {MPI.COMM_WORLD.Get_rank()}: {type(e).__name__}: {printable(first_line(e))}")
         if MPI.COMM_WORLD.Get_size() > 1:
             MPI.COMM_WORLD.Abort(EXIT_FAILED)

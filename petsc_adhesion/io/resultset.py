@@ -29,7 +29,7 @@ import socket
 import stat
 from contextlib import contextmanager
 
-from ..errors import InputError, Interrupted, printable, say
+from ..errors import InputError, Interrupted, interrupted_in, printable, say
 
 __all__ = ["check_targets", "ResultSet", "written", "mark_done", "said_after", "atomic_write", "PLOT_FORMATS", "plot_format",
            "JOURNAL"]
@@ -294,9 +294,10 @@ def written(targets: dict, drop=()):
     files = ResultSet(targets, drop)
     try:
         yield files
-    except Interrupted as e:
-        if not files.committed:
+    except BaseException as e:
+        signal_ = interrupted_in(e)     # a signal during an import inside the block comes wrapped
+        if signal_ is None or not files.committed:
             raise
-        said_after(e.signum)
+        said_after(signal_.signum)
     finally:
         files.discard()

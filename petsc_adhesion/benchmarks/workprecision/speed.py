@@ -18,7 +18,7 @@ from ...app.options.reading import AppOptions, read_settings
 from ...discretization import grid
 from ...discretization.preconditioning import create as create_pmat
 from ...model.parameters import Model
-from ...singleton import OPENMPI_SINGLETON
+from ...singleton import OPENMPI_SINGLETON, SESSION_VARIABLE
 from ...tracing.edge_grids import RMAX
 from .accuracy import ENV, REPEATS, SCALE_N, SCALE_STEPS, SLOW, _trace
 
@@ -32,7 +32,9 @@ def _user_env(singleton: bool = True) -> dict:
     with petsc-adhesion's Open MPI singleton defaults unless ``singleton`` is False.  The cache is written
     first, as by a user's first run."""
     compileall.compile_dir(os.path.dirname(os.path.dirname(__file__)), quiet=1)
-    env = {k: v for k, v in os.environ.items() if k not in OPENMPI_SINGLETON and k != "PYTHONDONTWRITEBYTECODE"}
+    # the session folder this process's own import chose is its own: a timed process chooses its own
+    env = {k: v for k, v in os.environ.items()
+           if k not in OPENMPI_SINGLETON and k not in (SESSION_VARIABLE, "PYTHONDONTWRITEBYTECODE")}
     return env | ENV | (OPENMPI_SINGLETON if singleton else {})
 
 
