@@ -595,8 +595,8 @@ def test_the_shape_preserving_cubic_keeps_a_step_monotone_and_a_smooth_curve_to_
 
 @pytest.mark.parametrize("mu, sigma, within", [(0.178, 1.5, 0.003), (0.0316, 0.2, 0.03)])
 def test_a_sparse_rough_node_is_sampled_as_its_refined_curve(mu, sigma, within):
-    """A rough node's default curve has few points (34 and 35 here) about the pull-off, and its cubic splines
-    swung past them: at (0.178, 1.5) the table's pull-off was -0.075 (an earlier table: docs/family.md) against
+    """A rough curve traced with the library's default steps (no bound on its bend: a table's nodes now have one,
+    and 78 and 114 points here) has few points (34 and 35) about the pull-off, and cubic splines swung past them: at (0.178, 1.5) the table's pull-off was -0.075 (an earlier table: docs/family.md) against
     the solver's -0.0139, at (0.0316, 0.2) -0.944 against -0.644.  Sampled shape-preserving through its points
     and located turning points, its pull-off is the one located on the curve traced with steps 8 times
     shorter (within 1e-4 of it), and its F at every tau node that curve's within ``within`` (the spline's were
@@ -619,7 +619,9 @@ def test_a_sparse_rough_node_is_sampled_as_its_refined_curve(mu, sigma, within):
     model = Model(mu=mu, sigma=sigma)
     fine = curve_settings(step_scale(model), observable_max=F_MAX + _PAST)
     fine = replace(fine, ds=fine.ds / 8, ds_max=fine.ds_max / 8)
-    coarse_c, fine_c = trace_node(mu, sigma), trace_curve(model, settings=fine, request=CurveRequest(error_bars=False))
+    coarse_c = trace_curve(model, settings=curve_settings(step_scale(model), observable_max=F_MAX + _PAST),
+                           request=CurveRequest(error_bars=False))
+    fine_c = trace_curve(model, settings=fine, request=CurveRequest(error_bars=False))
     assert coarse_c.branch.lam.size < 40 and fine_c.branch.lam.size > 100
     coarse, ref = sampled(coarse_c), sampled(fine_c)
     assert coarse.shape is not None                       # the spline was not kept: it swung or missed
@@ -655,9 +657,14 @@ def test_a_node_the_default_steps_leave_incomplete_is_traced_with_shorter_ones(m
     with steps a quarter as long (FINER) and tabulated, its pull-off the one the default curve had located, to
     1e-4 (a trace with other steps: the two agree where the coarse one resolved its minimum).  The default curve
     is the one `build` traced first, kept as it passes (the same call as trace_node(mu, sigma) on one rank):
-    traced once, not again here."""
+    traced once, not again here.  The nodes' bound on their bend (WALL_BEND_F) makes this node's default curve
+    complete (its steps shorter where F bends), so the curves here are traced without it, as the node was
+    before: the way back to shorter steps is what is tested."""
     from petsc_adhesion.family import build as building
     from petsc_adhesion.family.build import FINER
+    from petsc_adhesion.tracing import trace as tracing
+
+    monkeypatch.setattr(tracing, "wall_bend", lambda model: math.inf)
 
     mu, sigma = 10 ** 0.5, 0.2
     traced, trace = [], building.trace_node

@@ -162,7 +162,7 @@ def test_a_branch_traced_without_its_cycles_holds_the_same_points_and_says_the_e
 
 def test_a_rough_branch_keeps_the_kink_where_the_rules_wall_stops_the_sphere():
     """mu = 0.0055, sigma = 1 behind K = 0.19: the roughness rule's outermost wall stops the sphere at lambda of about
-    -5.7, dF/dlambda turning from 0 to 50 within 0.02 epsilon.  The fit's branch (its steps' bend bounded, BEND_F)
+    -5.7, dF/dlambda turning from 0 to 50 within 0.02 epsilon.  The fit's branch (its steps' bend bounded, WALL_BEND_F)
     reads within 1e-3 of 2 pi R w of a curve traced with steps of 0.01 in F and in the state (the refinement's
     truth: 2.1e-4 measured, against 0.044 with the steps bounded in F alone, 15 times the noise of 0.3%), and a
     synthetic curve's truth within 5e-4 (3.1e-4 measured, a tenth of that noise), with finer steps (as the

@@ -4,7 +4,10 @@ ranks, each curve sampled on the table's coordinate (:mod:`~petsc_adhesion.famil
 Each node is the library's default curve (:func:`~petsc_adhesion.tracing.trace.trace_curve`:
 grids that follow the contact edge, the default roughness rule, no error bars) traced
 on one rank (``PETSc.COMM_SELF``) past the table's F_max, so that its end F = F_max
-lies between two traced points.  The nodes go to the ranks the costliest first
+lies between two traced points; on a rough sphere its steps bend the load by at most
+:data:`~petsc_adhesion.tracing.trace.WALL_BEND_F` from its tangent's line, so that the
+kink where the roughness rule's outermost wall stops the sphere is a point of the curve,
+not rounded over by a spline through steps on either side of it (as fits' branches).  The nodes go to the ranks the costliest first
 (the cost grows with mu: 0.1 s at mu = 1e-3, 0.7 s at mu = 1, 7 s at mu = 10, 20 s at
 mu = 100, 85 s at mu = 1000 on this machine, docs/family.md), each to the rank with
 the least work so far; rank 0 gathers them.  Collective.
@@ -71,10 +74,11 @@ def trace_node(mu: float, sigma: float, F_max: float = F_MAX, comm=None, step: f
     """The default curve of (mu, sigma), no error bars, traced past ``F_max`` (a Curve; collective on comm);
     ``step``: its steps (first, largest and the events' unit) as a fraction of the default's."""
     from ..discretization.problem import step_scale
-    from ..tracing.trace import CurveRequest, curve_settings, trace_curve
+    from ..tracing.trace import CurveRequest, curve_settings, trace_curve, wall_bend
 
     model = Model(mu=mu, sigma=sigma, roughness=ROUGHNESS)
-    return trace_curve(model, settings=curve_settings(step * step_scale(model), observable_max=F_max + _PAST),
+    return trace_curve(model, settings=curve_settings(step * step_scale(model), observable_max=F_max + _PAST,
+                                                      observable_bend=wall_bend(model) * step),
                        request=CurveRequest(error_bars=False), comm=comm)
 
 

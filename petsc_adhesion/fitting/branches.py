@@ -41,12 +41,6 @@ __all__ = ["SolverBranch", "BranchCache", "BRANCHES", "STEP_F", "f_level", "bran
 
 #: The branch's largest step in F (units 2 pi R w; the continuation's observable_step).
 STEP_F = 0.05
-#: The largest distance of a rough branch's load from its tangent's line in one step (units 2 pi R w; the
-#: continuation's observable_bend): where the roughness rule's outermost wall stops the sphere, dF/dlambda turns
-#: from 0 to 50 within 0.02 epsilon, a kink the steps of STEP_F alone passed over, the spline through their points
-#: rounding it by 0.044 (mu = 0.0055, sigma = 1, behind K = 0.19: 15 times the noise of 0.3%); with this bound
-#: 2.1e-4, in the same CPU.
-BEND_F = 1e-3
 #: The branch's largest continuation step in units of mu where its curve is traced in those units (mu >= 20).
 DS_MAX_PER_MU = 0.05
 #: The loads the branches are traced to: F_LADDER times powers of 2, RUNGS of them an octave (2, 2.83, 4, 5.66, ...):
@@ -68,8 +62,8 @@ def branch_settings(model, f_max: float):
     """The continuation's settings of a branch: the library's curve's in its units
     (:func:`~petsc_adhesion.discretization.problem.step_scale`: mu from 20 on, as the table's curves are traced)
     to the load ``f_max``, with steps of at most STEP_F in F and of at most DS_MAX_PER_MU times mu in the
-    continuation's norm there, the quadratic predictor, and on a rough sphere F within BEND_F of its tangent's line
-    in a step.
+    continuation's norm there, the quadratic predictor, and on a rough sphere F within
+    :data:`~petsc_adhesion.tracing.trace.WALL_BEND_F` of its tangent's line in a step.
 
     Why the units: in units of 1 a branch at mu = 100 took 4878 steps (the continuation's cap is 5000; at mu =
     1000 it would stop at the cap) where lambda runs over 1000 epsilon: 104 s of CPU.  In units of mu with steps
@@ -85,11 +79,11 @@ def branch_settings(model, f_max: float):
     behind K = 0.005 to 0.5 within 4e-5 of the linear predictor's, in about 0.8 of its CPU (docs/fitting.md,
     "What a branch costs")."""
     from ..discretization.problem import step_scale
-    from ..tracing.trace import curve_settings
+    from ..tracing.trace import curve_settings, wall_bend
 
     scale = step_scale(model)
     s = curve_settings(scale, observable_max=f_max, observable_step=STEP_F, predictor="quadratic",
-                       observable_bend=BEND_F if model.sigma > 0 and model.roughness != "none" else math.inf)
+                       observable_bend=wall_bend(model))
     return s if scale == 1.0 else replace(s, ds=min(s.ds, DS_MAX_PER_MU * scale), ds_max=DS_MAX_PER_MU * scale)
 
 

@@ -67,7 +67,7 @@ def truth_settings(model: Model, top: float, finer: float = 1.0):
     """The continuation's settings of a curve made to be measured (:func:`forward_curve`) to the load ``top``:
     below mu = MU_SOFT the library's curve's (units of 1); from MU_SOFT on a fit's branch's
     (:func:`~petsc_adhesion.fitting.branches.branch_settings`: units of mu, steps of at most 0.05 mu and 0.05
-    in F), their largest steps divided by ``finer``; on a rough sphere the load within BEND_F / (2 finer) of its
+    in F), their largest steps divided by ``finer``; on a rough sphere the load within WALL_BEND_F / (2 finer) of its
     tangent's line in a step (:func:`rough_truth`).
 
     Why: in units of 1 a curve at mu = 60 took 45 CPU s (lambda runs over some 600 epsilon in steps of at most
@@ -86,7 +86,8 @@ def truth_settings(model: Model, top: float, finer: float = 1.0):
 
 
 def rough_truth(settings, model: Model, finer: float = 1.0):
-    """``settings`` with, on a rough sphere, the load within BEND_F / (2 finer) of its tangent's line in a step.
+    """``settings`` with, on a rough sphere, the load within
+    :data:`~petsc_adhesion.tracing.trace.WALL_BEND_F` / (2 finer) of its tangent's line in a step.
 
     Why: a rough sphere's load turns sharply where the roughness rule's outermost wall stops it (at mu = 0.0055,
     sigma = 1, dF/dlambda from 0 to 50 within 0.02 epsilon); steps bounded in F and in the state's norm alone pass
@@ -94,11 +95,9 @@ def rough_truth(settings, model: Model, finer: float = 1.0):
     with 0.2 and 0.05 steps differed from one another by chi^2 of 165 to 11,594 at 0.3% noise, where a fit's
     model at the truth must meet its curve to the noise.  With the bound at 5e-4 the curve is within 3.1e-4 of
     one with steps of 0.005 (a tenth of 0.3% noise), with finer = 2 (the bound 2.5e-4) within 1.1e-5."""
-    from .branches import BEND_F
+    from ..tracing.trace import wall_bend
 
-    if model.sigma > 0 and model.roughness != "none":
-        return replace(settings, observable_bend=min(settings.observable_bend, BEND_F / (2.0 * finer)))
-    return settings
+    return replace(settings, observable_bend=min(settings.observable_bend, wall_bend(model) / (2.0 * finer)))
 
 
 def forward_curve(model: Model, K: float, top: float = 2.0, grid=None, solver=None, settings=None,
