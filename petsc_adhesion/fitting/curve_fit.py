@@ -68,7 +68,7 @@ from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines,
 from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, profiled, to_moduli, verdicts
 from .pull_off import maugis_dugdale_gamma
 from .results import CurveFit, Features, FitChoice, FittedFeatures, Spring, misfit, misfit_p
-from .table_search import START_MUS, START_SIGMAS, TABLE_CAP, TableStep, search_cap, start_gamma, cpu, mu_profile, solver_steps, table_bounds
+from .table_search import START_MUS, START_SIGMAS, TABLE_CAP, TableStep, search_cap, searched, start_gamma, cpu, mu_profile, solver_steps, table_bounds
 
 if TYPE_CHECKING:
     from ..family.table import FamilyTable
@@ -123,11 +123,11 @@ class _Problem:
     t0: float = field(default_factory=time.perf_counter)
     table: FamilyTable | None = None   # the FamilyTable the search runs on (None: the solver's curves)
     upper: np.ndarray | None = None     # the search's upper bounds (a table's differences turn back at them)
+    mu_span: tuple | None = None        # where the table's profile of mu ran (table_search.mu_profile)
 
     def __post_init__(self):
         self.legs = np.r_[np.zeros(self.data.turn, int), np.ones(self.data.z.size - self.data.turn, int)]
-        # the branch each point is on, as the measured jumps say: 0 off the contact, 1 in contact, -1 where
-        # the curve shows no jump (there the model's own jumps decide)
+        # each point's branch, as the measured jumps say: 0 off the contact, 1 in it, -1 no jump (the model's decide)
         self.R, self.eps = self.bodies.R, self.bodies.epsilon
         feat = self.feat
         turn, n = self.data.turn, self.data.z.size
@@ -444,7 +444,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
             x[names.index("F0")] = (base[0] + base[1] * x[j] * eps) / noise
         return x, float(np.sum(pb._all(pb.unpack(x))[0] ** 2))
 
-    c0 = cpu()
+    c0, tries = cpu(), []
     if modulus is not None:
         x0, _ = start(float(modulus))
     else:
@@ -454,17 +454,17 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         sigmas = START_SIGMAS if pb.table is not None and choice.roughness else (sigma0,)
         tries = [start((start_gamma(P, R, m, s_, w_guess) if s_ > 0 else w_guess) * math.sqrt(R / (m**3 * eps**3)),
                        s_) for m in mus for s_ in sigmas]
-        x0 = min(tries, key=lambda t: t[1])[0]
+        x0 = min(tries, key=lambda t: t[1])[0]   # (the others: table_search.searched)
     pb.leave_out_edges(x0)
     lo, hi = bounds(pb, choice, modulus)
     if pb.table is not None:
         lo, hi = table_bounds(pb.table, names, lo, hi, modulus, R, eps)
         pb.upper = hi
-    x0 = np.clip(x0, lo + 1e-9 * (hi - lo if np.all(np.isfinite(hi - lo)) else 1), hi - 1e-9)
     pb.evaluations = 0
     cap = search_cap(choice, pb.table)
-    res = least_squares(pb.residuals, x0, jac=pb.jacobian, bounds=(lo, hi), method="trf", x_scale="jac",
-                        ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=cap)
+    res = searched(lambda x: least_squares(pb.residuals, x, jac=pb.jacobian, bounds=(lo, hi), method="trf",
+                                           x_scale="jac", ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=cap),
+                   x0, tries, lo, hi, pb.table is not None and choice.roughness)
     A = to_moduli(names)
     d, path = None, f"the solver's curves throughout: {why_not}"
     profile = None

@@ -92,8 +92,9 @@ def rough_first(fit, choice, model, bodies, mu_bounds: tuple):
     """A rough fit with ``-fit_table default`` (the roughness fitted, or held at a sigma > 0 of ``bodies``) where
     the shipped rough table holds its sigma (a fitted one: over the whole search, 0 to SIGMA_SEARCH) but mu over
     part of ``mu_bounds`` alone: ``fit("rough")`` (the search on the rough table, the final numbers from the
-    solver), kept where mu's 95% interval ends inside the table; else ``fit("none")`` (the solver's curves
-    throughout, over all of ``mu_bounds``), its path saying why.  None where this does not apply (smooth;
+    solver), kept where mu's 95% interval ends inside the table (where the curve hardly determines mu, where the
+    table's profile of mu ends: the linear interval runs to 1e139 at the DMT end); else ``fit("none")`` (the
+    solver's curves throughout, over all of ``mu_bounds``), its path saying why.  None where this does not apply (smooth;
     another rule, ``model``; a rough table that holds all of mu, which "default" takes itself).
 
     Why: on the solver's curves throughout a rough fit takes some 75 traces (82 CPU s at mu = 0.0055, sigma = 1);
@@ -104,7 +105,7 @@ def rough_first(fit, choice, model, bodies, mu_bounds: tuple):
     import numpy as np
 
     from ..family.table import shipped_path
-    from .results import MISFIT_P
+    from .results import BOUND_MARGIN, MISFIT_P
 
     sigma = 0.0 if bodies.rms is None else bodies.rms / bodies.epsilon
     if not (choice.roughness or sigma > 0) or not os.path.exists(shipped_path("rough")) or \
@@ -126,9 +127,14 @@ def rough_first(fit, choice, model, bodies, mu_bounds: tuple):
     else:
         var = 4.0 / 9.0 * float(cov[names.index("ln_gamma"), names.index("ln_gamma")])
     top = math.log(first.mu) + 1.96 * math.sqrt(var) if math.isfinite(var) and var >= 0 else math.inf
+    span = getattr(first.path, "mu_span", None)
+    if span is not None:                # mu hardly determined: the profile's reach, not the line's (+-1e139)
+        top = math.log(span[1])
     edge = float(t.mu[-1])
     misfit = not first.p_value >= MISFIT_P
-    if top < math.log(edge) - 1e-9 and not misfit:
+    # a mu at the table's end (within BOUND_MARGIN) is the search's bound, not the data's (its profile goes
+    # inwards alone from there: mu = 1, ending 7e-9 inside, was kept)
+    if top < math.log(edge) - 1e-9 and math.log(first.mu) < math.log(edge) - BOUND_MARGIN and not misfit:
         return first
     from dataclasses import replace
 

@@ -65,9 +65,12 @@ def verdicts(pb, choice: FitChoice, x, lo, hi, p: dict, sd: dict, modulus) -> tu
         edge = at[name]
         if name == "ln_mu" or (name == "ln_gamma" and not choice.modulus and
                                 math.log(1e-6) < edge < math.log(100.0)):
-            # the search's range: the model's, or a table's that holds less of it (the rough one: mu to 1)
-            rng = MU_BOUNDS if getattr(pb, "table", None) is None else (float(pb.table.mu[0]), float(pb.table.mu[-1]))
-            whose = "the model's" if rng == MU_BOUNDS else "the table's"
+            # the search's range: the model's, or a table's that holds less of it (the rough one: mu to 1), read
+            # from the search's bounds (the table is gone by now: the solver's curves took over after it)
+            k = pb.names.index("ln_mu") if "ln_mu" in pb.names else None
+            rng = MU_BOUNDS if k is None else (math.exp(lo[k]), math.exp(hi[k]))
+            model_s = all(math.isclose(a, b, rel_tol=1e-6) for a, b in zip(rng, MU_BOUNDS))
+            rng, whose = (MU_BOUNDS, "the model's") if model_s else (rng, "the table's")
             mu_edge = rng[0] if p["mu"] < math.sqrt(rng[0] * rng[1]) else rng[1]
             where = f"mu = {p['mu']:.4g} is at the bound {mu_edge:g} of {whose} range [{rng[0]:g}, {rng[1]:g}]"
             e = sd.get("ln_E_star") if name == "ln_mu" else None
