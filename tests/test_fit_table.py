@@ -161,6 +161,15 @@ def test_the_error_is_measured_on_the_piece_each_point_is_on():
     assert eF < 1e-3 and eZ < 1e-3 and eJ < 1e-3, (eF, eZ, eJ)
 
 
+def _rough_curve(mu: float, sigma: float, k: float = 1.0, noise_share: float = 0.01, seed: int = 3):
+    """A curve the solver made at (mu, sigma) behind k N/m (w = 0.05 J/m^2, E* by eq. 9), noise a share of
+    2 pi R w; its E*."""
+    E = W * math.sqrt(R / (mu**3 * EPS**3))
+    truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=EPS, gamma=W, rms=sigma * EPS)
+    return synthetic_curve(truth, Spring(k), Sampling(noise=noise_share * 2 * math.pi * R * W, points=300,
+                                                      z0=3e-9, F0=1e-10, seed=seed)), E
+
+
 @pytest.mark.parametrize("mu, sigma", [(0.2, 0.12), (0.2, 0.25)])
 def test_a_rough_curve_fitted_through_the_rough_table_recovers_w_and_E(mu, sigma):
     """A curve the solver made on a rough surface (mu = 0.2 between the rough table's nodes; sigma = 0.12 between
@@ -168,10 +177,7 @@ def test_a_rough_curve_fitted_through_the_rough_table_recovers_w_and_E(mu, sigma
     table: w and E* within their 95% intervals, the path the table's and one to three solver curves after it.  (A
     fitted roughness is refused by a table that does not hold sigma from 0 to 3, the search's range: it would
     leave the table mid-fit.)"""
-    E = W * math.sqrt(R / (mu**3 * EPS**3))
-    truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=EPS, gamma=W, rms=sigma * EPS)
-    data = synthetic_curve(truth, Spring(1.0), Sampling(noise=0.01 * 2 * math.pi * R * W, points=300, z0=3e-9,
-                                                        F0=1e-10, seed=3))
+    data, E = _rough_curve(mu, sigma)
     tip = Bodies(radius=R, young1=None, poisson1=None, epsilon=EPS, rms=sigma * EPS)
     fit = fit_curve(data, tip, Spring(1.0), table="rough")
     assert isinstance(fit.path, TableStep) and fit.path.table == "rough" and 1 <= fit.path.curves <= 3, fit.path
@@ -185,10 +191,7 @@ def default_rough_fit():
     """-fit_table default with the roughness fitted (mu = 0.0055, sigma = 1, behind 4 N/m, K = 0.19; 0.3% noise,
     seed 1): the fit, and the truth (w, E*, rms)."""
     mu, sigma = 0.0055, 1.0
-    E = W * math.sqrt(R / (mu**3 * EPS**3))
-    truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=EPS, gamma=W, rms=sigma * EPS)
-    data = synthetic_curve(truth, Spring(4.0), Sampling(noise=0.003 * 2 * math.pi * R * W, points=300, z0=3e-9,
-                                                        F0=1e-10, seed=1))
+    data, E = _rough_curve(mu, sigma, k=4.0, noise_share=0.003, seed=1)
     tip = Bodies(radius=R, young1=None, poisson1=None, epsilon=EPS)
     return fit_curve(data, tip, Spring(4.0), FitChoice(roughness=True)), (W, E, sigma * EPS)
 
@@ -326,10 +329,7 @@ def test_a_mu_at_the_rough_tables_end_is_said_at_the_tables_bound():
     end, and the warning names the table's range, not the model's (it said "mu = 1 is at the bound 1000 of the
     model's range": the table is gone once the solver's curves take over, and the range was read from it)."""
     mu, sigma = 3.0, 0.3
-    E = W * math.sqrt(R / (mu**3 * EPS**3))
-    truth = Bodies(radius=R, young1=E, poisson1=0.0, epsilon=EPS, gamma=W, rms=sigma * EPS)
-    data = synthetic_curve(truth, Spring(1.0), Sampling(noise=0.01 * 2 * math.pi * R * W, points=300, z0=3e-9,
-                                                        F0=1e-10, seed=3))
+    data, E = _rough_curve(mu, sigma)
     tip = Bodies(radius=R, young1=None, poisson1=None, epsilon=EPS, rms=sigma * EPS)
     fit = fit_curve(data, tip, Spring(1.0), table="rough")
     said = [w for w in fit.warnings if "is at the bound" in w]
