@@ -227,8 +227,9 @@ def test_a_rough_fit_whose_mu_reaches_the_rough_tables_end_goes_to_the_solver():
     kept; at +-0.9 at 1.23 of it: the fit is made again on the solver's curves, its path saying so; so too where
     the table's fit is a misfit (p below MISFIT_P).  Where the table's profile of mu ran (mu hardly determined),
     its end decides, not the linear interval: +-0.9 with the profile ending at 0.8 of the table's last mu is
-    kept, and with the profile at the table's end it is not."""
-    from dataclasses import dataclass
+    kept, and with the profile at the table's end it is not; nor is a mu at the table's end whose profile ran
+    inwards alone (ending a hair inside: case 83 of the coverage study was kept so)."""
+    from dataclasses import dataclass, replace
 
     from petsc_adhesion.fitting.forward import rough_first
 
@@ -275,6 +276,10 @@ def test_a_rough_fit_whose_mu_reaches_the_rough_tables_end_goes_to_the_solver():
     made.clear()
     again = rough_first(lambda t: fit(t, 0.9, span=(1e-3, edge)), FitChoice(roughness=True), None, tip, (1e-3, 1e3))
     assert made == ["rough", "none"] and f"95% interval up to {edge:.3g}" in again.path, again.path
+    made.clear()                         # at the table's end, its profile running inwards alone
+    again = rough_first(lambda t: replace(fit(t, 0.9, span=(0.5 * edge, edge * (1 - 1e-8))), mu=edge),
+                        FitChoice(roughness=True), None, tip, (1e-3, 1e3))
+    assert made == ["rough", "none"] and f"stopped at mu = {edge:.3g}, the table's end" in again.path, again.path
 
 
 def test_the_default_takes_the_rough_table_where_its_range_holds_the_fit():

@@ -139,6 +139,7 @@ def rough_first(fit, choice, model, bodies, mu_bounds: tuple):
     from dataclasses import replace
 
     why = (f"the fit on it misfit the data (reduced chi^2 {first.reduced_chi2:.3g})" if misfit else
+           f"the fit on it stopped at mu = {first.mu:.3g}, the table's end" if top < math.log(edge) - 1e-9 else
            f"the fit on it reached mu = {first.mu:.3g} with its 95% interval up to {math.exp(min(top, 700.0)):.3g}")
     return replace(fit("none"), path=f"the solver's curves throughout: the rough table holds mu up to {edge:g}, and "
                                      f"{why}")
