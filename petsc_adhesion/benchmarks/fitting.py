@@ -58,9 +58,9 @@ NOISE_SHARES = (0.003, 0.01, 0.03)
 #: pull-off since version 2; version 3: the fit's steps and bars on the solver's Jacobian, the rebuilt tables,
 #: the truths from mu = 20 on in units of mu; version 4: a rough truth's and a rough branch's bends bounded
 #: (-cont_dF_bend), a rough fit searched on the rough table first and from several sigma, a search on a table
-#: allowed 5 times the cap on evaluations).
+#: allowed 5 times the cap on evaluations; version 5: the rough table rebuilt with its nodes' bends bounded).
 SIGMA_TOP = 2.0
-TABLE_COVERAGE_VERSION = 4
+TABLE_COVERAGE_VERSION = 5
 #: In the order the cases run: one rough case after every ROUGH_EVERY smooth ones.
 ROUGH_EVERY = 4
 
