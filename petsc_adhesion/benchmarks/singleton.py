@@ -65,8 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("-starts", type=int, default=1200, help="processes started for each way (default 1200)")
     parser.add_argument("-at_once", type=int, default=8, help="processes running at a time (default 8)")
     a = parser.parse_args(argv)
-    if a.starts < 1 or a.at_once < 1:
-        parser.error("-starts and -at_once take a positive whole number")
+    for name in ("starts", "at_once"):
+        if getattr(a, name) < 1:
+            parser.error(f"-{name}: takes a positive whole number, got {getattr(a, name)}")
     print(f"{a.starts} isolated singleton starts, {a.at_once} at a time, load {os.getloadavg()[0]:.1f}")
     for way, name in (("shared", "one session folder for all (Open MPI 4's)"),
                       ("own", "a folder each (petsc-adhesion's singleton defaults)")):
