@@ -94,8 +94,8 @@ def rough_first(fit, choice, model, bodies, mu_bounds: tuple):
     part of ``mu_bounds`` alone: ``fit("rough")`` (the search on the rough table, the final numbers from the
     solver), kept where mu's 95% interval ends inside the table (where the curve hardly determines mu, where the
     table's profile of mu ends: the linear interval runs to 1e139 at the DMT end); else ``fit("none")`` (the
-    solver's curves throughout, over all of ``mu_bounds``), its path saying why.  None where this does not apply (smooth;
-    another rule, ``model``; a rough table that holds all of mu, which "default" takes itself).
+    solver's curves throughout, over all of ``mu_bounds``), its path saying why.  None where this does not apply
+    (smooth; another rule, ``model``; a rough table that holds all of mu, which "default" takes itself).
 
     Why: on the solver's curves throughout a rough fit takes some 75 traces (82 CPU s at mu = 0.0055, sigma = 1);
     through the rough table 3 (2.1 s) to the same optimum (mu 0.0053055 against 0.0053061).  A search bounded
