@@ -374,6 +374,27 @@ def speed(table: FamilyTable, repeats: int = 20, out=print) -> None:
                     f"{1e3 * np.median(cpu):.2f} | {len(sc.legs.pieces)} |")
 
 
+#: The regions of docs/family.md's error table: sigma and mu ranges (the centres strictly inside).
+REGIONS_SIGMA = ((0.02, 0.2), (0.2, 0.5), (0.5, 1.0), (1.0, 3.0))
+REGIONS_MU = ((0.0, 0.03), (0.03, 1.0))
+
+
+def regions(table: FamilyTable, out=print) -> None:
+    """The table's measured error at its centres, median / largest over each region of (sigma, mu) (a table's
+    region with no centre left out), as docs/family.md shows it."""
+    out("| sigma | mu | centres | F at Z | jump Z | jump F | event lambda | event F |")
+    out("|---|---|---|---|---|---|---|---|")
+    for slo, shi in REGIONS_SIGMA:
+        for mlo, mhi in REGIONS_MU:
+            sel = (table.err_sigma > slo) & (table.err_sigma < shi) & (table.err_mu > mlo) & (table.err_mu < mhi)
+            if not sel.any():
+                continue
+            cells = " | ".join(f"{np.median(table.errors[f][sel]):.2g} / {np.max(table.errors[f][sel]):.2g}"
+                               for f in ERROR_FIELDS)
+            out(f"| {table.err_sigma[sel].min():.3g} to {table.err_sigma[sel].max():.3g} | "
+                f"{table.err_mu[sel].min():.2g} to {table.err_mu[sel].max():.2g} | {int(sel.sum())} | {cells} |")
+
+
 def _parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="python -m petsc_adhesion.benchmarks.family", label="benchmarks.family")
     sub = p.add_subparsers(dest="command", required=True)
@@ -404,6 +425,8 @@ def _parser() -> argparse.ArgumentParser:
     j.add_argument("parts", nargs="+", help="tables on the same tau nodes and the same mu (or the same sigma)")
     j.add_argument("--errors-from", help="a measured table whose error at the midpoints the joined table "
                    "interpolates from the same nodes is kept (the others are to be measured)")
+    r = sub.add_parser("regions")
+    r.add_argument("table")
     s = sub.add_parser("speed")
     s.add_argument("table")
     s.add_argument("--repeats", type=int, default=20)
@@ -412,13 +435,16 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
-    if args.command == "speed":
+    if args.command in ("speed", "regions"):
         try:
             table = FamilyTable.load(args.table)
         except ValueError as e:
             say(str(e))
             return 2
-        speed(table, args.repeats)
+        if args.command == "regions" and not table.measured:
+            say(f"benchmarks.family: {args.table}: its error is not measured (measure it first)")
+            return 2
+        speed(table, args.repeats) if args.command == "speed" else regions(table)
         return 0
     if args.command in ("spacing", "join"):
         from ..family.build import join, keep_errors
