@@ -62,7 +62,7 @@ from ..model.parameters import Model, tabor
 from ..model.physical import Bodies
 from .data import MeasuredCurve
 from .branches import BRANCHES
-from .forward import APPROACH, RETRACT, ForwardCurve, rough_first, table_choice, table_covers, table_legs
+from .forward import APPROACH, RETRACT, ForwardCurve, aligned_contact, rough_first, table_choice, table_covers, table_legs
 from .domain import (MU_BOUNDS, SIGNAL, CurveFitError, OutsideDomain, baselines, calibrated_invols,
                      domain_reasons, features, refuse_a_line, refuse_empty)
 from .outcome import SIGMA_MAX, bounds, curve_spread, instrument_values, profiled, to_moduli, verdicts
@@ -426,8 +426,9 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
     names = pb.names
     reach = MU_BOUNDS if pb.table is None else (float(pb.table.mu[0]), float(pb.table.mu[-1]))
 
-    def start(E: float, sigma: float = sigma0) -> tuple[np.ndarray, float]:
-        w = bodies.gamma if bodies.gamma is not None else maugis_dugdale_gamma(P, R, E, eps)
+    def start(E: float, sigma: float = sigma0, w_rough: float | None = None) -> tuple[np.ndarray, float]:
+        # a rough start's w is the pull-off table's (start_gamma), never the smooth relation's, 30 times low at sigma 1
+        w = bodies.gamma if bodies.gamma is not None else w_rough or maugis_dugdale_gamma(P, R, E, eps)
         mu = min(max(tabor(R, w, E, eps), reach[0] * 1.01), reach[1] * 0.99)
         if pb.table is not None and "ln_gamma" in names:     # a held modulus: w's start, too, where the
             w = math.sqrt(mu**3 * E**2 * eps**3 / R)           # table holds mu (eq. 9 inverted)
@@ -439,7 +440,7 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
                  "drag": base[2] / noise}
         x = np.array([given[n_] for n_ in names], dtype=float)
         j = names.index("z0")
-        x[j] = _align(pb, x)
+        x[j] = aligned_contact(pb, x)
         if sloped:
             x[names.index("F0")] = (base[0] + base[1] * x[j] * eps) / noise
         return x, float(np.sum(pb._all(pb.unpack(x))[0] ** 2))
@@ -452,8 +453,8 @@ def fit_curve(data: MeasuredCurve, bodies: Bodies, spring: Spring, choice: FitCh
         mus = (0.1, 0.3, 1.0, 3.0) if pb.table is None else \
             [m for m in START_MUS if reach[0] <= m <= reach[1]] or [math.sqrt(reach[0] * reach[1])]
         sigmas = START_SIGMAS if pb.table is not None and choice.roughness else (sigma0,)
-        tries = [start((start_gamma(P, R, m, s_, w_guess) if s_ > 0 else w_guess) * math.sqrt(R / (m**3 * eps**3)),
-                       s_) for m in mus for s_ in sigmas]
+        ws = [(m, s_, start_gamma(P, R, m, s_, w_guess) if s_ > 0 else None) for m in mus for s_ in sigmas]
+        tries = [start((w_ or w_guess) * math.sqrt(R / (m**3 * eps**3)), s_, w_) for m, s_, w_ in ws]
         x0 = min(tries, key=lambda t: t[1])[0]   # (the others: table_search.searched)
     pb.leave_out_edges(x0)
     lo, hi = bounds(pb, choice, modulus)
@@ -535,27 +536,6 @@ def _path_note(path) -> str:
     return path.describe({"ln_E_star": "E*", "ln_gamma": "w", "z0": "z0", "F0": "F0", "sigma": "sigma",
                           "ln_invols": "the sensitivity", "ln_k": "k", "slope": "the virtual deflection",
                           "drag": "the drag"})
-
-
-def _align(pb: _Problem, x: np.ndarray) -> float:
-    """The contact point z0 / eps that best puts the model's curve on the data, the other parameters held: its
-    jump-off on the measured pull-off, then the least squares in z0 alone (Brent's bounded minimum)."""
-    from .. import brent
-
-    p = pb.unpack(x)
-    fc = pb.forward(p)
-    jumps = fc.jumps[RETRACT]
-    Z_off = jumps[-1] if jumps else fc.pieces[-1].Z_lo
-    guess = (pb.feat.pull_off_z_m - pb.data.direction * pb.eps * Z_off) / pb.eps
-    j = pb.names.index("z0")
-
-    def cost(z0):
-        y = x.copy()
-        y[j] = z0
-        return float(np.sum(pb._all(pb.unpack(y))[0] ** 2))
-
-    width = 2.0 + 0.1 * abs(Z_off)
-    return brent.minimum(cost, guess - width, guess + width, xatol=1e-4)
 
 
 def _fitted_features(pb: _Problem, p: dict, fc: ForwardCurve) -> FittedFeatures:

@@ -19,11 +19,13 @@ from __future__ import annotations
 import math
 import os
 
+import numpy as np
+
 from ..family.legs import APPROACH, RETRACT, Legs, Piece
 from ..family.table import SHIPPED, FamilyTable, default_table, shipped
 from ..tracing.legs import turn_of
 
-__all__ = ["Piece", "ForwardCurve", "APPROACH", "RETRACT", "curve_stop_reason", "curve_jumps", "pull_off_values",
+__all__ = ["Piece", "ForwardCurve", "aligned_contact", "APPROACH", "RETRACT", "curve_stop_reason", "curve_jumps", "pull_off_values",
            "open_table", "table_choice", "table_covers", "table_legs", "SIGMA_SEARCH", "rough_first"]
 
 
@@ -178,3 +180,29 @@ def table_legs(table: FamilyTable, mu: float, sigma: float, K: float, reach: flo
     contact continued linearly past the table's F_max, as a traced curve's past its end; its far branch
     tabulated beyond the base position ``reach``)."""
     return table.curve(mu, sigma, error=False).behind(K, reach).legs     # (the legs carry no error bars)
+
+
+def aligned_contact(pb, x: np.ndarray) -> float:
+    """The contact point z0 / eps that best puts the model's curve on the data, the other coordinates of ``x``
+    held (``pb``, the curve fit's problem): its jump-off (or, behind a lever stiffer than its well, its least
+    force) on the measured pull-off, then the least squares in z0 alone (Brent's bounded minimum)."""
+    from .. import brent
+
+    p = pb.unpack(x)
+    fc = pb.forward(p)
+    jumps = fc.jumps[RETRACT]
+    # without a jump-off the pull-off is the least force; the far end of the curve (as before) put every rough
+    # start 25 epsilon off (mu 0.0055, sigma 1, K 0.19), where the model is flat over the data and the search
+    # went to w's bound
+    low = min((fc.pieces[i] for i in fc.chains[RETRACT][0]), key=lambda piece: float(piece.F.min()))
+    Z_off = jumps[-1] if jumps else float(low.Z[int(np.argmin(low.F))])
+    guess = (pb.feat.pull_off_z_m - pb.data.direction * pb.eps * Z_off) / pb.eps
+    j = pb.names.index("z0")
+
+    def cost(z0):
+        y = x.copy()
+        y[j] = z0
+        return float(np.sum(pb._all(pb.unpack(y))[0] ** 2))
+
+    width = 2.0 + 0.1 * abs(Z_off)
+    return brent.minimum(cost, guess - width, guess + width, xatol=1e-4)
