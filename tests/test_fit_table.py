@@ -361,13 +361,18 @@ def test_case_134_of_the_coverage_study_is_fitted_on_the_rough_table():
 
 
 def test_a_mu_at_the_rough_tables_end_is_said_at_the_tables_bound():
-    """A curve of mu = 3 (sigma 0.3 held) searched on the rough table alone (mu to 1): its mu stops at the table's
-    end, and the warning names the table's range, not the model's (it said "mu = 1 is at the bound 1000 of the
-    model's range": the table is gone once the solver's curves take over, and the range was read from it)."""
+    """A curve of mu = 3 (sigma 0.3 held) searched on the rough table's nodes up to mu = 1 alone: its mu stops at
+    the table's end, and the warning names the table's range, not the model's (it said "mu = 1 is at the bound
+    1000 of the model's range": the table is gone once the solver's curves take over, and the range was read
+    from it)."""
+    from petsc_adhesion.family.build import select
+
+    rough = shipped("rough")
+    to_1 = select(rough, mu=np.flatnonzero(rough.mu <= 1.0 + 1e-9))
     mu, sigma = 3.0, 0.3
     data, E = _rough_curve(mu, sigma)
     tip = Bodies(radius=R, young1=None, poisson1=None, epsilon=EPS, rms=sigma * EPS)
-    fit = fit_curve(data, tip, Spring(1.0), table="rough")
+    fit = fit_curve(data, tip, Spring(1.0), table=to_1)
     said = [w for w in fit.warnings if "is at the bound" in w]
     assert fit.mu == pytest.approx(1.0, rel=0.02) and said, (fit.mu, fit.warnings)
     assert all("of the table's range [0.001, 1]" in w for w in said), said

@@ -376,7 +376,7 @@ def speed(table: FamilyTable, repeats: int = 20, out=print) -> None:
 
 #: The regions of docs/family.md's error table: sigma and mu ranges (the centres strictly inside).
 REGIONS_SIGMA = ((0.02, 0.2), (0.2, 0.5), (0.5, 1.0), (1.0, 3.0))
-REGIONS_MU = ((0.0, 0.03), (0.03, 1.0))
+REGIONS_MU = ((0.0, 0.03), (0.03, 1.0), (1.0, 10.0), (10.0, 1e3))
 
 
 def regions(table: FamilyTable, out=print) -> None:
