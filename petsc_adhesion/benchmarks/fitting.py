@@ -58,8 +58,9 @@ NOISE_SHARES = (0.003, 0.01, 0.03)
 #: pull-off since version 2; version 3: the fit's steps and bars on the solver's Jacobian, the rebuilt tables,
 #: the truths from mu = 20 on in units of mu; version 4: a rough truth's and a rough branch's bends bounded
 #: (-cont_dF_bend), a rough fit searched on the rough table first and from several sigma, a search on a table
-#: allowed 5 times the cap on evaluations; version 5: the rough table rebuilt with its nodes' bends bounded; version 6: the starts' contact point on the least force
-#: where a curve has no jump-off, a rough start's w the pull-off table's, the rough table to mu = 10).
+#: allowed 5 times the cap on evaluations; version 5: the rough table rebuilt with its nodes' bends bounded;
+#: version 6: the starts' contact point on the least force where a curve has no jump-off, a rough start's w the
+#: pull-off table's, the rough table to mu = 10).
 SIGMA_TOP = 2.0
 TABLE_COVERAGE_VERSION = 6
 #: In the order the cases run: one rough case after every ROUGH_EVERY smooth ones.
