@@ -680,3 +680,38 @@ def test_a_node_the_default_steps_leave_incomplete_is_traced_with_shorter_ones(m
     (pl, pF), = [(e.lam.value, e.F.value) for e in node.curve(mu, sigma).events() if e.kind == "pull_off"]
     want = _solver_events(coarse)["pull_off"][0][1]
     assert FINER == 0.25 and abs(pF - want) < 1e-4, (pF, want)
+
+
+def test_a_node_whose_default_trace_raises_is_traced_with_shorter_ones(monkeypatch):
+    """An event the default steps could not locate raised out of the build (mu 1000, sigma 1.5: "event location
+    failed near lambda = -52.2"), and the build of 200 nodes wrote nothing.  Now the node is traced again with
+    steps FINER as long, as an incomplete one is.  Here the default trace of a cheap node (mu 0.1, sigma 0.05)
+    is made to raise so: the node is tabulated from the shorter steps' curve, its pull-off that curve's located
+    one to 1e-5 (the sampling passes through the located turning points), and the second trace's steps are
+    FINER's, with 1 / FINER times the default's cap on steps."""
+    from petsc_adhesion.core.continuation import Settings
+    from petsc_adhesion.family import build as building
+    from petsc_adhesion.family.build import FINER
+    from petsc_adhesion.tracing import trace as tracing
+
+    mu, sigma = 0.1, 0.05
+    steps, caps, traced = [], [], []
+    trace, trace_curve = building.trace_node, tracing.trace_curve
+
+    def failing(m, s, F_max=building.F_MAX, comm=None, step=1.0):
+        steps.append(step)
+        if step == 1.0:
+            raise RuntimeError("event location failed near lambda = -52.2481")
+        traced.append(trace(m, s, F_max, comm, step))
+        return traced[-1]
+
+    def spy(model, settings=None, **kw):
+        caps.append(settings.max_steps)
+        return trace_curve(model, settings=settings, **kw)
+    monkeypatch.setattr(building, "trace_node", failing)
+    monkeypatch.setattr(tracing, "trace_curve", spy)
+    node = build(TableGrid(mu=(mu,), sigma=(sigma,), n_tau=150))
+    assert steps == [1.0, FINER] and caps == [math.ceil(Settings().max_steps / FINER)], (steps, caps)
+    (pF,) = [e.F.value for e in node.curve(mu, sigma).events() if e.kind == "pull_off"]
+    want = _solver_events(traced[0])["pull_off"][0][1]
+    assert abs(pF - want) < 1e-5, (pF, want)
