@@ -182,6 +182,13 @@ class Legs:
             out.append((float(before), float(after)))
         return out
 
+    def least_force(self, leg: str) -> tuple[float, float]:
+        """(Z, F) of the most tensile of the points on the pieces ``leg`` follows (its pull-off on the
+        retract)."""
+        piece = min((self.pieces[i] for i in self.chains[leg][0]), key=lambda p: float(p.F.min()))
+        k = int(np.argmin(piece.F))
+        return float(piece.Z[k]), float(piece.F[k])
+
     def steep(self, leg: str) -> float:
         """The width in Z, next to the first turning point of ``leg``, of the part of the branch before it that
         is steeper than the spring (|dF/dZ| > K, where dF/dlambda < -K/2): there the force goes as the square

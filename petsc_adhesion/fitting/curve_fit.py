@@ -543,7 +543,7 @@ def _fitted_features(pb: _Problem, p: dict, fc: ForwardCurve) -> FittedFeatures:
     in SI."""
     scale = p["gain"] * 2 * math.pi * pb.R * p["w"]         # the force as the file measures it
     ins, offs = fc.jumps[APPROACH], fc.jumps[RETRACT]
-    lowest = min(float(fc.pieces[i].F.min()) for i in fc.chains[RETRACT][0])
+    lowest = fc.least_force(RETRACT)[1]
     return FittedFeatures(pull_off_N=-lowest * scale,
                           jump_in_z_m=p["z0"] + pb.data.direction * pb.eps * ins[0] if ins else None,
                           jump_off_z_m=p["z0"] + pb.data.direction * pb.eps * offs[0] if offs else None)

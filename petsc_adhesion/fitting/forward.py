@@ -104,7 +104,6 @@ def rough_first(fit, choice, model, bodies, mu_bounds: tuple):
     at the table's end would stop at the table's bound, not the data's: where mu or its interval reaches that end
     the solver takes over; and where the search on the table ended in another valley than the data's (a misfit,
     as at mu = 0.3, sigma = 1.5 at 1% noise: reduced chi^2 121), the solver's own search is tried."""
-    import numpy as np
 
     from ..family.table import shipped_path
     from .results import BOUND_MARGIN, MISFIT_P
@@ -194,8 +193,7 @@ def aligned_contact(pb, x: np.ndarray) -> float:
     # without a jump-off the pull-off is the least force; the far end of the curve (as before) put every rough
     # start 25 epsilon off (mu 0.0055, sigma 1, K 0.19), where the model is flat over the data and the search
     # went to w's bound
-    low = min((fc.pieces[i] for i in fc.chains[RETRACT][0]), key=lambda piece: float(piece.F.min()))
-    Z_off = jumps[-1] if jumps else float(low.Z[int(np.argmin(low.F))])
+    Z_off = jumps[-1] if jumps else fc.least_force(RETRACT)[0]
     guess = (pb.feat.pull_off_z_m - pb.data.direction * pb.eps * Z_off) / pb.eps
     j = pb.names.index("z0")
 
